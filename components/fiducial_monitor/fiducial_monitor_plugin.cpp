@@ -1,0 +1,62 @@
+// fiducial_monitor: reports the rate, size and latency of a FiducialArray stream.
+#include <chrono>
+
+#include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+
+#include "stream_statistics.hpp"
+
+namespace mocap::demo {
+namespace {
+
+constexpr const char* kTopic = "/demo/fiducials";
+
+class FiducialMonitor final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description("Logs the rate, size and latency (stamp to arrival) of fiducial arrays.");
+    spec.parameter("report_period_s", 2.0, "seconds between reports").range(0.1, 3600);
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(kTopic, Qos::sensor_data(),
+                                                    "the stream to watch");
+  }
+
+  explicit FiducialMonitor(Context& context) : Component(context) {
+    period_s_ = param<double>("report_period_s");
+    create_subscription<mocap_msgs::msg::FiducialArray>(
+        kTopic, [this](const mocap_msgs::msg::FiducialArray& array) {
+          double latency = std::chrono::duration<double>(now() -
+                                                         from_time_msg(array.header().stamp()))
+                               .count();
+          statistics_.add(latency, array.fiducials().size());
+        });
+    create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                     std::chrono::duration<double>(period_s_)),
+                 [this] { report(); });
+  }
+
+  ~FiducialMonitor() override {
+    log().info("received {} arrays in all", statistics_.total_messages());
+  }
+
+ private:
+  void report() {
+    auto r = statistics_.report();
+    if (!r) {
+      log().info("nothing received in the last {} s", period_s_);
+      return;
+    }
+    log().info("{} arrays ({:.1f}/s), {:.1f} fiducials each, latency median {:.3f} ms, "
+               "p99 {:.3f} ms, max {:.3f} ms",
+               r->messages, static_cast<double>(r->messages) / period_s_, r->mean_items,
+               r->latency_median_s * 1e3, r->latency_p99_s * 1e3, r->latency_max_s * 1e3);
+  }
+
+  double period_s_;
+  StreamStatistics statistics_;
+};
+
+}  // namespace
+}  // namespace mocap::demo
+
+MOCAP_REGISTER_COMPONENT(mocap::demo::FiducialMonitor, "fiducial_monitor")

@@ -1,0 +1,174 @@
+// The component API: everything a plugin needs, and the one macro that registers it.
+//
+//   class Doubler final : public mocap::Component {
+//    public:
+//     static void declare(mocap::ComponentSpec& spec);   // parameters and topics
+//     explicit Doubler(mocap::Context& context) : Component(context) {
+//       output_ = create_publisher<Msg>("/out");
+//       create_subscription<Msg>("/in", [this](const Msg& in) { output_.publish(twice(in)); });
+//     }
+//    private:
+//     mocap::Publisher<Msg> output_;
+//   };
+//   MOCAP_REGISTER_COMPONENT(Doubler, "doubler")
+//
+// A component's callbacks never run concurrently with each other, so a component needs no
+// locks of its own; different components run in parallel on the executor's threads. A
+// component does not know whether its peers are in its process, another process or another
+// host: topics are delivered in-process by pointer and to other processes over DDS.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <utility>
+
+#include <mocap/component_spec.hpp>
+#include <mocap/logger.hpp>
+#include <mocap/message_type.hpp>
+#include <mocap/parameter.hpp>
+#include <mocap/qos.hpp>
+
+namespace mocap {
+
+using Clock = std::chrono::system_clock;
+
+// The runtime side of a publisher.
+class PublisherPort {
+ public:
+  virtual ~PublisherPort() = default;
+  virtual void publish(std::shared_ptr<const void> message) = 0;
+  // Matched subscriptions in this process and in others.
+  virtual size_t matched_subscribers() const = 0;
+  // The topic after remapping.
+  virtual const std::string& topic() const = 0;
+};
+
+template <class Message>
+class Publisher {
+ public:
+  Publisher() = default;
+
+  // In-process subscribers receive this very pointer; other processes a serialized copy.
+  void publish(std::shared_ptr<const Message> message) const { port_->publish(std::move(message)); }
+  void publish(Message message) const {
+    publish(std::make_shared<const Message>(std::move(message)));
+  }
+  size_t matched_subscribers() const { return port_->matched_subscribers(); }
+  const std::string& topic() const { return port_->topic(); }
+  explicit operator bool() const { return port_ != nullptr; }
+
+ private:
+  friend class Component;
+  explicit Publisher(std::shared_ptr<PublisherPort> port) : port_(std::move(port)) {}
+  std::shared_ptr<PublisherPort> port_;
+};
+
+using MessageCallback = std::function<void(const std::shared_ptr<const void>&)>;
+
+// What the runtime gives a component. Topic names passed here are the declared ones; the
+// context applies the launch file's remaps and QoS overrides.
+class Context {
+ public:
+  virtual ~Context() = default;
+  virtual const std::string& name() const = 0;
+  virtual const Parameters& parameters() const = 0;
+  virtual const Logger& logger() const = 0;
+  virtual Clock::time_point now() const = 0;
+  virtual std::shared_ptr<PublisherPort> advertise(std::string_view topic,
+                                                   const MessageType& type) = 0;
+  virtual void subscribe(std::string_view topic, const MessageType& type,
+                         MessageCallback callback) = 0;
+  virtual void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) = 0;
+  // Ends the process's run once the current callbacks return; the process exits with
+  // `exit_code` (the largest requested, if several components ask).
+  virtual void request_shutdown(int exit_code) = 0;
+};
+
+class Component {
+ public:
+  explicit Component(Context& context) : context_(context) {}
+  virtual ~Component() = default;
+  Component(const Component&) = delete;
+  Component& operator=(const Component&) = delete;
+
+  const std::string& name() const { return context_.name(); }
+
+ protected:
+  template <class Message>
+  Publisher<Message> create_publisher(std::string_view topic) {
+    return Publisher<Message>(context_.advertise(topic, message_type<Message>()));
+  }
+
+  // `callback` takes `const Message&` or `const std::shared_ptr<const Message>&`; keep the
+  // shared pointer to hold on to a message without copying it.
+  template <class Message, class Callback>
+  void create_subscription(std::string_view topic, Callback&& callback) {
+    context_.subscribe(topic, message_type<Message>(),
+                       [cb = std::forward<Callback>(callback)](const std::shared_ptr<const void>& m) {
+                         auto typed = std::static_pointer_cast<const Message>(m);
+                         if constexpr (std::is_invocable_v<Callback&,
+                                                           const std::shared_ptr<const Message>&>) {
+                           cb(typed);
+                         } else {
+                           cb(*typed);
+                         }
+                       });
+  }
+
+  // Runs `callback` every `period` (steady clock). Late ticks are not queued: a callback
+  // slower than its period runs back to back, not in a burst.
+  template <class Callback>
+  void create_timer(std::chrono::nanoseconds period, Callback&& callback) {
+    context_.add_timer(period, std::forward<Callback>(callback));
+  }
+
+  template <class T>
+  T param(std::string_view name) const {
+    return context_.parameters().get<T>(name);
+  }
+  const Logger& log() const { return context_.logger(); }
+  Clock::time_point now() const { return context_.now(); }
+  void request_shutdown(int exit_code = 0) { context_.request_shutdown(exit_code); }
+  Context& context() const { return context_; }
+
+ private:
+  Context& context_;
+};
+
+// What a plugin library exports, through MOCAP_REGISTER_COMPONENT.
+struct ComponentFactory {
+  // Raised whenever Component, Context or this struct change layout.
+  static constexpr uint32_t kAbiVersion = 1;
+  static constexpr const char* kSymbol = "mocap_component_factory";
+
+  uint32_t abi_version;
+  const char* name;
+  void (*declare)(ComponentSpec& spec);
+  std::unique_ptr<Component> (*create)(Context& context);
+};
+
+template <class ComponentClass>
+constexpr ComponentFactory make_component_factory(const char* name) {
+  static_assert(std::is_base_of_v<Component, ComponentClass>, "components derive mocap::Component");
+  return {ComponentFactory::kAbiVersion, name, &ComponentClass::declare,
+          [](Context& context) -> std::unique_ptr<Component> {
+            return std::make_unique<ComponentClass>(context);
+          }};
+}
+
+}  // namespace mocap
+
+// Makes the enclosing shared library a plugin named `plugin_name` (the launch files'
+// `plugin:` value). One component per library.
+#define MOCAP_REGISTER_COMPONENT(ComponentClass, plugin_name)                                  \
+  extern "C" __attribute__((visibility("default"))) const ::mocap::ComponentFactory*           \
+  mocap_component_factory() {                                                                   \
+    static constexpr ::mocap::ComponentFactory factory =                                        \
+        ::mocap::make_component_factory<ComponentClass>(plugin_name);                           \
+    return &factory;                                                                            \
+  }

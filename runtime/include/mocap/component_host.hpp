@@ -1,0 +1,90 @@
+// One process's share of a graph: its components, executor, timers and transports.
+//
+// mocap_launch builds one host per launch-file group. Tests and benchmarks use it directly:
+//
+//   mocap::ComponentHost host({.name = "test", .dds = {.enabled = false}});
+//   host.add(mocap::make_component_factory<Source>("source"), {.name = "source"});
+//   host.add(mocap::make_component_factory<Sink>("sink"), {.name = "sink"});
+//   int exit_code = host.run(std::chrono::seconds(2));
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <mocap/component.hpp>
+#include <mocap/parameter.hpp>
+#include <mocap/qos.hpp>
+
+namespace mocap {
+
+struct DdsOptions {
+  // Off: the process talks to nobody outside itself (no participant is created).
+  bool enabled = true;
+  // 0..232; the MOCAP_DOMAIN_ID environment variable overrides it.
+  int domain_id = 0;
+  // Off: UDP only. Needed between containers that do not share /dev/shm, and to force the
+  // network path between network namespaces.
+  bool shared_memory = true;
+};
+
+struct HostOptions {
+  std::string name = "mocap";  // process name; also the DDS participant name
+  int threads = 0;             // executor threads; 0: one per CPU core
+  DdsOptions dds;
+};
+
+struct ComponentConfig {
+  std::string name;
+  // Parameters not given take their declared defaults.
+  std::map<std::string, ParameterValue> parameters;
+  // Declared topic -> topic actually used.
+  std::map<std::string, std::string> remaps;
+  // Declared topic -> QoS replacing the declared one.
+  std::map<std::string, Qos> qos;
+};
+
+// A component that could not be configured or constructed; the message names it.
+class ComponentError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class ComponentHost {
+ public:
+  explicit ComponentHost(HostOptions options = {});
+  ~ComponentHost();  // stops, then destroys components in reverse order of addition
+  ComponentHost(const ComponentHost&) = delete;
+  ComponentHost& operator=(const ComponentHost&) = delete;
+
+  // Checks `config` against the factory's declaration and constructs the component. Throws
+  // ComponentError naming the component, for bad configuration or a throwing constructor.
+  Component& add(const ComponentFactory& factory, ComponentConfig config);
+
+  // Starts callbacks and timers. Components added later start at once.
+  void start();
+  // start(), then blocks until SIGINT or SIGTERM, a component's request_shutdown(), or
+  // `duration`; then stop(). Returns the exit code: 0, or what components requested.
+  int run(std::optional<std::chrono::duration<double>> duration = std::nullopt);
+  // Waits for running callbacks to return; no callback runs afterwards.
+  void stop();
+
+  // Callbacks that threw, over all components.
+  uint64_t callback_errors() const;
+  const HostOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Every problem with `config` for a component declared by `spec` ("parameter 'x' expects
+// double, got string "a""), or an empty list. Also used by the launch file validation.
+std::vector<std::string> check_component_config(const ComponentSpec& spec,
+                                                const ComponentConfig& config);
+
+}  // namespace mocap

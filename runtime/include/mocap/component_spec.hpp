@@ -1,0 +1,90 @@
+// What a component declares before it exists: a description, parameters and topics.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <mocap/message_type.hpp>
+#include <mocap/parameter.hpp>
+#include <mocap/qos.hpp>
+
+namespace mocap {
+
+enum class TopicDirection { Publish, Subscribe };
+
+struct TopicSpec {
+  std::string topic;  // default name; launch files may remap it
+  const MessageType* type = nullptr;
+  TopicDirection direction = TopicDirection::Publish;
+  Qos qos;  // default; launch files may override it
+  std::string description;
+};
+
+// The declaration lets the launcher validate a launch file, and `mocap_launch --describe`
+// document a plugin, without constructing the component (which may open devices).
+//
+//   static void declare(mocap::ComponentSpec& spec) {
+//     spec.description("Finds bright round fiducials in mono8 images.");
+//     spec.parameter("threshold_ratio", 0.75, "threshold as a fraction of the brightest pixel")
+//         .range(0.0, 1.0);
+//     spec.subscribes<sensor_msgs::msg::Image>("/camera/ir/image_raw", mocap::Qos::sensor_data(),
+//                                              "camera images, mono8");
+//     spec.publishes<mocap_msgs::msg::FiducialArray>("/mocap/fiducials", mocap::Qos::reliable(),
+//                                                    "one array per image");
+//   }
+class ComponentSpec {
+ public:
+  class ParameterDeclaration {
+   public:
+    // Inclusive bounds, checked for numbers and for every element of number lists.
+    ParameterDeclaration& range(double min, double max);
+    ParameterDeclaration& min(double min);
+    ParameterDeclaration& max(double max);
+
+   private:
+    friend class ComponentSpec;
+    ParameterDeclaration(ComponentSpec& spec, size_t index) : spec_(spec), index_(index) {}
+    ParameterSpec& parameter();
+    ComponentSpec& spec_;
+    size_t index_;
+  };
+
+  void description(std::string text) { description_ = std::move(text); }
+
+  // The type is that of the default: bool, an integer, a floating-point number, a string,
+  // or a std::vector of int64_t, int, double or std::string.
+  template <class T>
+  ParameterDeclaration parameter(std::string name, T default_value, std::string description) {
+    return add_parameter(std::move(name), detail::to_parameter_value(std::move(default_value)),
+                         std::move(description));
+  }
+
+  template <class Message>
+  void publishes(std::string topic, Qos qos, std::string description) {
+    add_topic({std::move(topic), &message_type<Message>(), TopicDirection::Publish, qos,
+               std::move(description)});
+  }
+  template <class Message>
+  void subscribes(std::string topic, Qos qos, std::string description) {
+    add_topic({std::move(topic), &message_type<Message>(), TopicDirection::Subscribe, qos,
+               std::move(description)});
+  }
+
+  const std::string& description() const { return description_; }
+  const std::vector<ParameterSpec>& parameters() const { return parameters_; }
+  const std::vector<TopicSpec>& topics() const { return topics_; }
+  const ParameterSpec* find_parameter(std::string_view name) const;
+  const TopicSpec* find_topic(std::string_view topic) const;
+
+ private:
+  ParameterDeclaration add_parameter(std::string name, ParameterValue default_value,
+                                     std::string description);
+  void add_topic(TopicSpec topic);
+
+  std::string description_;
+  std::vector<ParameterSpec> parameters_;
+  std::vector<TopicSpec> topics_;
+};
+
+}  // namespace mocap

@@ -1,0 +1,343 @@
+#include <mocap/component_host.hpp>
+
+#include <algorithm>
+#include <atomic>
+
+#include <fmt/format.h>
+
+#include "executor.hpp"
+#include "fastdds_transport.hpp"
+#include "intra_process_transport.hpp"
+#include "shutdown_signal.hpp"
+#include "names.hpp"
+#include "timer_service.hpp"
+
+namespace mocap {
+namespace {
+
+std::string format_period(std::chrono::nanoseconds period) {
+  double seconds = std::chrono::duration<double>(period).count();
+  if (seconds >= 1.0) return fmt::format("{:g} s", seconds);
+  if (seconds >= 1e-3) return fmt::format("{:g} ms", seconds * 1e3);
+  return fmt::format("{:g} us", seconds * 1e6);
+}
+
+std::string declared_topics(const ComponentSpec& spec) {
+  std::vector<std::string> names;
+  for (const TopicSpec& topic : spec.topics()) names.push_back(topic.topic);
+  return names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "));
+}
+
+// A publisher as components see it: one port per transport.
+class HostPublisher final : public PublisherPort {
+ public:
+  explicit HostPublisher(std::string topic) : topic_(std::move(topic)) {}
+
+  void publish(std::shared_ptr<const void> message) override {
+    if (message == nullptr) throw std::invalid_argument("publish() of a null message on " + topic_);
+    Clock::time_point now = Clock::now();
+    for (auto& port : ports_) port->publish(message, now);
+  }
+
+  size_t matched_subscribers() const override {
+    size_t count = 0;
+    for (const auto& port : ports_) count += port->matched_subscribers();
+    return count;
+  }
+
+  const std::string& topic() const override { return topic_; }
+
+  std::vector<std::unique_ptr<TransportPublisher>> ports_;
+
+ private:
+  std::string topic_;
+};
+
+// A subscription as the executor sees it: takes from every transport in turn.
+class HostSubscription final : public Waitable {
+ public:
+  HostSubscription(std::string label, MessageCallback callback)
+      : Waitable(std::move(label)), callback_(std::move(callback)) {}
+
+  bool execute_one() override {
+    ReceivedMessage received;
+    for (size_t i = 0; i < sources_.size(); ++i) {
+      // Round robin, so that a busy transport cannot starve another.
+      size_t index = (next_ + i) % sources_.size();
+      if (sources_[index]->take(received)) {
+        next_ = index + 1;
+        callback_(received.message);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  std::vector<std::unique_ptr<TransportSubscription>> sources_;
+
+ private:
+  MessageCallback callback_;
+  size_t next_ = 0;
+};
+
+}  // namespace
+
+std::vector<std::string> check_component_config(const ComponentSpec& spec,
+                                                const ComponentConfig& config) {
+  std::vector<std::string> problems;
+  std::vector<std::string> parameter_names;
+  for (const ParameterSpec& p : spec.parameters()) parameter_names.push_back(p.name);
+  for (const auto& [name, value] : config.parameters) {
+    const ParameterSpec* parameter = spec.find_parameter(name);
+    if (parameter == nullptr) {
+      problems.push_back(fmt::format("unknown parameter '{}'{}", name,
+                                     did_you_mean(name, parameter_names, "parameters")));
+    } else if (auto why = parameter->check(value)) {
+      problems.push_back(fmt::format("parameter '{}' {}", name, *why));
+    }
+  }
+  std::vector<std::string> topic_names;
+  for (const TopicSpec& t : spec.topics()) topic_names.push_back(t.topic);
+  for (const auto& [from, to] : config.remaps) {
+    if (spec.find_topic(from) == nullptr) {
+      problems.push_back(fmt::format("remap of unknown topic '{}'{}", from,
+                                     did_you_mean(from, topic_names, "topics")));
+    }
+    if (!valid_topic_name(to)) {
+      problems.push_back(fmt::format("remap target '{}' is not a topic name (like /a/b_c)", to));
+    }
+  }
+  for (const auto& [topic, qos] : config.qos) {
+    if (spec.find_topic(topic) == nullptr) {
+      problems.push_back(fmt::format("QoS for unknown topic '{}'{}", topic,
+                                     did_you_mean(topic, topic_names, "topics")));
+    }
+  }
+  return problems;
+}
+
+// ---------------------------------------------------------------------------------------
+
+struct ComponentHost::Impl {
+  class ComponentContext;
+
+  explicit Impl(HostOptions host_options)
+      : options(std::move(host_options)), executor(options.threads), logger(options.name) {
+    transports.push_back(std::make_unique<IntraProcessTransport>());
+    if (options.dds.enabled) {
+      transports.push_back(std::make_unique<FastDdsTransport>(options.dds, options.name));
+    }
+  }
+
+  void request_shutdown(int code) {
+    int current = exit_code.load();
+    while (code > current && !exit_code.compare_exchange_weak(current, code)) {
+    }
+    shutdown_requested.store(true);
+    ShutdownSignal::wake();
+  }
+
+  HostOptions options;
+  Executor executor;
+  TimerService timers;
+  Logger logger;
+  std::vector<std::unique_ptr<Transport>> transports;
+  // Declared after the transports: destroyed before them.
+  std::vector<std::unique_ptr<ComponentContext>> contexts;
+  std::vector<std::unique_ptr<Component>> components;
+  std::atomic<bool> shutdown_requested{false};
+  std::atomic<int> exit_code{0};
+  bool started = false;
+};
+
+class ComponentHost::Impl::ComponentContext final : public Context {
+ public:
+  ComponentContext(Impl& host, ComponentSpec spec, ComponentConfig config, Parameters parameters)
+      : host_(host),
+        spec_(std::move(spec)),
+        config_(std::move(config)),
+        parameters_(std::move(parameters)),
+        logger_(config_.name),
+        strand_(host.executor, logger_) {}
+
+  ~ComponentContext() override {
+    for (const auto& timer : timers_) host_.timers.remove(timer.get());
+    // Transport endpoints go first, so that nothing notifies the strand once it is gone.
+    publishers_.clear();
+    waitables_.clear();
+  }
+
+  const std::string& name() const override { return config_.name; }
+  const Parameters& parameters() const override { return parameters_; }
+  const Logger& logger() const override { return logger_; }
+  Clock::time_point now() const override { return Clock::now(); }
+
+  std::shared_ptr<PublisherPort> advertise(std::string_view topic,
+                                           const MessageType& type) override {
+    Endpoint endpoint = resolve(topic, type, TopicDirection::Publish);
+    auto publisher = std::make_shared<HostPublisher>(endpoint.topic);
+    for (auto& transport : host_.transports) {
+      publisher->ports_.push_back(transport->advertise(endpoint));
+    }
+    publishers_.push_back(publisher);
+    return publisher;
+  }
+
+  void subscribe(std::string_view topic, const MessageType& type,
+                 MessageCallback callback) override {
+    Endpoint endpoint = resolve(topic, type, TopicDirection::Subscribe);
+    auto subscription =
+        std::make_shared<HostSubscription>("subscription to " + endpoint.topic, std::move(callback));
+    for (auto& transport : host_.transports) {
+      subscription->sources_.push_back(
+          transport->subscribe(endpoint, [strand = &strand_] { strand->notify(); }));
+    }
+    waitables_.push_back(subscription);
+    strand_.add(subscription);
+  }
+
+  void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) override {
+    if (period <= std::chrono::nanoseconds::zero()) {
+      throw std::invalid_argument(fmt::format("timer period must be positive, got {} ns",
+                                              period.count()));
+    }
+    auto timer = std::make_shared<Timer>("timer every " + format_period(period), period,
+                                         std::move(callback), strand_);
+    timers_.push_back(timer);
+    waitables_.push_back(timer);
+    strand_.add(timer);
+    host_.timers.add(timer);
+  }
+
+  void request_shutdown(int exit_code) override { host_.request_shutdown(exit_code); }
+
+  Strand& strand() { return strand_; }
+
+ private:
+  Endpoint resolve(std::string_view topic, const MessageType& type, TopicDirection direction) {
+    const TopicSpec* declared = spec_.find_topic(topic);
+    std::string_view verb = direction == TopicDirection::Publish ? "publishes" : "subscribes";
+    if (declared == nullptr) {
+      throw std::logic_error(fmt::format("component '{}' {} to '{}', which its declare() does not "
+                                         "declare (declared: {})",
+                                         config_.name, verb, topic, declared_topics(spec_)));
+    }
+    if (declared->type != &type || declared->direction != direction) {
+      throw std::logic_error(fmt::format(
+          "component '{}' {} to '{}' with {}, but declares it as {} ({})", config_.name, verb,
+          topic, type.name(), declared->type->name(),
+          declared->direction == TopicDirection::Publish ? "published" : "subscribed"));
+    }
+    Endpoint endpoint{declared->topic, &type, declared->qos, config_.name};
+    if (auto it = config_.remaps.find(declared->topic); it != config_.remaps.end()) {
+      endpoint.topic = it->second;
+    }
+    if (auto it = config_.qos.find(declared->topic); it != config_.qos.end()) {
+      endpoint.qos = it->second;
+    }
+    return endpoint;
+  }
+
+  Impl& host_;
+  ComponentSpec spec_;
+  ComponentConfig config_;
+  Parameters parameters_;
+  Logger logger_;
+  Strand strand_;
+  std::vector<std::shared_ptr<HostPublisher>> publishers_;
+  std::vector<std::shared_ptr<Waitable>> waitables_;
+  std::vector<std::shared_ptr<Timer>> timers_;
+};
+
+// ---------------------------------------------------------------------------------------
+
+ComponentHost::ComponentHost(HostOptions options)
+    : impl_(std::make_unique<Impl>(std::move(options))) {}
+
+ComponentHost::~ComponentHost() {
+  stop();
+  while (!impl_->components.empty()) {
+    impl_->components.pop_back();
+    impl_->contexts.pop_back();
+  }
+}
+
+Component& ComponentHost::add(const ComponentFactory& factory, ComponentConfig config) {
+  ComponentSpec spec;
+  factory.declare(spec);
+  std::string label = fmt::format("component '{}' ({})", config.name, factory.name);
+  if (!valid_component_name(config.name)) {
+    throw ComponentError(fmt::format("{}: names use letters, digits, '_' and '-'", label));
+  }
+  for (const auto& context : impl_->contexts) {
+    if (context->name() == config.name) throw ComponentError(label + ": the name is taken");
+  }
+  std::vector<std::string> problems = check_component_config(spec, config);
+  if (!problems.empty()) {
+    throw ComponentError(fmt::format("{}: {}", label, fmt::join(problems, "; ")));
+  }
+
+  std::map<std::string, ParameterValue, std::less<>> values;
+  for (const ParameterSpec& parameter : spec.parameters()) {
+    auto given = config.parameters.find(parameter.name);
+    values[parameter.name] =
+        given == config.parameters.end() ? parameter.default_value : parameter.coerce(given->second);
+  }
+
+  auto context = std::make_unique<Impl::ComponentContext>(*impl_, std::move(spec), std::move(config),
+                                                          Parameters(std::move(values)));
+  std::unique_ptr<Component> component;
+  try {
+    component = factory.create(*context);
+  } catch (const std::exception& e) {
+    throw ComponentError(fmt::format("{} failed to start: {}", label, e.what()));
+  }
+  context->strand().enable();
+  impl_->contexts.push_back(std::move(context));
+  impl_->components.push_back(std::move(component));
+  return *impl_->components.back();
+}
+
+void ComponentHost::start() {
+  if (impl_->started) return;
+  impl_->started = true;
+  impl_->executor.start();
+  impl_->timers.start();
+}
+
+int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
+  ShutdownSignal::install();
+  start();
+  auto deadline =
+      duration ? std::chrono::steady_clock::now() +
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(*duration)
+               : std::chrono::steady_clock::time_point::max();
+  while (!impl_->shutdown_requested.load()) {
+    std::optional<std::chrono::steady_clock::duration> left;
+    if (duration) {
+      left = deadline - std::chrono::steady_clock::now();
+      if (*left <= std::chrono::steady_clock::duration::zero()) break;
+    }
+    if (ShutdownSignal::wait(left)) {
+      impl_->logger.info("shutting down on signal");
+      break;
+    }
+  }
+  stop();
+  return impl_->exit_code.load();
+}
+
+void ComponentHost::stop() {
+  impl_->timers.stop();
+  impl_->executor.stop();
+}
+
+uint64_t ComponentHost::callback_errors() const {
+  uint64_t errors = 0;
+  for (const auto& context : impl_->contexts) errors += context->strand().callback_errors();
+  return errors;
+}
+
+const HostOptions& ComponentHost::options() const { return impl_->options; }
+
+}  // namespace mocap

@@ -1,0 +1,63 @@
+#include <mocap/component_spec.hpp>
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace mocap {
+
+ParameterSpec& ComponentSpec::ParameterDeclaration::parameter() {
+  return spec_.parameters_[index_];
+}
+
+ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::range(double min,
+                                                                                double max) {
+  return this->min(min).max(max);
+}
+
+ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::min(double min) {
+  parameter().min = min;
+  return *this;
+}
+
+ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::max(double max) {
+  parameter().max = max;
+  return *this;
+}
+
+const ParameterSpec* ComponentSpec::find_parameter(std::string_view name) const {
+  for (const ParameterSpec& p : parameters_) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+const TopicSpec* ComponentSpec::find_topic(std::string_view topic) const {
+  for (const TopicSpec& t : topics_) {
+    if (t.topic == topic) return &t;
+  }
+  return nullptr;
+}
+
+ComponentSpec::ParameterDeclaration ComponentSpec::add_parameter(std::string name,
+                                                                 ParameterValue default_value,
+                                                                 std::string description) {
+  if (find_parameter(name) != nullptr) {
+    throw std::logic_error(fmt::format("parameter '{}' is declared twice", name));
+  }
+  parameters_.push_back({std::move(name), std::move(default_value), std::move(description),
+                         std::nullopt, std::nullopt});
+  return ParameterDeclaration(*this, parameters_.size() - 1);
+}
+
+void ComponentSpec::add_topic(TopicSpec topic) {
+  if (find_topic(topic.topic) != nullptr) {
+    throw std::logic_error(fmt::format("topic '{}' is declared twice", topic.topic));
+  }
+  if (!topic.topic.starts_with('/')) {
+    throw std::logic_error(fmt::format("topic '{}' must start with '/'", topic.topic));
+  }
+  topics_.push_back(std::move(topic));
+}
+
+}  // namespace mocap

@@ -1,0 +1,116 @@
+#include "executor.hpp"
+
+#include <algorithm>
+#include <exception>
+
+namespace mocap {
+
+Executor::Executor(int threads)
+    : thread_count_(threads > 0 ? threads
+                                : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {}
+
+Executor::~Executor() { stop(); }
+
+void Executor::start() {
+  std::lock_guard lock(mutex_);
+  if (!threads_.empty() || stopping_) return;
+  for (int i = 0; i < thread_count_; ++i) threads_.emplace_back([this] { work(); });
+}
+
+void Executor::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    ready_.clear();
+  }
+  ready_cv_.notify_all();
+  for (std::thread& thread : threads_) {
+    if (thread.joinable()) thread.join();
+  }
+  threads_.clear();
+}
+
+void Executor::schedule(Strand* strand) {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return;
+    ready_.push_back(strand);
+  }
+  ready_cv_.notify_one();
+}
+
+void Executor::work() {
+  for (;;) {
+    Strand* strand;
+    {
+      std::unique_lock lock(mutex_);
+      ready_cv_.wait(lock, [this] { return stopping_ || !ready_.empty(); });
+      if (stopping_) return;
+      strand = ready_.front();
+      ready_.pop_front();
+    }
+    strand->run();
+  }
+}
+
+void Strand::add(std::shared_ptr<Waitable> waitable) {
+  waitables_.push_back(std::move(waitable));
+}
+
+void Strand::remove(const Waitable* waitable) {
+  std::erase_if(waitables_, [&](const auto& w) { return w.get() == waitable; });
+}
+
+void Strand::notify() {
+  pending_.store(true);
+  if (enabled_.load() && !scheduled_.exchange(true)) executor_.schedule(this);
+}
+
+void Strand::enable() {
+  enabled_.store(true);
+  if (pending_.load() && !scheduled_.exchange(true)) executor_.schedule(this);
+}
+
+bool Strand::execute(Waitable& waitable) {
+  try {
+    return waitable.execute_one();
+  } catch (const std::exception& e) {
+    callback_errors_.fetch_add(1);
+    if (auto count = waitable.error_log_.count()) {
+      logger_.error("callback for {} threw ({} time(s) since last report): {}", waitable.label(),
+                    *count, e.what());
+    }
+  } catch (...) {
+    callback_errors_.fetch_add(1);
+    if (auto count = waitable.error_log_.count()) {
+      logger_.error("callback for {} threw a non-standard exception ({} time(s))",
+                    waitable.label(), *count);
+    }
+  }
+  return true;
+}
+
+void Strand::run() {
+  int budget = kBudget;
+  for (;;) {
+    pending_.store(false);
+    bool did_work = false;
+    // Index loop: a callback may add waitables to its own strand.
+    for (size_t i = 0; i < waitables_.size(); ++i) {
+      std::shared_ptr<Waitable> waitable = waitables_[i];
+      while (execute(*waitable)) {
+        did_work = true;
+        if (--budget == 0) {
+          executor_.schedule(this);  // stays scheduled; other strands get the thread first
+          return;
+        }
+      }
+    }
+    if (!did_work) break;
+  }
+  scheduled_.store(false);
+  // A notification that raced with the last pass must not be lost.
+  if (pending_.load() && !scheduled_.exchange(true)) executor_.schedule(this);
+}
+
+}  // namespace mocap

@@ -1,0 +1,95 @@
+// Runs component callbacks on a pool of threads, one component at a time per component.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <mocap/logger.hpp>
+
+#include "throttle.hpp"
+
+namespace mocap {
+
+class Strand;
+
+// A source of callbacks: a subscription or a timer.
+class Waitable {
+ public:
+  explicit Waitable(std::string label) : label_(std::move(label)) {}
+  virtual ~Waitable() = default;
+  // Runs at most one callback; false when there was nothing to do.
+  virtual bool execute_one() = 0;
+  const std::string& label() const { return label_; }
+
+ private:
+  std::string label_;
+  friend class Strand;
+  Throttle error_log_;
+};
+
+// A fixed pool of threads that runs ready strands in FIFO order.
+class Executor {
+ public:
+  explicit Executor(int threads);  // threads <= 0: one per CPU core
+  ~Executor();
+  Executor(const Executor&) = delete;
+  Executor& operator=(const Executor&) = delete;
+
+  void start();
+  // Lets running callbacks finish, then joins the threads. Later schedule() calls are ignored.
+  void stop();
+  void schedule(Strand* strand);
+  int threads() const { return thread_count_; }
+
+ private:
+  void work();
+
+  int thread_count_;
+  std::mutex mutex_;
+  std::condition_variable ready_cv_;
+  std::deque<Strand*> ready_;
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
+// The callbacks of one component. They run one at a time, in any executor thread; a strand
+// with work is queued once however many notifications arrive.
+class Strand {
+ public:
+  Strand(Executor& executor, const Logger& logger) : executor_(executor), logger_(logger) {}
+
+  // Not thread-safe against run(): call while the strand cannot run, or from its callbacks.
+  void add(std::shared_ptr<Waitable> waitable);
+  void remove(const Waitable* waitable);
+  // Thread-safe; called by transports and timers when a waitable may have work.
+  void notify();
+  // A strand runs nothing before it is enabled, so that a component's subscriptions cannot
+  // call into it before its constructor has returned. Notifications are kept until then.
+  void enable();
+  // Called by the executor.
+  void run();
+  uint64_t callback_errors() const { return callback_errors_.load(); }
+
+ private:
+  // Callbacks before the strand yields its thread to other strands.
+  static constexpr int kBudget = 64;
+
+  bool execute(Waitable& waitable);
+
+  Executor& executor_;
+  const Logger& logger_;
+  std::vector<std::shared_ptr<Waitable>> waitables_;
+  std::atomic<bool> enabled_{false};
+  std::atomic<bool> scheduled_{false};
+  std::atomic<bool> pending_{false};
+  std::atomic<uint64_t> callback_errors_{0};
+};
+
+}  // namespace mocap

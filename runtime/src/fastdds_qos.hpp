@@ -1,0 +1,24 @@
+// Our QoS and host options as Fast DDS QoS. Shared by the transport and the benchmark's raw
+// Fast DDS reference, so both run with the very same settings.
+#pragma once
+
+#include <string>
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+#include <mocap/component_host.hpp>
+#include <mocap/qos.hpp>
+
+namespace mocap {
+
+eprosima::fastdds::dds::DataWriterQos to_writer_qos(const Qos& qos);
+eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);
+eprosima::fastdds::dds::DomainParticipantQos to_participant_qos(const DdsOptions& options,
+                                                                const std::string& name);
+
+// How long a reliable publisher waits for a subscriber that is `depth` samples behind.
+constexpr int kReliableBlockingMilliseconds = 100;
+
+}  // namespace mocap

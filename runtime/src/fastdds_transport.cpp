@@ -1,0 +1,359 @@
+#include "fastdds_transport.hpp"
+
+#include <atomic>
+#include <charconv>
+#include <cstdlib>
+#include <stdexcept>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/common/InstanceHandle.h>
+#include <fastrtps/rtps/builtin/data/ReaderProxyData.h>
+#include <fastrtps/rtps/builtin/data/WriterProxyData.h>
+#include <fmt/format.h>
+
+#include "fastdds_qos.hpp"
+#include "fastdds_type_adapter.hpp"
+
+namespace mocap {
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace {
+
+rtps::GuidPrefix_t prefix_of(const rtps::InstanceHandle_t& handle) {
+  rtps::GUID_t guid;
+  rtps::iHandle2GUID(guid, handle);
+  return guid.guidPrefix;
+}
+
+Clock::time_point to_time_point(const rtps::Time_t& time) {
+  return Clock::time_point(std::chrono::duration_cast<Clock::duration>(
+      std::chrono::seconds(time.seconds()) + std::chrono::nanoseconds(time.nanosec())));
+}
+
+}  // namespace
+
+int resolve_domain_id(int configured) {
+  const char* text = std::getenv("MOCAP_DOMAIN_ID");
+  if (text == nullptr || *text == '\0') return configured;
+  int value = -1;
+  auto [end, error] = std::from_chars(text, text + std::strlen(text), value);
+  if (error != std::errc() || *end != '\0' || value < 0 || value > 232) {
+    throw std::runtime_error(
+        fmt::format("MOCAP_DOMAIN_ID='{}' is not a DDS domain id (an integer 0..232)", text));
+  }
+  return value;
+}
+
+// ---------------------------------------------------------------------------------------
+// Discovery: what other participants read and write, for tools such as `mocap_topic list`.
+
+class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
+ public:
+  void on_publisher_discovery(dds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
+    const auto& data = info.info;
+    bool alive = info.status == rtps::WriterDiscoveryInfo::DISCOVERED_WRITER ||
+                 info.status == rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER;
+    update(data.guid(), alive, data.topicName().to_string(), data.typeName().to_string(), true,
+           data.m_qos.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS,
+           data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS);
+  }
+
+  void on_subscriber_discovery(dds::DomainParticipant*,
+                               rtps::ReaderDiscoveryInfo&& info) override {
+    const auto& data = info.info;
+    bool alive = info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
+                 info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER;
+    update(data.guid(), alive, data.topicName().to_string(), data.typeName().to_string(), false,
+           data.m_qos.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS,
+           data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS);
+  }
+
+  void on_participant_discovery(dds::DomainParticipant*,
+                                rtps::ParticipantDiscoveryInfo&& info) override {
+    std::lock_guard lock(mutex_);
+    auto prefix = info.info.m_guid.guidPrefix;
+    if (info.status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT) {
+      participants_[prefix] = info.info.m_participantName.to_string();
+    } else if (info.status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT ||
+               info.status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
+      participants_.erase(prefix);
+      std::erase_if(endpoints_, [&](const auto& entry) { return entry.first.guidPrefix == prefix; });
+    }
+  }
+
+  std::vector<DiscoveredEndpoint> endpoints() const {
+    std::lock_guard lock(mutex_);
+    std::vector<DiscoveredEndpoint> out;
+    for (const auto& [guid, endpoint] : endpoints_) {
+      DiscoveredEndpoint copy = endpoint;
+      if (auto it = participants_.find(guid.guidPrefix); it != participants_.end()) {
+        copy.participant = it->second;
+      }
+      out.push_back(std::move(copy));
+    }
+    return out;
+  }
+
+ private:
+  void update(const rtps::GUID_t& guid, bool alive, const std::string& topic,
+              const std::string& type, bool is_publisher, bool reliable, bool transient_local) {
+    std::lock_guard lock(mutex_);
+    if (!alive) {
+      endpoints_.erase(guid);
+      return;
+    }
+    DiscoveredEndpoint& endpoint = endpoints_[guid];
+    endpoint.topic = ros_topic_name(topic);
+    endpoint.type = type;
+    endpoint.is_publisher = is_publisher;
+    endpoint.qos.reliability = reliable ? Reliability::Reliable : Reliability::BestEffort;
+    endpoint.qos.durability = transient_local ? Durability::TransientLocal : Durability::Volatile;
+  }
+
+  mutable std::mutex mutex_;
+  std::map<rtps::GUID_t, DiscoveredEndpoint> endpoints_;
+  std::map<rtps::GuidPrefix_t, std::string> participants_;
+};
+
+// ---------------------------------------------------------------------------------------
+
+class FastDdsTransport::Writer final : public TransportPublisher, public dds::DataWriterListener {
+ public:
+  Writer(FastDdsTransport& transport, const Endpoint& endpoint)
+      : transport_(transport),
+        endpoint_(endpoint),
+        own_prefix_(transport.participant_->guid().guidPrefix),
+        drops_(endpoint, "publisher") {
+    topic_ = transport.acquire_topic(endpoint);
+    writer_ = transport.publisher_->create_datawriter(topic_, to_writer_qos(endpoint.qos), this,
+                                                      dds::StatusMask::publication_matched() <<
+                                                          dds::StatusMask::offered_incompatible_qos());
+    if (writer_ == nullptr) {
+      transport.release_topic(topic_);
+      throw std::runtime_error(fmt::format("cannot create a DDS writer for {}", endpoint.topic));
+    }
+  }
+
+  ~Writer() override {
+    writer_->set_listener(nullptr);
+    transport_.publisher_->delete_datawriter(writer_);
+    transport_.release_topic(topic_);
+  }
+
+  void publish(const std::shared_ptr<const void>& message, Clock::time_point) override {
+    // Nobody in another process listens, and nobody who joins later may ask for it.
+    if (remote_readers_.load() == 0 && endpoint_.qos.durability == Durability::Volatile) return;
+    auto result = writer_->write(const_cast<void*>(message.get()), dds::HANDLE_NIL);
+    if (result == ReturnCode_t::RETCODE_TIMEOUT) {
+      drops_.count(1, fmt::format("a reliable subscriber in another process is {} samples behind "
+                                  "and did not catch up within {} ms",
+                                  endpoint_.qos.depth, kReliableBlockingMilliseconds));
+    } else if (result != ReturnCode_t::RETCODE_OK) {
+      drops_.count(1, fmt::format("DDS write failed (code {})", result()));
+    }
+  }
+
+  size_t matched_subscribers() const override { return static_cast<size_t>(remote_readers_.load()); }
+
+  void on_publication_matched(dds::DataWriter*,
+                              const dds::PublicationMatchedStatus& status) override {
+    if (prefix_of(status.last_subscription_handle) != own_prefix_) {
+      remote_readers_.fetch_add(status.current_count_change);
+    }
+  }
+
+  void on_offered_incompatible_qos(dds::DataWriter*,
+                                   const dds::OfferedIncompatibleQosStatus& status) override {
+    Logger(endpoint_.owner)
+        .warn("{}: a subscriber in another process requests QoS this publisher ({}) does not "
+              "offer (policy id {}); it receives nothing",
+              endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
+  }
+
+ private:
+  FastDdsTransport& transport_;
+  Endpoint endpoint_;
+  rtps::GuidPrefix_t own_prefix_;
+  DropReport drops_;
+  dds::Topic* topic_ = nullptr;
+  dds::DataWriter* writer_ = nullptr;
+  std::atomic<int> remote_readers_{0};
+};
+
+// ---------------------------------------------------------------------------------------
+
+class FastDdsTransport::Reader final : public TransportSubscription,
+                                       public dds::DataReaderListener {
+ public:
+  Reader(FastDdsTransport& transport, const Endpoint& endpoint, std::function<void()> on_data)
+      : transport_(transport),
+        endpoint_(endpoint),
+        on_data_(std::move(on_data)),
+        own_prefix_(transport.participant_->guid().guidPrefix),
+        drops_(endpoint, "subscriber") {
+    topic_ = transport.acquire_topic(endpoint);
+    reader_ = transport.subscriber_->create_datareader(
+        topic_, to_reader_qos(endpoint.qos), this,
+        dds::StatusMask::data_available() << dds::StatusMask::sample_lost()
+                                          << dds::StatusMask::sample_rejected()
+                                          << dds::StatusMask::requested_incompatible_qos());
+    if (reader_ == nullptr) {
+      transport.release_topic(topic_);
+      throw std::runtime_error(fmt::format("cannot create a DDS reader for {}", endpoint.topic));
+    }
+  }
+
+  ~Reader() override {
+    reader_->set_listener(nullptr);
+    transport_.subscriber_->delete_datareader(reader_);
+    transport_.release_topic(topic_);
+  }
+
+  bool take(ReceivedMessage& out) override {
+    dds::SampleInfo info;
+    while (reader_->get_first_untaken_info(&info) == ReturnCode_t::RETCODE_OK) {
+      DdsSample sample;
+      sample.skip = is_own(info);
+      if (reader_->take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return false;
+      // A sample can arrive between peeking and taking; judge what was actually taken.
+      if (!info.valid_data || is_own(info)) continue;
+      if (sample.skip) {
+        drops_.count(1, "replaced in the reader queue while being taken");
+        continue;
+      }
+      if (sample.malformed) {
+        drops_.count(1, "malformed serialized data");
+        continue;
+      }
+      out.message = std::move(sample.message);
+      out.source_time = to_time_point(info.source_timestamp);
+      return true;
+    }
+    return false;
+  }
+
+  void on_data_available(dds::DataReader*) override { on_data_(); }
+
+  void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override {
+    drops_.count(static_cast<uint64_t>(status.total_count_change),
+                 "lost in transit (best effort)");
+  }
+
+  void on_sample_rejected(dds::DataReader*, const dds::SampleRejectedStatus& status) override {
+    drops_.count(static_cast<uint64_t>(status.total_count_change),
+                 "rejected: the subscriber's queue is full");
+  }
+
+  void on_requested_incompatible_qos(dds::DataReader*,
+                                     const dds::RequestedIncompatibleQosStatus& status) override {
+    Logger(endpoint_.owner)
+        .warn("{}: a publisher in another process does not offer the QoS this subscriber "
+              "requests ({}; policy id {}); nothing arrives from it",
+              endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
+  }
+
+ private:
+  bool is_own(const dds::SampleInfo& info) const {
+    return info.sample_identity.writer_guid().guidPrefix == own_prefix_;
+  }
+
+  FastDdsTransport& transport_;
+  Endpoint endpoint_;
+  std::function<void()> on_data_;
+  rtps::GuidPrefix_t own_prefix_;
+  DropReport drops_;
+  dds::Topic* topic_ = nullptr;
+  dds::DataReader* reader_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------------------
+
+FastDdsTransport::FastDdsTransport(const DdsOptions& options, const std::string& participant_name)
+    : domain_id_(resolve_domain_id(options.domain_id)), listener_(std::make_unique<Listener>()) {
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  participant_ = factory->create_participant(
+      domain_id_, to_participant_qos(options, participant_name), listener_.get(),
+      dds::StatusMask::none());
+  if (participant_ == nullptr) {
+    throw std::runtime_error(
+        fmt::format("cannot create a DDS participant on domain {}", domain_id_));
+  }
+  publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) {
+    participant_->delete_contained_entities();
+    factory->delete_participant(participant_);
+    throw std::runtime_error("cannot create the DDS publisher and subscriber");
+  }
+}
+
+FastDdsTransport::~FastDdsTransport() {
+  participant_->set_listener(nullptr);
+  participant_->delete_contained_entities();
+  dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+std::unique_ptr<TransportPublisher> FastDdsTransport::advertise(const Endpoint& endpoint) {
+  return std::make_unique<Writer>(*this, endpoint);
+}
+
+std::unique_ptr<TransportSubscription> FastDdsTransport::subscribe(const Endpoint& endpoint,
+                                                                   std::function<void()> on_data) {
+  return std::make_unique<Reader>(*this, endpoint, std::move(on_data));
+}
+
+std::vector<DiscoveredEndpoint> FastDdsTransport::discovered_endpoints() const {
+  return listener_->endpoints();
+}
+
+dds::Topic* FastDdsTransport::acquire_topic(const Endpoint& endpoint) {
+  std::lock_guard lock(mutex_);
+  std::string name = dds_topic_name(endpoint.topic);
+  if (auto it = topics_.find(name); it != topics_.end()) {
+    std::string used = it->second.topic->get_type_name();
+    if (used != endpoint.type->dds_name()) {
+      throw std::invalid_argument(fmt::format("topic '{}' is already used with type {} here; '{}' "
+                                              "uses it with {}",
+                                              endpoint.topic, ros_type_name(used), endpoint.owner,
+                                              endpoint.type->name()));
+    }
+    ++it->second.users;
+    return it->second.topic;
+  }
+  if (participant_->find_type(endpoint.type->dds_name()).empty()) {
+    dds::TypeSupport support(new DdsTypeAdapter(*endpoint.type));
+    if (support.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error(
+          fmt::format("cannot register type {} with DDS", endpoint.type->dds_name()));
+    }
+  }
+  dds::Topic* topic =
+      participant_->create_topic(name, endpoint.type->dds_name(), dds::TOPIC_QOS_DEFAULT);
+  if (topic == nullptr) {
+    throw std::runtime_error(fmt::format("cannot create DDS topic {}", name));
+  }
+  topics_[name] = {topic, 1};
+  return topic;
+}
+
+void FastDdsTransport::release_topic(dds::Topic* topic) {
+  std::lock_guard lock(mutex_);
+  auto it = topics_.find(topic->get_name());
+  if (it == topics_.end() || --it->second.users > 0) return;
+  participant_->delete_topic(topic);
+  topics_.erase(it);
+}
+
+}  // namespace mocap

@@ -1,0 +1,78 @@
+// Delivery between processes and hosts over Fast DDS, one participant per process.
+//
+// Topic and type names follow ROS 2 ("rt/a/b", "pkg::msg::dds_::Type_"). Samples written by
+// this process are never delivered back to it (the in-process transport already did): Fast
+// DDS 2.9 matches a participant's own readers and writers, so readers drop their own
+// participant's samples before deserializing them, and writers skip writing volatile samples
+// when no reader of another participant is matched.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <mocap/component_host.hpp>
+
+#include "transport.hpp"
+
+namespace eprosima::fastdds::dds {
+class DomainParticipant;
+class Publisher;
+class Subscriber;
+class Topic;
+}  // namespace eprosima::fastdds::dds
+
+namespace mocap {
+
+// A reader or writer of another participant, as discovery reports it.
+struct DiscoveredEndpoint {
+  std::string topic;  // ROS name when the DDS name is a ROS one ("rt/a" -> "/a")
+  std::string type;   // DDS type name
+  bool is_publisher = false;
+  Qos qos;  // reliability and durability as announced; history is not announced
+  std::string participant;
+};
+
+class FastDdsTransport final : public Transport {
+ public:
+  // Throws std::runtime_error when the participant cannot be created.
+  FastDdsTransport(const DdsOptions& options, const std::string& participant_name);
+  ~FastDdsTransport() override;
+
+  std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) override;
+  std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
+                                                   std::function<void()> on_data) override;
+
+  int domain_id() const { return domain_id_; }
+  // Endpoints of other participants seen so far (alive ones only).
+  std::vector<DiscoveredEndpoint> discovered_endpoints() const;
+
+  class Listener;  // discovery
+  class Writer;
+  class Reader;
+
+ private:
+  friend class Writer;
+  friend class Reader;
+  eprosima::fastdds::dds::Topic* acquire_topic(const Endpoint& endpoint);
+  void release_topic(eprosima::fastdds::dds::Topic* topic);
+
+  int domain_id_;
+  std::unique_ptr<Listener> listener_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::mutex mutex_;
+  struct TopicUse {
+    eprosima::fastdds::dds::Topic* topic;
+    int users;
+  };
+  std::map<std::string, TopicUse> topics_;
+};
+
+// MOCAP_DOMAIN_ID if set (validated), otherwise `configured`.
+int resolve_domain_id(int configured);
+
+}  // namespace mocap

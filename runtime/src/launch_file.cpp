@@ -1,0 +1,460 @@
+#include "launch_file.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "names.hpp"
+#include "yaml_value.hpp"
+
+namespace mocap {
+namespace {
+
+int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
+
+class Problems {
+ public:
+  explicit Problems(std::string file) : file_(std::move(file)) {}
+
+  void add(int line, std::string message) {
+    list_.push_back(fmt::format("{}:{}: {}", file_, line, message));
+  }
+  void add(const YAML::Node& at, std::string message) { add(line_of(at), std::move(message)); }
+  void add_plain(std::string message) { list_.push_back(std::move(message)); }
+  bool empty() const { return list_.empty(); }
+  std::vector<std::string> take() { return std::move(list_); }
+
+ private:
+  std::string file_;
+  std::vector<std::string> list_;
+};
+
+// Flags repeated keys and, when `allowed` is given, keys outside it. `what` names the map in
+// messages.
+void check_keys(const YAML::Node& map, const std::optional<std::vector<std::string>>& allowed,
+                std::string_view what, Problems& problems) {
+  std::set<std::string> seen;
+  for (const auto& entry : map) {
+    std::string key = entry.first.as<std::string>();
+    if (!seen.insert(key).second) {
+      problems.add(entry.first, fmt::format("duplicate key '{}' in {}", key, what));
+    } else if (allowed && std::find(allowed->begin(), allowed->end(), key) == allowed->end()) {
+      problems.add(entry.first, fmt::format("unknown key '{}' in {}{}", key, what,
+                                            did_you_mean(key, *allowed, "keys")));
+    }
+  }
+}
+
+std::optional<std::string> string_value(const YAML::Node& node, std::string_view key,
+                                        Problems& problems) {
+  if (!node.IsScalar()) {
+    problems.add(node, fmt::format("'{}' must be a text value", key));
+    return std::nullopt;
+  }
+  return node.Scalar();
+}
+
+std::optional<int64_t> int_value(const YAML::Node& node, std::string_view key, int64_t min,
+                                 int64_t max, Problems& problems) {
+  try {
+    ParameterValue value = parameter_value_from_yaml(node);
+    if (const int64_t* number = std::get_if<int64_t>(&value); number && *number >= min &&
+                                                             *number <= max) {
+      return *number;
+    }
+  } catch (const std::invalid_argument&) {
+  }
+  problems.add(node, fmt::format("'{}' must be an integer in [{}, {}]", key, min, max));
+  return std::nullopt;
+}
+
+std::optional<bool> bool_value(const YAML::Node& node, std::string_view key, Problems& problems) {
+  try {
+    ParameterValue value = parameter_value_from_yaml(node);
+    if (const bool* flag = std::get_if<bool>(&value)) return *flag;
+  } catch (const std::invalid_argument&) {
+  }
+  problems.add(node, fmt::format("'{}' must be true or false", key));
+  return std::nullopt;
+}
+
+std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Problems& problems) {
+  auto unknown_profile = [&](const YAML::Node& at, const std::string& name) {
+    problems.add(at, fmt::format("QoS for '{}': unknown profile '{}' (profiles: {})", topic, name,
+                                 Qos::profile_names));
+  };
+  if (node.IsScalar()) {
+    if (auto qos = Qos::from_profile(node.Scalar())) return qos;
+    unknown_profile(node, node.Scalar());
+    return std::nullopt;
+  }
+  if (!node.IsMap()) {
+    problems.add(node, fmt::format("QoS for '{}' must be a profile name or {{profile, depth}}",
+                                   topic));
+    return std::nullopt;
+  }
+  check_keys(node, std::vector<std::string>{"profile", "depth"}, fmt::format("the QoS of '{}'", topic), problems);
+  std::optional<Qos> qos;
+  if (YAML::Node profile = node["profile"]) {
+    if (!profile.IsScalar() || !(qos = Qos::from_profile(profile.Scalar()))) {
+      unknown_profile(profile, profile.IsScalar() ? profile.Scalar() : "?");
+      return std::nullopt;
+    }
+  } else {
+    problems.add(node, fmt::format("QoS for '{}' needs a 'profile'", topic));
+    return std::nullopt;
+  }
+  if (YAML::Node depth = node["depth"]) {
+    auto value = int_value(depth, "depth", 1, 1000000, problems);
+    if (!value) return std::nullopt;
+    qos->depth = static_cast<int>(*value);
+  }
+  return qos;
+}
+
+// Where each component sits, for the checks across the file.
+struct Placed {
+  const LaunchComponent* component;
+  const LaunchGroup* group;
+};
+
+void check_topics(const std::vector<Placed>& placed, Problems& problems) {
+  struct Use {
+    const TopicSpec* spec;
+    Qos qos;
+    const LaunchComponent* component;
+  };
+  std::map<std::string, std::vector<Use>> uses;
+  for (const Placed& p : placed) {
+    const ComponentConfig& config = p.component->config;
+    for (const TopicSpec& topic : p.component->plugin->spec.topics()) {
+      auto remap = config.remaps.find(topic.topic);
+      auto qos = config.qos.find(topic.topic);
+      uses[remap == config.remaps.end() ? topic.topic : remap->second].push_back(
+          {&topic, qos == config.qos.end() ? topic.qos : qos->second, p.component});
+    }
+  }
+  for (const auto& [topic, list] : uses) {
+    const Use& first = list.front();
+    for (const Use& use : list) {
+      if (use.spec->type != first.spec->type) {
+        problems.add(use.component->line,
+                     fmt::format("topic '{}' is {} for component '{}' but {} for component '{}' "
+                                 "(line {})",
+                                 topic, use.spec->type->name(), use.component->config.name,
+                                 first.spec->type->name(), first.component->config.name,
+                                 first.component->line));
+        break;
+      }
+    }
+    for (const Use& subscriber : list) {
+      if (subscriber.spec->direction != TopicDirection::Subscribe) continue;
+      for (const Use& publisher : list) {
+        if (publisher.spec->direction != TopicDirection::Publish) continue;
+        if (auto why = qos_mismatch(publisher.qos, subscriber.qos)) {
+          problems.add(subscriber.component->line,
+                       fmt::format("topic '{}': component '{}' ({}) would receive nothing from "
+                                   "component '{}' (line {}, {}): {}",
+                                   topic, subscriber.component->config.name,
+                                   subscriber.qos.to_string(), publisher.component->config.name,
+                                   publisher.component->line, publisher.qos.to_string(), *why));
+        }
+      }
+    }
+  }
+}
+
+class Reader {
+ public:
+  Reader(std::string file, PluginLoader& plugins) : problems_(file), plugins_(plugins) {
+    result_.path = std::move(file);
+  }
+
+  LaunchFile read(const YAML::Node& root, const std::vector<ParameterOverride>& overrides) {
+    if (!root.IsMap()) {
+      problems_.add(root, "a launch file is a map with 'groups' (and optionally 'dds')");
+      throw LaunchError(problems_.take());
+    }
+    check_keys(root, std::vector<std::string>{"dds", "groups"}, "the launch file", problems_);
+    if (YAML::Node dds = root["dds"]) read_dds(dds);
+    YAML::Node groups = root["groups"];
+    if (!groups || !groups.IsSequence() || groups.size() == 0) {
+      problems_.add(groups ? groups : root, "'groups' must be a non-empty list of groups");
+    } else {
+      for (const YAML::Node& group : groups) read_group(group);
+    }
+    apply(overrides);
+    std::vector<Placed> placed;
+    for (const LaunchGroup& group : result_.groups) {
+      for (const LaunchComponent& component : group.components) {
+        if (component.plugin != nullptr) placed.push_back({&component, &group});
+      }
+    }
+    check_topics(placed, problems_);
+    if (!problems_.empty()) throw LaunchError(problems_.take());
+    return std::move(result_);
+  }
+
+ private:
+  void read_dds(const YAML::Node& dds) {
+    if (!dds.IsMap()) {
+      problems_.add(dds, "'dds' must be a map (enabled, domain_id, shared_memory)");
+      return;
+    }
+    check_keys(dds, std::vector<std::string>{"enabled", "domain_id", "shared_memory"}, "'dds'", problems_);
+    if (YAML::Node n = dds["enabled"]) {
+      if (auto v = bool_value(n, "enabled", problems_)) result_.dds.enabled = *v;
+    }
+    if (YAML::Node n = dds["domain_id"]) {
+      if (auto v = int_value(n, "domain_id", 0, 232, problems_)) result_.dds.domain_id = int(*v);
+    }
+    if (YAML::Node n = dds["shared_memory"]) {
+      if (auto v = bool_value(n, "shared_memory", problems_)) result_.dds.shared_memory = *v;
+    }
+  }
+
+  void read_group(const YAML::Node& node) {
+    if (!node.IsMap()) {
+      problems_.add(node, "a group is a map with 'name' and 'components'");
+      return;
+    }
+    LaunchGroup group;
+    group.line = line_of(node);
+    check_keys(node, std::vector<std::string>{"name", "threads", "components"}, "a group", problems_);
+    if (YAML::Node name = node["name"]) {
+      group.name = string_value(name, "name", problems_).value_or("");
+      if (!valid_component_name(group.name)) {
+        problems_.add(name, fmt::format("group name '{}' must use letters, digits, '_' and '-'",
+                                        group.name));
+      }
+      for (const LaunchGroup& other : result_.groups) {
+        if (other.name == group.name) {
+          problems_.add(name, fmt::format("duplicate group name '{}' (first at line {})",
+                                          group.name, other.line));
+        }
+      }
+    } else {
+      problems_.add(node, "a group needs a 'name'");
+    }
+    if (YAML::Node threads = node["threads"]) {
+      group.threads = static_cast<int>(int_value(threads, "threads", 1, 256, problems_).value_or(0));
+    }
+    YAML::Node components = node["components"];
+    if (!components || !components.IsSequence() || components.size() == 0) {
+      problems_.add(components ? components : node,
+                    fmt::format("group '{}' needs 'components', a non-empty list", group.name));
+    } else {
+      result_.groups.push_back(std::move(group));
+      for (const YAML::Node& component : components) read_component(component);
+      return;
+    }
+    result_.groups.push_back(std::move(group));
+  }
+
+  void read_component(const YAML::Node& node) {
+    if (!node.IsMap()) {
+      problems_.add(node, "a component is a map with 'plugin' and 'name'");
+      return;
+    }
+    check_keys(node, std::vector<std::string>{"plugin", "name", "parameters", "remap", "qos"}, "a component",
+               problems_);
+    LaunchComponent component;
+    component.line = line_of(node);
+    YAML::Node name = node["name"];
+    if (!name) {
+      problems_.add(node, "a component needs a 'name'");
+    } else if (auto text = string_value(name, "name", problems_)) {
+      component.config.name = *text;
+      component.line = line_of(name);
+      if (!valid_component_name(*text)) {
+        problems_.add(name, fmt::format("component name '{}' must use letters, digits, '_' "
+                                        "and '-'",
+                                        *text));
+      }
+      if (auto [it, fresh] = component_lines_.emplace(*text, component.line); !fresh) {
+        problems_.add(name, fmt::format("duplicate component name '{}' (first at line {})",
+                                        *text, it->second));
+      }
+    }
+    YAML::Node plugin = node["plugin"];
+    if (!plugin) {
+      problems_.add(node, "a component needs a 'plugin'");
+    } else if (auto text = string_value(plugin, "plugin", problems_)) {
+      try {
+        component.plugin = &plugins_.load(*text);
+      } catch (const PluginError& e) {
+        problems_.add(plugin, e.what());
+      }
+    }
+    std::string who = fmt::format("component '{}'", component.config.name);
+    if (YAML::Node parameters = node["parameters"]) {
+      if (!parameters.IsMap()) {
+        problems_.add(parameters, "'parameters' must be a map of name: value");
+      } else {
+        check_keys(parameters, std::nullopt, "'parameters'", problems_);
+        for (const auto& entry : parameters) {
+          std::string key = entry.first.as<std::string>();
+          try {
+            component.config.parameters[key] = parameter_value_from_yaml(entry.second);
+            parameter_lines_[{component.config.name, key}] = line_of(entry.first);
+          } catch (const std::invalid_argument& e) {
+            problems_.add(entry.second,
+                          fmt::format("{}: parameter '{}' has {}", who, key, e.what()));
+          }
+        }
+      }
+    }
+    if (YAML::Node remap = node["remap"]) {
+      read_topic_map(remap, "remap", component.config.name, [&](const std::string& from, const YAML::Node& to) {
+        if (auto text = string_value(to, "remap target", problems_)) {
+          component.config.remaps[from] = *text;
+        }
+      });
+    }
+    if (YAML::Node qos = node["qos"]) {
+      read_topic_map(qos, "qos", component.config.name, [&](const std::string& topic, const YAML::Node& value) {
+        if (auto parsed = qos_value(value, topic, problems_)) component.config.qos[topic] = *parsed;
+      });
+    }
+    if (result_.groups.empty()) return;
+    result_.groups.back().components.push_back(std::move(component));
+  }
+
+  template <class Each>
+  void read_topic_map(const YAML::Node& map, std::string_view key, const std::string& component,
+                      Each each) {
+    if (!map.IsMap()) {
+      problems_.add(map, fmt::format("'{}' must be a map of topic: value", key));
+      return;
+    }
+    check_keys(map, std::nullopt, fmt::format("'{}'", key), problems_);
+    for (const auto& entry : map) {
+      std::string topic = entry.first.as<std::string>();
+      topic_lines_[{component, topic}] = line_of(entry.first);
+      each(topic, entry.second);
+    }
+  }
+
+  void apply(const std::vector<ParameterOverride>& overrides) {
+    for (const ParameterOverride& o : overrides) {
+      LaunchComponent* target = nullptr;
+      for (LaunchGroup& group : result_.groups) {
+        for (LaunchComponent& component : group.components) {
+          if (component.config.name == o.component) target = &component;
+        }
+      }
+      if (target == nullptr) {
+        problems_.add_plain(fmt::format("--set {}: no component named '{}' in {}", o.text,
+                                        o.component, result_.path));
+        continue;
+      }
+      try {
+        target->config.parameters[o.parameter] =
+            parameter_value_from_yaml(YAML::Load(o.value));
+        parameter_lines_[{o.component, o.parameter}] = -1;
+      } catch (const std::exception& e) {
+        problems_.add_plain(fmt::format("--set {}: the value is not valid: {}", o.text, e.what()));
+      }
+    }
+    // With every value in place, check each component against its plugin's declaration.
+    for (LaunchGroup& group : result_.groups) {
+      for (LaunchComponent& component : group.components) {
+        if (component.plugin == nullptr) continue;
+        check_component(component);
+      }
+    }
+  }
+
+  void check_component(const LaunchComponent& component) {
+    const ComponentSpec& spec = component.plugin->spec;
+    const ComponentConfig& config = component.config;
+    std::string who = fmt::format("component '{}' ({})", config.name, component.plugin->name);
+    // One config at a time, so each problem gets the line of its own key.
+    for (const auto& [name, value] : config.parameters) {
+      ComponentConfig one{config.name, {{name, value}}, {}, {}};
+      for (const std::string& problem : check_component_config(spec, one)) {
+        int line = parameter_lines_[{config.name, name}];
+        if (line < 0) {
+          problems_.add_plain(fmt::format("--set {}.{}: {}: {}", config.name, name, who, problem));
+        } else {
+          problems_.add(line, fmt::format("{}: {}", who, problem));
+        }
+      }
+    }
+    for (const auto& [from, to] : config.remaps) {
+      ComponentConfig one{config.name, {}, {{from, to}}, {}};
+      for (const std::string& problem : check_component_config(spec, one)) {
+        problems_.add(topic_lines_[{config.name, from}], fmt::format("{}: {}", who, problem));
+      }
+    }
+    for (const auto& [topic, qos] : config.qos) {
+      ComponentConfig one{config.name, {}, {}, {{topic, qos}}};
+      for (const std::string& problem : check_component_config(spec, one)) {
+        problems_.add(topic_lines_[{config.name, topic}], fmt::format("{}: {}", who, problem));
+      }
+    }
+  }
+
+  Problems problems_;
+  PluginLoader& plugins_;
+  LaunchFile result_;
+  std::map<std::string, int> component_lines_;
+  std::map<std::pair<std::string, std::string>, int> parameter_lines_;
+  std::map<std::pair<std::string, std::string>, int> topic_lines_;
+};
+
+}  // namespace
+
+LaunchError::LaunchError(std::vector<std::string> problems)
+    : std::runtime_error(problems.empty() ? "invalid launch file" : problems.front()),
+      problems_(std::move(problems)) {}
+
+const LaunchGroup* LaunchFile::find_group(std::string_view name) const {
+  for (const LaunchGroup& group : groups) {
+    if (group.name == name) return &group;
+  }
+  return nullptr;
+}
+
+size_t LaunchFile::component_count() const {
+  size_t count = 0;
+  for (const LaunchGroup& group : groups) count += group.components.size();
+  return count;
+}
+
+ParameterOverride parse_parameter_override(std::string_view text) {
+  size_t equals = text.find('=');
+  size_t dot = text.substr(0, equals).find('.');
+  if (equals == std::string_view::npos || dot == std::string_view::npos || dot == 0 ||
+      dot + 1 == equals) {
+    throw LaunchError({fmt::format("--set {}: expected COMPONENT.PARAMETER=VALUE", text)});
+  }
+  return {std::string(text.substr(0, dot)), std::string(text.substr(dot + 1, equals - dot - 1)),
+          std::string(text.substr(equals + 1)), std::string(text)};
+}
+
+LaunchFile load_launch_file(const std::filesystem::path& path, PluginLoader& plugins,
+                            const std::vector<ParameterOverride>& overrides) {
+  std::ifstream stream(path);
+  if (!stream) {
+    throw LaunchError({fmt::format("{}: cannot read the launch file: {}", path.string(),
+                                   std::strerror(errno))});
+  }
+  std::stringstream text;
+  text << stream.rdbuf();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    throw LaunchError({fmt::format("{}:{}:{}: YAML syntax error: {}", path.string(),
+                                   e.mark.line + 1, e.mark.column + 1, e.msg)});
+  }
+  return Reader(path.string(), plugins).read(root, overrides);
+}
+
+}  // namespace mocap
