@@ -40,6 +40,10 @@ void apply(const Qos& qos, EndpointQos& out) {
 dds::DataWriterQos to_writer_qos(const Qos& qos) {
   dds::DataWriterQos out;
   apply(qos, out);
+  // A sample lost in transit is repaired when the reader answers a heartbeat. Fast DDS's
+  // default period, 3 s, would outlast a reliable publisher's wait for room; heartbeats are
+  // only sent while samples are unacknowledged, so a short period costs nothing when idle.
+  out.reliable_writer_qos().times.heartbeatPeriod = {0, 25000000u};
   return out;
 }
 

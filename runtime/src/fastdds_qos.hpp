@@ -18,7 +18,4 @@ eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);
 eprosima::fastdds::dds::DomainParticipantQos to_participant_qos(const DdsOptions& options,
                                                                 const std::string& name);
 
-// How long a reliable publisher waits for a subscriber that is `depth` samples behind.
-constexpr int kReliableBlockingMilliseconds = 100;
-
 }  // namespace mocap

@@ -155,7 +155,7 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   void publish(const std::shared_ptr<const void>& message, Clock::time_point) override {
     // Nobody in another process listens, and nobody who joins later may ask for it.
     if (remote_readers_.load() == 0 && endpoint_.qos.durability == Durability::Volatile) return;
-    auto result = writer_->write(const_cast<void*>(message.get()), dds::HANDLE_NIL);
+    auto result = write(message.get());
     if (result == ReturnCode_t::RETCODE_TIMEOUT) {
       drops_.count(1, fmt::format("a reliable subscriber in another process is {} samples behind "
                                   "and did not catch up within {} ms",
@@ -166,6 +166,21 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   }
 
   size_t matched_subscribers() const override { return static_cast<size_t>(remote_readers_.load()); }
+
+  // Fast DDS 2.9 can report a timeout long before the blocking time has passed: when acks
+  // free a full keep-all history, a volatile writer removes the acknowledged samples itself,
+  // and the waiting write, finding no sample left to remove, gives up although there is room
+  // now. Writing again within the blocking time succeeds at once.
+  ReturnCode_t write(const void* message) {
+    auto deadline = std::chrono::steady_clock::now() +
+                    std::chrono::milliseconds(kReliableBlockingMilliseconds);
+    for (;;) {
+      auto result = writer_->write(const_cast<void*>(message), dds::HANDLE_NIL);
+      if (result != ReturnCode_t::RETCODE_TIMEOUT || std::chrono::steady_clock::now() >= deadline) {
+        return result;
+      }
+    }
+  }
 
   void on_publication_matched(dds::DataWriter*,
                               const dds::PublicationMatchedStatus& status) override {

@@ -1,6 +1,7 @@
 #include "intra_process_transport.hpp"
 
 #include <algorithm>
+#include <condition_variable>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -19,23 +20,32 @@ class IntraProcessTransport::Subscription final : public TransportSubscription {
   ~Subscription() override { transport_.remove(this); }
 
   bool take(ReceivedMessage& out) override {
-    std::lock_guard lock(mutex_);
-    if (queue_.empty()) return false;
-    out = std::move(queue_.front());
-    queue_.pop_front();
+    {
+      std::lock_guard lock(mutex_);
+      if (queue_.empty()) return false;
+      out = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    room_.notify_one();
     return true;
   }
 
+  // Keep last: the oldest sample makes room. Keep all: the publisher waits for room, as a
+  // reliable DDS writer does, and drops the sample if none comes in time.
   void push(const ReceivedMessage& message) {
     {
-      std::lock_guard lock(mutex_);
-      if (queue_.size() >= static_cast<size_t>(endpoint_.qos.depth)) {
+      std::unique_lock lock(mutex_);
+      size_t depth = static_cast<size_t>(endpoint_.qos.depth);
+      if (queue_.size() >= depth) {
         if (endpoint_.qos.history == History::KeepLast) {
           queue_.pop_front();
           drops_.count(1, "the subscriber is slower than the publisher (keep_last queue full)");
-        } else {
-          drops_.count(1, fmt::format("the subscriber is {} samples behind (keep_all queue full)",
-                                      queue_.size()));
+        } else if (!room_.wait_for(lock,
+                                   std::chrono::milliseconds(kReliableBlockingMilliseconds),
+                                   [&] { return queue_.size() < depth; })) {
+          drops_.count(1, fmt::format("the subscriber is {} samples behind and did not catch up "
+                                      "within {} ms",
+                                      queue_.size(), kReliableBlockingMilliseconds));
           return;
         }
       }
@@ -51,6 +61,7 @@ class IntraProcessTransport::Subscription final : public TransportSubscription {
   Endpoint endpoint_;
   std::function<void()> on_data_;
   std::mutex mutex_;
+  std::condition_variable room_;
   std::deque<ReceivedMessage> queue_;
   DropReport drops_;
 };

@@ -2,7 +2,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -17,21 +20,31 @@ namespace {
 
 int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
 
+// Problems in file order; those of --set options last.
 class Problems {
  public:
   explicit Problems(std::string file) : file_(std::move(file)) {}
 
   void add(int line, std::string message) {
-    list_.push_back(fmt::format("{}:{}: {}", file_, line, message));
+    list_.emplace_back(line, fmt::format("{}:{}: {}", file_, line, message));
   }
   void add(const YAML::Node& at, std::string message) { add(line_of(at), std::move(message)); }
-  void add_plain(std::string message) { list_.push_back(std::move(message)); }
+  void add_plain(std::string message) {
+    list_.emplace_back(std::numeric_limits<int>::max(), std::move(message));
+  }
   bool empty() const { return list_.empty(); }
-  std::vector<std::string> take() { return std::move(list_); }
+  std::vector<std::string> take() {
+    std::stable_sort(list_.begin(), list_.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<std::string> messages;
+    for (auto& [line, message] : list_) messages.push_back(std::move(message));
+    list_.clear();
+    return messages;
+  }
 
  private:
   std::string file_;
-  std::vector<std::string> list_;
+  std::vector<std::pair<int, std::string>> list_;
 };
 
 // Flags repeated keys and, when `allowed` is given, keys outside it. `what` names the map in
@@ -301,7 +314,7 @@ class Reader {
           std::string key = entry.first.as<std::string>();
           try {
             component.config.parameters[key] = parameter_value_from_yaml(entry.second);
-            parameter_lines_[{component.config.name, key}] = line_of(entry.first);
+            component.parameter_lines[key] = line_of(entry.first);
           } catch (const std::invalid_argument& e) {
             problems_.add(entry.second,
                           fmt::format("{}: parameter '{}' has {}", who, key, e.what()));
@@ -310,14 +323,14 @@ class Reader {
       }
     }
     if (YAML::Node remap = node["remap"]) {
-      read_topic_map(remap, "remap", component.config.name, [&](const std::string& from, const YAML::Node& to) {
+      read_topic_map(remap, "remap", component.remap_lines, [&](const std::string& from, const YAML::Node& to) {
         if (auto text = string_value(to, "remap target", problems_)) {
           component.config.remaps[from] = *text;
         }
       });
     }
     if (YAML::Node qos = node["qos"]) {
-      read_topic_map(qos, "qos", component.config.name, [&](const std::string& topic, const YAML::Node& value) {
+      read_topic_map(qos, "qos", component.qos_lines, [&](const std::string& topic, const YAML::Node& value) {
         if (auto parsed = qos_value(value, topic, problems_)) component.config.qos[topic] = *parsed;
       });
     }
@@ -326,7 +339,7 @@ class Reader {
   }
 
   template <class Each>
-  void read_topic_map(const YAML::Node& map, std::string_view key, const std::string& component,
+  void read_topic_map(const YAML::Node& map, std::string_view key, std::map<std::string, int>& lines,
                       Each each) {
     if (!map.IsMap()) {
       problems_.add(map, fmt::format("'{}' must be a map of topic: value", key));
@@ -335,7 +348,7 @@ class Reader {
     check_keys(map, std::nullopt, fmt::format("'{}'", key), problems_);
     for (const auto& entry : map) {
       std::string topic = entry.first.as<std::string>();
-      topic_lines_[{component, topic}] = line_of(entry.first);
+      lines[topic] = line_of(entry.first);
       each(topic, entry.second);
     }
   }
@@ -345,7 +358,7 @@ class Reader {
       LaunchComponent* target = nullptr;
       for (LaunchGroup& group : result_.groups) {
         for (LaunchComponent& component : group.components) {
-          if (component.config.name == o.component) target = &component;
+          if (component.config.name == o.component && target == nullptr) target = &component;
         }
       }
       if (target == nullptr) {
@@ -356,7 +369,8 @@ class Reader {
       try {
         target->config.parameters[o.parameter] =
             parameter_value_from_yaml(YAML::Load(o.value));
-        parameter_lines_[{o.component, o.parameter}] = -1;
+        target->parameter_lines[o.parameter] = -1;
+        set_texts_[{target, o.parameter}] = o.text;
       } catch (const std::exception& e) {
         problems_.add_plain(fmt::format("--set {}: the value is not valid: {}", o.text, e.what()));
       }
@@ -378,9 +392,10 @@ class Reader {
     for (const auto& [name, value] : config.parameters) {
       ComponentConfig one{config.name, {{name, value}}, {}, {}};
       for (const std::string& problem : check_component_config(spec, one)) {
-        int line = parameter_lines_[{config.name, name}];
+        int line = component.parameter_lines.at(name);
         if (line < 0) {
-          problems_.add_plain(fmt::format("--set {}.{}: {}: {}", config.name, name, who, problem));
+          problems_.add_plain(
+              fmt::format("--set {}: {}: {}", set_texts_.at({&component, name}), who, problem));
         } else {
           problems_.add(line, fmt::format("{}: {}", who, problem));
         }
@@ -389,13 +404,13 @@ class Reader {
     for (const auto& [from, to] : config.remaps) {
       ComponentConfig one{config.name, {}, {{from, to}}, {}};
       for (const std::string& problem : check_component_config(spec, one)) {
-        problems_.add(topic_lines_[{config.name, from}], fmt::format("{}: {}", who, problem));
+        problems_.add(component.remap_lines.at(from), fmt::format("{}: {}", who, problem));
       }
     }
     for (const auto& [topic, qos] : config.qos) {
       ComponentConfig one{config.name, {}, {}, {{topic, qos}}};
       for (const std::string& problem : check_component_config(spec, one)) {
-        problems_.add(topic_lines_[{config.name, topic}], fmt::format("{}: {}", who, problem));
+        problems_.add(component.qos_lines.at(topic), fmt::format("{}: {}", who, problem));
       }
     }
   }
@@ -404,8 +419,7 @@ class Reader {
   PluginLoader& plugins_;
   LaunchFile result_;
   std::map<std::string, int> component_lines_;
-  std::map<std::pair<std::string, std::string>, int> parameter_lines_;
-  std::map<std::pair<std::string, std::string>, int> topic_lines_;
+  std::map<std::pair<const LaunchComponent*, std::string>, std::string> set_texts_;
 };
 
 }  // namespace

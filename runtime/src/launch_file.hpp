@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -14,9 +15,13 @@
 namespace mocap {
 
 struct LaunchComponent {
-  const LoadedPlugin* plugin = nullptr;
+  const LoadedPlugin* plugin = nullptr;  // null when it could not be loaded
   ComponentConfig config;
-  int line = 0;
+  int line = 0;  // of its name
+  // Lines of its parameter, remap and QoS keys, for messages; -1 for a --set value.
+  std::map<std::string, int> parameter_lines;
+  std::map<std::string, int> remap_lines;
+  std::map<std::string, int> qos_lines;
 };
 
 struct LaunchGroup {

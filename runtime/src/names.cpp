@@ -44,7 +44,9 @@ std::string did_you_mean(std::string_view word, const std::vector<std::string>& 
   const std::string* best = nullptr;
   size_t best_distance = 0;
   for (const std::string& candidate : candidates) {
-    size_t distance = edit_distance(word, candidate);
+    // A word cut short ("domain" for "domain_id") is as good as a typo.
+    bool prefix = word.size() >= 3 && std::string_view(candidate).starts_with(word);
+    size_t distance = prefix ? 1 : edit_distance(word, candidate);
     if (best == nullptr || distance < best_distance) {
       best = &candidate;
       best_distance = distance;

@@ -58,6 +58,12 @@ class DropReport {
  public:
   DropReport(const Endpoint& endpoint, std::string what)
       : logger_(endpoint.owner), topic_(endpoint.topic), what_(std::move(what)) {}
+  // Drops counted after the last report are reported here, so none go unmentioned.
+  ~DropReport() {
+    if (throttle_.total() > 0) {
+      logger_.warn("{}: {} dropped {} sample(s) in all", topic_, what_, throttle_.total());
+    }
+  }
 
   void count(uint64_t n, std::string_view reason) {
     if (auto since_last = throttle_.count(n)) {

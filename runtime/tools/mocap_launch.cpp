@@ -159,6 +159,7 @@ int main(int argc, char** argv) {
     launch = mocap::load_launch_file(*file, plugins, overrides);
   } catch (const mocap::LaunchError& e) {
     for (const std::string& problem : e.problems()) fmt::print(stderr, "{}\n", problem);
+    fmt::print(stderr, "{}: {} problem(s); nothing was started\n", *file, e.problems().size());
     return 1;
   }
   if (group && launch.find_group(*group) == nullptr) {

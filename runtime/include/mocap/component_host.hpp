@@ -39,13 +39,13 @@ struct HostOptions {
 };
 
 struct ComponentConfig {
-  std::string name;
+  std::string name = {};
   // Parameters not given take their declared defaults.
-  std::map<std::string, ParameterValue> parameters;
+  std::map<std::string, ParameterValue> parameters = {};
   // Declared topic -> topic actually used.
-  std::map<std::string, std::string> remaps;
+  std::map<std::string, std::string> remaps = {};
   // Declared topic -> QoS replacing the declared one.
-  std::map<std::string, Qos> qos;
+  std::map<std::string, Qos> qos = {};
 };
 
 // A component that could not be configured or constructed; the message names it.

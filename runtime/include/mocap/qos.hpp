@@ -17,9 +17,9 @@ struct Qos {
   Reliability reliability = Reliability::Reliable;
   Durability durability = Durability::Volatile;
   History history = History::KeepAll;
-  // KeepLast: samples kept per endpoint. KeepAll: samples a subscriber may fall behind
-  // before a DDS publisher waits (up to 100 ms, then drops and counts) and before an
-  // in-process subscriber drops and counts.
+  // KeepLast: samples kept per endpoint, the oldest dropped first. KeepAll: samples a
+  // subscriber may fall behind before its publishers wait for it (see
+  // kReliableBlockingMilliseconds).
   int depth = 1000;
 
   // Streams where the newest sample matters most: best effort, volatile, keep last 5.
@@ -37,6 +37,10 @@ struct Qos {
   std::string to_string() const;
   bool operator==(const Qos&) const = default;
 };
+
+// How long a publisher waits for a keep-all (reliable) subscriber that is `depth` samples
+// behind before it drops the sample and counts it.
+constexpr int kReliableBlockingMilliseconds = 100;
 
 // DDS request/offer rules: a reliable subscriber needs a reliable publisher, a transient
 // local subscriber needs a transient local publisher. Returns why they do not match, or

@@ -1,0 +1,64 @@
+// sequence_source (test plugin): publishes the test stream of sequence_message.hpp.
+#include <fmt/format.h>
+
+#include <mocap/component.hpp>
+
+#include "sequence_message.hpp"
+
+namespace mocap::test {
+namespace {
+
+class SequenceSource final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description("Test stream: numbered FiducialArrays whose content a sink can check.");
+    spec.parameter("count", 1000, "messages to publish; 0 for no end").min(0);
+    spec.parameter("batch", 10, "messages per tick").min(1);
+    spec.parameter("period_s", 0.01, "seconds between ticks").range(1e-5, 60);
+    spec.parameter("subscribers", 1, "matched subscribers to wait for before publishing").min(0);
+    spec.publishes<mocap_msgs::msg::FiducialArray>(kSequenceTopic, Qos::reliable(),
+                                                   "the numbered stream");
+  }
+
+  explicit SequenceSource(Context& context) : Component(context) {
+    count_ = param<int>("count");
+    batch_ = param<int>("batch");
+    subscribers_ = param<size_t>("subscribers");
+    publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kSequenceTopic);
+    create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                     std::chrono::duration<double>(param<double>("period_s"))),
+                 [this] { tick(); });
+  }
+
+ private:
+  void tick() {
+    if (!started_) {
+      if (publisher_.matched_subscribers() < subscribers_) return;
+      started_ = true;
+      log().info("{} subscriber(s) matched; publishing", publisher_.matched_subscribers());
+    }
+    for (int i = 0; i < batch_ && (count_ == 0 || next_ < count_); ++i) {
+      auto message = std::make_shared<mocap_msgs::msg::FiducialArray>(make_sequence_message(next_++));
+      // In-process subscribers receive this very object; they check its address.
+      message->header().frame_id(fmt::format("{}", reinterpret_cast<uintptr_t>(message.get())));
+      publisher_.publish(std::move(message));
+    }
+    if (count_ != 0 && next_ == count_ && !reported_) {
+      reported_ = true;
+      log().info("published {} messages", count_);
+    }
+  }
+
+  int count_;
+  int batch_;
+  size_t subscribers_;
+  int next_ = 0;
+  bool started_ = false;
+  bool reported_ = false;
+  Publisher<mocap_msgs::msg::FiducialArray> publisher_;
+};
+
+}  // namespace
+}  // namespace mocap::test
+
+MOCAP_REGISTER_COMPONENT(mocap::test::SequenceSource, "sequence_source")

@@ -1,0 +1,220 @@
+// Components in one process: declared topics, parameters, zero-copy delivery, timers,
+// errors and shutdown, through the same ComponentHost that mocap_launch uses.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+#include <set>
+
+#include <mocap/component_host.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+
+namespace mocap {
+namespace {
+
+using Array = mocap_msgs::msg::FiducialArray;
+
+HostOptions in_process() { return {.name = "test", .threads = 2, .dds = {.enabled = false}}; }
+
+// What the test components saw; reset by each test.
+struct Record {
+  std::mutex mutex;
+  std::vector<const void*> published;
+  std::vector<const void*> received;
+  std::atomic<int> ticks{0};
+  std::atomic<int> active{0};
+  std::atomic<int> max_active{0};
+  void clear() {
+    published.clear();
+    received.clear();
+    ticks = active = max_active = 0;
+  }
+} record;
+
+class Source final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.parameter("count", 50, "messages to publish").min(1);
+    spec.publishes<Array>("/numbers", Qos::reliable(), "");
+  }
+  explicit Source(Context& context) : Component(context) {
+    publisher_ = create_publisher<Array>("/numbers");
+    create_timer(std::chrono::milliseconds(1), [this] {
+      if (publisher_.matched_subscribers() == 0 || sent_ == param<int>("count")) return;
+      auto message = std::make_shared<Array>();
+      message->header().stamp().sec(sent_++);
+      {
+        std::lock_guard lock(record.mutex);
+        record.published.push_back(message.get());
+      }
+      publisher_.publish(std::move(message));
+    });
+  }
+
+ private:
+  Publisher<Array> publisher_;
+  int sent_ = 0;
+};
+
+class Sink final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.parameter("expect", 50, "messages before shutdown").min(1);
+    spec.subscribes<Array>("/numbers", Qos::reliable(), "");
+  }
+  explicit Sink(Context& context) : Component(context) {
+    create_subscription<Array>("/numbers", [this](const std::shared_ptr<const Array>& m) {
+      std::lock_guard lock(record.mutex);
+      record.received.push_back(m.get());
+      if (static_cast<int>(record.received.size()) == param<int>("expect")) request_shutdown(0);
+    });
+  }
+};
+
+constexpr ComponentFactory kSource = make_component_factory<Source>("source");
+constexpr ComponentFactory kSink = make_component_factory<Sink>("sink");
+
+class ComponentHostTest : public ::testing::Test {
+ protected:
+  void SetUp() override { record.clear(); }
+};
+
+TEST_F(ComponentHostTest, InProcessDeliveryIsByPointer) {
+  ComponentHost host(in_process());
+  host.add(kSource, {.name = "source"});
+  host.add(kSink, {.name = "sink"});
+  EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
+  ASSERT_EQ(record.received.size(), 50u);
+  EXPECT_EQ(record.received, record.published);
+}
+
+TEST_F(ComponentHostTest, RemapsConnectTopics) {
+  ComponentHost host(in_process());
+  host.add(kSource, {.name = "source", .remaps = {{"/numbers", "/renamed"}}});
+  host.add(kSink, {.name = "unconnected", .parameters = {{"expect", int64_t{1}}}});
+  host.add(kSink, {.name = "sink", .remaps = {{"/numbers", "/renamed"}}});
+  EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
+  EXPECT_EQ(record.received.size(), 50u);  // all from "sink"
+}
+
+TEST_F(ComponentHostTest, QosOverrideThatCannotMatchDeliversNothing) {
+  ComponentHost host(in_process());
+  host.add(kSource, {.name = "source", .qos = {{"/numbers", Qos::sensor_data()}}});
+  host.add(kSink, {.name = "sink"});  // reliable: does not match best effort
+  host.run(std::chrono::milliseconds(200));
+  EXPECT_TRUE(record.received.empty());
+}
+
+class Latcher final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) { spec.publishes<Array>("/numbers", Qos::latched(), ""); }
+  explicit Latcher(Context& context) : Component(context) {
+    auto message = std::make_shared<Array>();
+    record.published.push_back(message.get());
+    create_publisher<Array>("/numbers").publish(std::move(message));
+  }
+};
+
+TEST_F(ComponentHostTest, LatchedSampleReachesALateComponentByPointer) {
+  ComponentHost host(in_process());
+  host.add(make_component_factory<Latcher>("latcher"), {.name = "latcher"});
+  host.start();
+  host.add(kSink, {.name = "late",
+                   .parameters = {{"expect", int64_t{1}}},
+                   .qos = {{"/numbers", Qos::latched()}}});
+  EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
+  ASSERT_EQ(record.received.size(), 1u);
+  EXPECT_EQ(record.received[0], record.published[0]);
+}
+
+class Undeclared final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) { spec.publishes<Array>("/declared", Qos::reliable(), ""); }
+  explicit Undeclared(Context& context) : Component(context) {
+    create_publisher<Array>("/undeclared");
+  }
+};
+
+class Throwing final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit Throwing(Context& context) : Component(context) {
+    throw std::runtime_error("cannot open /dev/ttyUSB9");
+  }
+};
+
+TEST_F(ComponentHostTest, StartErrorsNameTheComponent) {
+  ComponentHost host(in_process());
+  try {
+    host.add(make_component_factory<Undeclared>("undeclared"), {.name = "u"});
+    FAIL();
+  } catch (const ComponentError& e) {
+    EXPECT_STREQ(e.what(), "component 'u' (undeclared) failed to start: component 'u' publishes "
+                           "to '/undeclared', which its declare() does not declare (declared: "
+                           "/declared)");
+  }
+  try {
+    host.add(make_component_factory<Throwing>("throwing"), {.name = "t"});
+    FAIL();
+  } catch (const ComponentError& e) {
+    EXPECT_STREQ(e.what(), "component 't' (throwing) failed to start: cannot open /dev/ttyUSB9");
+  }
+}
+
+TEST_F(ComponentHostTest, ConfigurationErrors) {
+  ComponentHost host(in_process());
+  host.add(kSink, {.name = "sink"});
+  auto error_of = [&](ComponentConfig config) -> std::string {
+    try {
+      host.add(kSink, std::move(config));
+    } catch (const ComponentError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error_of({.name = "sink"}), "component 'sink' (sink): the name is taken");
+  EXPECT_EQ(error_of({.name = "a b"}),
+            "component 'a b' (sink): names use letters, digits, '_' and '-'");
+  EXPECT_EQ(error_of({.name = "other", .parameters = {{"expct", int64_t{2}}, {"expect", 0.5}}}),
+            "component 'other' (sink): unknown parameter 'expct' (did you mean 'expect'?); "
+            "parameter 'expect' expects int >= 1, got double 0.5");
+  EXPECT_EQ(error_of({.name = "other", .remaps = {{"/numbers", "numbers"}}}),
+            "component 'other' (sink): remap target 'numbers' is not a topic name (like /a/b_c)");
+}
+
+class Ticker final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.parameter("fail", false, "throw from every other tick");
+  }
+  explicit Ticker(Context& context) : Component(context) {
+    bool fail = param<bool>("fail");
+    for (int timer = 0; timer < 3; ++timer) {
+      create_timer(std::chrono::microseconds(200), [this, fail] {
+        // Callbacks of one component never overlap, however many threads there are.
+        int now_active = ++record.active;
+        int seen = record.max_active;
+        while (now_active > seen && !record.max_active.compare_exchange_weak(seen, now_active)) {
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+        --record.active;
+        int tick = ++record.ticks;
+        if (tick == 300) request_shutdown(7);
+        if (fail && tick % 2 == 0) throw std::runtime_error("odd failure");
+      });
+    }
+  }
+};
+
+TEST_F(ComponentHostTest, OneComponentsCallbacksNeverOverlapAndErrorsAreCounted) {
+  ComponentHost host({.name = "test", .threads = 4, .dds = {.enabled = false}});
+  host.add(make_component_factory<Ticker>("ticker"), {.name = "ticker",
+                                                      .parameters = {{"fail", true}}});
+  EXPECT_EQ(host.run(std::chrono::seconds(60)), 7);  // the requested exit code
+  EXPECT_GE(record.ticks, 300);
+  EXPECT_EQ(record.max_active, 1);
+  EXPECT_GE(host.callback_errors(), 150u);
+}
+
+}  // namespace
+}  // namespace mocap

@@ -1,0 +1,246 @@
+// DDS between processes: rediscovery, reliability, zero-copy kept beside remote subscribers,
+// late joiners of latched topics, and the command-line tools.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <fmt/format.h>
+
+#include "test_support.hpp"
+
+namespace mocap {
+namespace {
+
+std::map<std::string, std::string> environment(int slot) {
+  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))},
+          {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}};
+}
+
+std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
+std::string topic_tool() { return (test::bin_dir() / "mocap_topic").string(); }
+
+std::string source_yaml(const std::string& parameters, const std::string& qos = "reliable") {
+  return fmt::format(R"(groups:
+  - name: source
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {{{}}}
+        qos: {{/test/sequence: {}}}
+)",
+                     parameters, qos);
+}
+
+std::string sink_yaml(const std::string& parameters, const std::string& qos = "reliable") {
+  return fmt::format(R"(groups:
+  - name: sink
+    components:
+      - plugin: sequence_sink
+        name: sink
+        parameters: {{{}}}
+        qos: {{/test/sequence: {}}}
+)",
+                     parameters, qos);
+}
+
+TEST(Dds, ARestartedSubscriberProcessReceivesAgain) {
+  test::TempDir dir;
+  auto env = environment(10);
+  test::write_file(dir / "source.yaml", source_yaml("count: 0, batch: 1, period_s: 0.01, subscribers: 0"));
+  test::write_file(dir / "sink.yaml", sink_yaml("expect: 0, log_every: 20, timeout_s: 120"));
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+
+  test::ChildProcess first({launcher(), (dir / "sink.yaml").string()}, env, dir / "first.log");
+  ASSERT_TRUE(first.wait_for_output("received 20", std::chrono::seconds(60))) << first.output();
+  first.signal(SIGKILL);  // no goodbye to the publisher
+  ASSERT_EQ(first.wait(std::chrono::seconds(10)), 128 + SIGKILL);
+
+  test::ChildProcess second({launcher(), (dir / "sink.yaml").string()}, env, dir / "second.log");
+  EXPECT_TRUE(second.wait_for_output("received 20", std::chrono::seconds(60)))
+      << second.output() << source.output();
+  second.signal(SIGTERM);
+  EXPECT_EQ(second.wait(std::chrono::seconds(30)), 0) << second.output();
+  source.signal(SIGTERM);
+  EXPECT_EQ(source.wait(std::chrono::seconds(30)), 0) << source.output();
+}
+
+TEST(Dds, ReliableLosesNothingAcrossTenThousandMessages) {
+  test::TempDir dir;
+  test::write_file(dir / "graph.yaml", fmt::format(R"(groups:
+  - name: source
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {{count: 10000, batch: 200, period_s: 0.002}}
+  - name: sink
+    components:
+      - plugin: sequence_sink
+        name: sink
+        parameters: {{expect: 10000, summary_file: "{}", timeout_s: 120}}
+)",
+                                                   (dir / "summary.yaml").string()));
+  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
+                                          environment(11), std::chrono::seconds(180));
+  ASSERT_EQ(code, 0) << output;
+  auto summary = test::read_summary(dir / "summary.yaml");
+  EXPECT_EQ(summary.at("received"), 10000);
+  EXPECT_EQ(summary.at("missing"), 0);
+  EXPECT_EQ(summary.at("out_of_order"), 0);
+  EXPECT_EQ(summary.at("corrupt"), 0);
+  EXPECT_EQ(output.find("dropped"), std::string::npos) << output;
+}
+
+// A topic with subscribers in the publisher's process and in another: the local one still
+// gets pointers, and gets each sample once (not again through DDS).
+TEST(Dds, LocalDeliveryStaysZeroCopyAndSingleBesideARemoteSubscriber) {
+  test::TempDir dir;
+  auto env = environment(12);
+  test::write_file(dir / "local.yaml", fmt::format(R"(groups:
+  - name: local
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {{count: 500, batch: 50, period_s: 0.01, subscribers: 2}}
+      - plugin: sequence_sink
+        name: local_sink
+        parameters: {{expect: 500, summary_file: "{}", stop_when_done: false}}
+)",
+                                                   (dir / "local.yaml.summary").string()));
+  test::write_file(dir / "remote.yaml",
+                   sink_yaml(fmt::format("expect: 500, summary_file: \"{}\"",
+                                         (dir / "remote.yaml.summary").string())));
+  test::ChildProcess local({launcher(), (dir / "local.yaml").string()}, env, dir / "local.log");
+  test::ChildProcess remote({launcher(), (dir / "remote.yaml").string()}, env, dir / "remote.log");
+  ASSERT_EQ(remote.wait(std::chrono::seconds(90)), 0) << remote.output() << local.output();
+  ASSERT_TRUE(local.wait_for_output("received 500 messages", std::chrono::seconds(30)))
+      << local.output();
+  // Anything the local sink would get twice would have arrived by now.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  local.signal(SIGTERM);
+  EXPECT_EQ(local.wait(std::chrono::seconds(30)), 0) << local.output();
+
+  auto local_summary = test::read_summary(dir / "local.yaml.summary");
+  EXPECT_EQ(local_summary.at("received"), 500);
+  EXPECT_EQ(local_summary.at("same_object"), 500);
+  EXPECT_EQ(local_summary.at("out_of_order"), 0);
+  EXPECT_EQ(local.output().find("received 501"), std::string::npos);
+  auto remote_summary = test::read_summary(dir / "remote.yaml.summary");
+  EXPECT_EQ(remote_summary.at("received"), 500);
+  EXPECT_EQ(remote_summary.at("missing"), 0);
+  EXPECT_EQ(remote_summary.at("same_object"), 0);
+}
+
+TEST(Dds, ALatchedSampleReachesAProcessStartedLater) {
+  test::TempDir dir;
+  auto env = environment(13);
+  test::write_file(dir / "source.yaml", source_yaml("count: 1, subscribers: 0", "latched"));
+  test::write_file(dir / "sink.yaml",
+                   sink_yaml(fmt::format("expect: 1, summary_file: \"{}\"",
+                                         (dir / "summary").string()),
+                             "latched"));
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+  ASSERT_TRUE(source.wait_for_output("published 1 messages", std::chrono::seconds(30)));
+  auto [code, output] = test::run_command({launcher(), (dir / "sink.yaml").string()}, env);
+  EXPECT_EQ(code, 0) << output;
+  EXPECT_EQ(test::read_summary(dir / "summary").at("received"), 1);
+  source.signal(SIGTERM);
+}
+
+TEST(Dds, TopicToolListsEchoesAndMeasures) {
+  test::TempDir dir;
+  auto env = environment(14);
+  test::write_file(dir / "source.yaml",
+                   source_yaml("count: 0, batch: 1, period_s: 0.01, subscribers: 0"));
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+
+  auto [list_code, list] = test::run_command({topic_tool(), "list", "--wait", "3"}, env);
+  EXPECT_EQ(list_code, 0);
+  EXPECT_NE(list.find("/test/sequence [mocap_msgs/msg/FiducialArray] 1 publisher(s)"),
+            std::string::npos)
+      << list;
+
+  auto [echo_code, echo] =
+      test::run_command({topic_tool(), "echo", "/test/sequence", "--count", "2"}, env);
+  EXPECT_EQ(echo_code, 0) << echo;
+  EXPECT_NE(echo.find("header:\n  stamp:\n    sec: "), std::string::npos) << echo;
+  EXPECT_NE(echo.find("fiducials:\n  - x: "), std::string::npos) << echo;
+  EXPECT_NE(echo.find("    uncertainty: 0.5\n"), std::string::npos) << echo;
+  EXPECT_EQ(std::count(echo.begin(), echo.end(), '-') >= 2, true);
+
+  auto [hz_code, hz] = test::run_command({topic_tool(), "hz", "/test/sequence", "--count", "2"}, env);
+  EXPECT_EQ(hz_code, 0) << hz;
+  EXPECT_NE(hz.find("average rate: "), std::string::npos) << hz;
+  source.signal(SIGTERM);
+}
+
+TEST(Launcher, CheckReportsProblemsAndStartsNothing) {
+  test::TempDir dir;
+  test::write_file(dir / "bad.yaml", sink_yaml("expect: -1, colour: red"));
+  auto [code, output] = test::run_command({launcher(), (dir / "bad.yaml").string(), "--check"},
+                                          environment(15));
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(output.find("bad.yaml:6: component 'sink' (sequence_sink): unknown parameter 'colour'"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("bad.yaml: 2 problem(s); nothing was started"), std::string::npos)
+      << output;
+  // Without --check, the same file starts nothing either.
+  auto [run_code, run_output] =
+      test::run_command({launcher(), (dir / "bad.yaml").string()}, environment(15));
+  EXPECT_EQ(run_code, 1);
+  EXPECT_EQ(run_output.find("[INFO]"), std::string::npos) << run_output;
+
+  test::write_file(dir / "good.yaml", sink_yaml("expect: 1"));
+  auto [good_code, good] = test::run_command({launcher(), (dir / "good.yaml").string(), "--check"},
+                                             environment(15));
+  EXPECT_EQ(good_code, 0) << good;
+  EXPECT_NE(good.find("valid (1 group(s), 1 component(s))"), std::string::npos);
+
+  auto [usage_code, usage] = test::run_command({launcher(), "--frobnicate"});
+  EXPECT_EQ(usage_code, 2);
+  EXPECT_NE(usage.find("unknown option --frobnicate"), std::string::npos);
+}
+
+TEST(Launcher, DescribeListsParametersAndTopics) {
+  auto [code, output] =
+      test::run_command({launcher(), "--describe", "sequence_sink"}, environment(16));
+  EXPECT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("  expect: int >= 0 = 1000\n"), std::string::npos) << output;
+  EXPECT_NE(output.find("subscribes /test/sequence [mocap_msgs/msg/FiducialArray] reliable"),
+            std::string::npos)
+      << output;
+  auto [missing_code, missing] = test::run_command({launcher(), "--describe", "sequence_snk"},
+                                                   environment(16));
+  EXPECT_EQ(missing_code, 1);
+  EXPECT_NE(missing.find("did you mean 'sequence_sink'?"), std::string::npos) << missing;
+}
+
+// A group whose component cannot start stops the whole deployment, loudly, with its code.
+TEST(Launcher, AGroupThatFailsToStartStopsTheOthers) {
+  test::TempDir dir;
+  test::write_file(dir / "graph.yaml", R"(groups:
+  - name: healthy
+    components:
+      - plugin: sequence_sink
+        name: sink
+        parameters: {expect: 0}
+  - name: broken
+    components:
+      - plugin: failing_start
+        name: servo
+)");
+  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
+                                          environment(17));
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find("[broken] " + (dir / "graph.yaml").string() +
+                        ":10: component 'servo' (failing_start) failed to start: cannot open "
+                        "/dev/ttyUSB9"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("[launch] group 'broken' exited with code 1; stopping the others"),
+            std::string::npos)
+      << output;
+}
+
+}  // namespace
+}  // namespace mocap

@@ -1,0 +1,42 @@
+// The demo components' algorithms.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fiducial_pattern.hpp"
+#include "stream_statistics.hpp"
+
+namespace mocap::demo {
+namespace {
+
+TEST(FiducialPattern, PointsOnATurningCircle) {
+  PatternOptions options{.count = 4, .image_width = 100, .image_height = 50, .radius_px = 10,
+                         .turns_per_second = 0.25};
+  auto points = fiducial_pattern(options, 0.0);
+  ASSERT_EQ(points.size(), 4u);
+  EXPECT_NEAR(points[0].x, 60, 1e-9);
+  EXPECT_NEAR(points[0].y, 25, 1e-9);
+  EXPECT_NEAR(points[1].x, 50, 1e-9);
+  EXPECT_NEAR(points[1].y, 35, 1e-9);
+  auto later = fiducial_pattern(options, 1.0);  // a quarter turn later
+  EXPECT_NEAR(later[0].x, points[1].x, 1e-9);
+  EXPECT_NEAR(later[0].y, points[1].y, 1e-9);
+}
+
+TEST(StreamStatistics, ReportsAndStartsOver) {
+  StreamStatistics statistics;
+  EXPECT_FALSE(statistics.report());
+  for (int i = 1; i <= 100; ++i) statistics.add(i * 1e-3, 12);
+  auto report = statistics.report();
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->messages, 100u);
+  EXPECT_DOUBLE_EQ(report->mean_items, 12);
+  EXPECT_DOUBLE_EQ(report->latency_median_s, 50e-3);
+  EXPECT_DOUBLE_EQ(report->latency_p99_s, 99e-3);
+  EXPECT_DOUBLE_EQ(report->latency_max_s, 100e-3);
+  EXPECT_FALSE(statistics.report());
+  EXPECT_EQ(statistics.total_messages(), 100u);
+}
+
+}  // namespace
+}  // namespace mocap::demo

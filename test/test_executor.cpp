@@ -1,0 +1,117 @@
+// The executor: strands run one callback at a time, yield to others, and survive errors.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
+
+#include "executor.hpp"
+#include "timer_service.hpp"
+
+namespace mocap {
+namespace {
+
+// A waitable with as much work as `remaining` says (-1: endless).
+class Work final : public Waitable {
+ public:
+  explicit Work(int remaining) : Waitable("work"), remaining_(remaining) {}
+  bool execute_one() override {
+    if (remaining_ == 0) return false;
+    if (remaining_ > 0) --remaining_;
+    ++done;
+    return true;
+  }
+  std::atomic<int> done{0};
+
+ private:
+  std::atomic<int> remaining_;
+};
+
+bool eventually(const std::function<bool()>& condition) {
+  for (int i = 0; i < 3000 && !condition(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return condition();
+}
+
+TEST(Executor, AStrandWithEndlessWorkDoesNotStarveOthers) {
+  Executor executor(1);
+  Logger logger("test");
+  Strand busy(executor, logger), quiet(executor, logger);
+  auto endless = std::make_shared<Work>(-1);
+  auto single = std::make_shared<Work>(1);
+  busy.add(endless);
+  quiet.add(single);
+  busy.enable();
+  busy.notify();
+  executor.start();
+  quiet.enable();
+  quiet.notify();
+  EXPECT_TRUE(eventually([&] { return single->done == 1; }));
+  executor.stop();
+  EXPECT_GT(endless->done, 0);
+}
+
+TEST(Executor, NothingRunsBeforeEnable) {
+  Executor executor(2);
+  Logger logger("test");
+  Strand strand(executor, logger);
+  auto work = std::make_shared<Work>(3);
+  strand.add(work);
+  executor.start();
+  strand.notify();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(work->done, 0);
+  strand.enable();  // the notification was kept
+  EXPECT_TRUE(eventually([&] { return work->done == 3; }));
+}
+
+class Thrower final : public Waitable {
+ public:
+  Thrower() : Waitable("thrower") {}
+  bool execute_one() override {
+    if (left_ == 0) return false;
+    --left_;
+    throw std::runtime_error("boom");
+  }
+
+ private:
+  std::atomic<int> left_{5};
+};
+
+TEST(Executor, ACallbackThatThrowsIsCountedAndTheStrandGoesOn) {
+  Executor executor(2);
+  Logger logger("test");
+  Strand strand(executor, logger);
+  auto thrower = std::make_shared<Thrower>();
+  auto work = std::make_shared<Work>(10);
+  strand.add(thrower);
+  strand.add(work);
+  strand.enable();
+  executor.start();
+  strand.notify();
+  EXPECT_TRUE(eventually([&] { return work->done == 10; }));
+  EXPECT_EQ(strand.callback_errors(), 5u);
+}
+
+TEST(Timers, FireOnTheirStrand) {
+  Executor executor(2);
+  Logger logger("test");
+  Strand strand(executor, logger);
+  TimerService timers;
+  std::atomic<int> ticks{0};
+  auto timer = std::make_shared<Timer>("t", std::chrono::milliseconds(1), [&] { ++ticks; }, strand);
+  strand.add(timer);
+  strand.enable();
+  timers.add(timer);
+  executor.start();
+  timers.start();
+  EXPECT_TRUE(eventually([&] { return ticks >= 20; }));
+  timers.stop();
+  executor.stop();
+  int after_stop = ticks;
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(ticks, after_stop);
+}
+
+}  // namespace
+}  // namespace mocap

@@ -1,0 +1,154 @@
+// One graph, run three ways with the same assertions on what arrives: in one process, in
+// two processes over DDS, and on two "hosts" (network namespaces joined by a veth pair).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "test_support.hpp"
+
+namespace mocap {
+namespace {
+
+constexpr int kCount = 2000;
+
+// The graph: a numbered stream from `source` to `sink`, reliable.
+std::string graph(const std::filesystem::path& summary, bool split, bool shared_memory = true) {
+  std::string source = R"(      - plugin: sequence_source
+        name: source
+        parameters: {count: 2000, batch: 100, period_s: 0.01}
+)";
+  std::string sink = fmt::format(R"(      - plugin: sequence_sink
+        name: sink
+        parameters: {{expect: 2000, summary_file: "{}", timeout_s: 60}}
+)",
+                                 summary.string());
+  std::string dds = fmt::format("dds: {{shared_memory: {}}}\n", shared_memory);
+  if (!split) return dds + "groups:\n  - name: all\n    components:\n" + source + sink;
+  return dds + "groups:\n  - name: source\n    components:\n" + source +
+         "  - name: sink\n    components:\n" + sink;
+}
+
+std::map<std::string, std::string> environment(int slot) {
+  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))},
+          {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}};
+}
+
+std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
+
+// What must arrive, however the graph is deployed.
+void expect_complete_stream(const std::map<std::string, long long>& summary) {
+  EXPECT_EQ(summary.at("received"), kCount);
+  EXPECT_EQ(summary.at("first"), 0);
+  EXPECT_EQ(summary.at("last"), kCount - 1);
+  EXPECT_EQ(summary.at("missing"), 0);
+  EXPECT_EQ(summary.at("out_of_order"), 0);
+  EXPECT_EQ(summary.at("corrupt"), 0);
+}
+
+TEST(Graph, OneProcessDeliversByPointer) {
+  test::TempDir dir;
+  test::write_file(dir / "graph.yaml", graph(dir / "summary.yaml", false));
+  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
+                                          environment(1));
+  ASSERT_EQ(code, 0) << output;
+  auto summary = test::read_summary(dir / "summary.yaml");
+  expect_complete_stream(summary);
+  EXPECT_EQ(summary.at("same_object"), kCount);  // the subscriber saw the publisher's pointers
+}
+
+TEST(Graph, TwoProcessesOverDds) {
+  test::TempDir dir;
+  test::write_file(dir / "graph.yaml", graph(dir / "summary.yaml", true));
+  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
+                                          environment(2));
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("[sink] "), std::string::npos) << output;  // the sink ran in its group
+  EXPECT_NE(output.find("[source] "), std::string::npos) << output;
+  expect_complete_stream(test::read_summary(dir / "summary.yaml"));
+}
+
+// Two network namespaces joined by a veth pair: each is a host with its own network stack.
+class TwoHosts {
+ public:
+  TwoHosts() {
+    std::string id = std::to_string(getpid() % 100000);
+    host_a_ = "mocap_a_" + id;
+    host_b_ = "mocap_b_" + id;
+    std::string link_a = "mva" + id, link_b = "mvb" + id;
+    std::string subnet = fmt::format("10.77.{}", getpid() % 250);
+    for (const auto& command : std::vector<std::vector<std::string>>{
+             {"ip", "netns", "add", host_a_},
+             {"ip", "netns", "add", host_b_},
+             {"ip", "link", "add", link_a, "type", "veth", "peer", "name", link_b},
+             {"ip", "link", "set", link_a, "netns", host_a_},
+             {"ip", "link", "set", link_b, "netns", host_b_},
+             {"ip", "-n", host_a_, "addr", "add", subnet + ".1/24", "dev", link_a},
+             {"ip", "-n", host_b_, "addr", "add", subnet + ".2/24", "dev", link_b},
+             {"ip", "-n", host_a_, "link", "set", "lo", "up"},
+             {"ip", "-n", host_b_, "link", "set", "lo", "up"},
+             {"ip", "-n", host_a_, "link", "set", link_a, "up"},
+             {"ip", "-n", host_b_, "link", "set", link_b, "up"},
+             // DDS discovery is multicast.
+             {"ip", "-n", host_a_, "route", "add", "224.0.0.0/4", "dev", link_a},
+             {"ip", "-n", host_b_, "route", "add", "224.0.0.0/4", "dev", link_b}}) {
+      auto [code, output] = test::run_command(command);
+      if (code != 0) {
+        error_ = fmt::format("{}: {}", fmt::join(command, " "), output);
+        return;
+      }
+    }
+    link_a_ = link_a;
+  }
+
+  ~TwoHosts() {
+    test::run_command({"ip", "netns", "del", host_a_});
+    test::run_command({"ip", "netns", "del", host_b_});
+  }
+
+  // Empty when the hosts are up; otherwise why not (no privileges, no `ip`).
+  const std::string& error() const { return error_; }
+
+  std::vector<std::string> on_a(std::vector<std::string> command) const { return on(host_a_, command); }
+  std::vector<std::string> on_b(std::vector<std::string> command) const { return on(host_b_, command); }
+
+  long long bytes_received_by_a() const {
+    auto [code, output] =
+        test::run_command(on_a({"cat", "/sys/class/net/" + link_a_ + "/statistics/rx_bytes"}));
+    return code == 0 ? std::stoll(output) : -1;
+  }
+
+ private:
+  static std::vector<std::string> on(const std::string& host, std::vector<std::string> command) {
+    command.insert(command.begin(), {"ip", "netns", "exec", host});
+    return command;
+  }
+
+  std::string host_a_, host_b_, link_a_, error_;
+};
+
+TEST(Graph, TwoHostsOverANetwork) {
+  TwoHosts hosts;
+  if (!hosts.error().empty()) GTEST_SKIP() << "cannot make network namespaces: " << hosts.error();
+  test::TempDir dir;
+  // No shared memory: the hosts share this machine's /dev/shm, and the test is about the
+  // network path.
+  test::write_file(dir / "graph.yaml", graph(dir / "summary.yaml", true, false));
+  std::string file = (dir / "graph.yaml").string();
+  long long received_before = hosts.bytes_received_by_a();
+  test::ChildProcess sink(hosts.on_a({launcher(), file, "--group", "sink"}), environment(3),
+                          dir / "sink.log");
+  test::ChildProcess source(hosts.on_b({launcher(), file, "--group", "source"}), environment(3),
+                            dir / "source.log");
+  auto code = sink.wait(std::chrono::seconds(90));
+  source.signal(SIGTERM);
+  ASSERT_EQ(code, 0) << sink.output() << source.output();
+  EXPECT_EQ(source.wait(std::chrono::seconds(30)), 0) << source.output();
+  expect_complete_stream(test::read_summary(dir / "summary.yaml"));
+  // The stream crossed the veth: at least its payload arrived on host A's link.
+  EXPECT_GT(hosts.bytes_received_by_a() - received_before, kCount * 40);
+}
+
+}  // namespace
+}  // namespace mocap

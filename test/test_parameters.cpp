@@ -1,0 +1,126 @@
+// Parameter values: YAML typing, declared types and ranges, typed reads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <mocap/component_spec.hpp>
+#include <mocap/parameter.hpp>
+
+#include "yaml_value.hpp"
+
+namespace mocap {
+namespace {
+
+ParameterValue yaml(const std::string& text) { return parameter_value_from_yaml(YAML::Load(text)); }
+
+TEST(YamlValues, PlainScalarsFollowTheCoreSchema) {
+  EXPECT_EQ(yaml("true"), ParameterValue(true));
+  EXPECT_EQ(yaml("False"), ParameterValue(false));
+  EXPECT_EQ(yaml("42"), ParameterValue(int64_t{42}));
+  EXPECT_EQ(yaml("-7"), ParameterValue(int64_t{-7}));
+  EXPECT_EQ(yaml("0x1F"), ParameterValue(int64_t{31}));
+  EXPECT_EQ(yaml("0.75"), ParameterValue(0.75));
+  EXPECT_EQ(yaml("1e-3"), ParameterValue(0.001));
+  EXPECT_EQ(yaml("-.inf"), ParameterValue(-INFINITY));
+  EXPECT_TRUE(std::isnan(std::get<double>(yaml(".nan"))));
+  EXPECT_EQ(yaml("camera_left"), ParameterValue(std::string("camera_left")));
+  EXPECT_EQ(yaml("yes"), ParameterValue(std::string("yes")));  // YAML 1.2: not a bool
+}
+
+TEST(YamlValues, QuotedScalarsAreStrings) {
+  EXPECT_EQ(yaml("\"42\""), ParameterValue(std::string("42")));
+  EXPECT_EQ(yaml("'true'"), ParameterValue(std::string("true")));
+}
+
+TEST(YamlValues, ListsTakeTheirElementsType) {
+  EXPECT_EQ(yaml("[1, 2, 3]"), ParameterValue(std::vector<int64_t>{1, 2, 3}));
+  EXPECT_EQ(yaml("[1, 2.5]"), ParameterValue(std::vector<double>{1.0, 2.5}));
+  EXPECT_EQ(yaml("[a, b]"), ParameterValue(std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(yaml("[]"), ParameterValue(std::vector<int64_t>{}));
+}
+
+TEST(YamlValues, WhatCannotBeAParameterIsRejected) {
+  EXPECT_THROW(yaml("{a: 1}"), std::invalid_argument);
+  EXPECT_THROW(yaml("[[1], [2]]"), std::invalid_argument);
+  EXPECT_THROW(yaml("[1, a]"), std::invalid_argument);
+  EXPECT_THROW(yaml("~"), std::invalid_argument);
+  EXPECT_THROW(yaml("99999999999999999999"), std::invalid_argument);
+}
+
+ParameterSpec declared(ParameterValue default_value, std::optional<double> min = {},
+                       std::optional<double> max = {}) {
+  return {"p", std::move(default_value), "", min, max};
+}
+
+TEST(ParameterSpec, AcceptsItsTypeAndIntsForDoubles) {
+  EXPECT_FALSE(declared(1.0).check(int64_t{3}));
+  EXPECT_EQ(declared(1.0).coerce(int64_t{3}), ParameterValue(3.0));
+  EXPECT_FALSE(declared(std::vector<double>{}).check(std::vector<int64_t>{1, 2}));
+  EXPECT_EQ(declared(std::vector<double>{}).coerce(std::vector<int64_t>{1, 2}),
+            ParameterValue(std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(declared(std::vector<std::string>{"x"}).coerce(std::vector<int64_t>{}),
+            ParameterValue(std::vector<std::string>{}));
+}
+
+TEST(ParameterSpec, RejectsOtherTypesWithAMessage) {
+  auto why = declared(int64_t{1}).check(1.5);
+  ASSERT_TRUE(why);
+  EXPECT_EQ(*why, "expects int, got double 1.5");
+  EXPECT_EQ(*declared(std::string("a")).check(int64_t{123}), "expects string, got int 123");
+  EXPECT_EQ(*declared(true).check(std::string("yes")), "expects bool, got string \"yes\"");
+  EXPECT_TRUE(declared(std::vector<int64_t>{}).check(int64_t{3}));
+}
+
+TEST(ParameterSpec, ChecksRangesOfNumbersAndListElements) {
+  EXPECT_FALSE(declared(0.5, 0.0, 1.0).check(1.0));
+  EXPECT_EQ(*declared(0.5, 0.0, 1.0).check(1.5), "expects double in [0, 1], got 1.5");
+  EXPECT_TRUE(declared(0.5, 0.0, 1.0).check(NAN));
+  EXPECT_EQ(*declared(int64_t{5}, 1).check(int64_t{0}), "expects int >= 1, got 0");
+  EXPECT_EQ(*declared(std::vector<double>{}, 0.0).check(std::vector<double>{1, -2}),
+            "expects list of double >= 0, got [1.0, -2.0] (element -2.0)");
+}
+
+TEST(Parameters, TypedReads) {
+  Parameters p({{"b", true},
+                {"i", int64_t{7}},
+                {"d", 0.25},
+                {"s", std::string("x")},
+                {"il", std::vector<int64_t>{1, 2}},
+                {"dl", std::vector<double>{0.5}},
+                {"sl", std::vector<std::string>{"a"}}});
+  EXPECT_TRUE(p.get<bool>("b"));
+  EXPECT_EQ(p.get<int>("i"), 7);
+  EXPECT_EQ(p.get<size_t>("i"), 7u);
+  EXPECT_EQ(p.get<double>("d"), 0.25);
+  EXPECT_EQ(p.get<std::string>("s"), "x");
+  EXPECT_EQ(p.get<std::vector<int>>("il"), (std::vector<int>{1, 2}));
+  EXPECT_EQ(p.get<std::vector<double>>("dl"), std::vector<double>{0.5});
+  EXPECT_EQ(p.get<std::vector<std::string>>("sl"), std::vector<std::string>{"a"});
+}
+
+TEST(Parameters, ReadingUndeclaredOrAsAnotherTypeIsABug) {
+  Parameters p({{"d", 0.25}});
+  EXPECT_THROW(p.get<double>("missing"), std::logic_error);
+  try {
+    p.get<int>("d");
+    FAIL();
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "parameter 'd' is double, read as an integer type");
+  }
+}
+
+TEST(ComponentSpec, DeclarationsAndTheirErrors) {
+  ComponentSpec spec;
+  spec.parameter("rate_hz", 30.0, "frames per second").range(1, 120);
+  spec.parameter("device", "/dev/video0", "camera device");
+  spec.parameter("ids", std::vector<int>{1, 2}, "servo ids");
+  ASSERT_EQ(spec.parameters().size(), 3u);
+  EXPECT_EQ(spec.find_parameter("rate_hz")->type_description(), "double in [1, 120]");
+  EXPECT_EQ(spec.find_parameter("device")->type(), ParameterType::String);
+  EXPECT_EQ(spec.find_parameter("ids")->type(), ParameterType::IntList);
+  EXPECT_THROW(spec.parameter("rate_hz", 1, "again"), std::logic_error);
+  EXPECT_EQ(to_string(ParameterValue(std::vector<std::string>{"a", "b\""})), "[\"a\", \"b\\\"\"]");
+}
+
+}  // namespace
+}  // namespace mocap
