@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <mutex>
 #include <thread>
 
 #include "executor.hpp"
@@ -91,6 +92,88 @@ TEST(Executor, ACallbackThatThrowsIsCountedAndTheStrandGoesOn) {
   strand.notify();
   EXPECT_TRUE(eventually([&] { return work->done == 10; }));
   EXPECT_EQ(strand.callback_errors(), 5u);
+}
+
+// A waitable that records the thread of each callback and takes `duration` to run.
+class Recorder final : public Waitable {
+ public:
+  explicit Recorder(std::chrono::microseconds duration) : Waitable("recorder"), duration_(duration) {}
+  bool execute_one() override {
+    if (!due.exchange(false)) return false;
+    std::this_thread::sleep_for(duration_);
+    std::lock_guard lock(mutex);
+    threads.push_back(std::this_thread::get_id());
+    return true;
+  }
+  std::atomic<bool> due{false};
+  std::mutex mutex;
+  std::vector<std::thread::id> threads;
+
+ private:
+  std::chrono::microseconds duration_;
+};
+
+TEST(Executor, DispatchRunsQuickCallbacksOnTheCallersThread) {
+  Executor executor(2);
+  Logger logger("test");
+  Strand strand(executor, logger);
+  auto recorder = std::make_shared<Recorder>(std::chrono::microseconds(0));
+  strand.add(recorder);
+  strand.enable();
+  recorder->due = true;
+  strand.dispatch();  // not started: the executor will run it
+  executor.start();
+  EXPECT_TRUE(eventually([&] { return !recorder->due; }));
+  for (int i = 0; i < 5; ++i) {
+    recorder->due = true;
+    strand.dispatch();
+  }
+  std::lock_guard lock(recorder->mutex);
+  ASSERT_EQ(recorder->threads.size(), 6u);
+  EXPECT_NE(recorder->threads[0], std::this_thread::get_id());
+  for (size_t i = 1; i < 6; ++i) EXPECT_EQ(recorder->threads[i], std::this_thread::get_id());
+}
+
+TEST(Executor, DispatchHandsSlowCallbacksToTheExecutor) {
+  Executor executor(2);
+  Logger logger("test");
+  Strand strand(executor, logger);
+  auto recorder = std::make_shared<Recorder>(std::chrono::milliseconds(3));
+  strand.add(recorder);
+  strand.enable();
+  executor.start();
+  // The first slow callback runs here; it teaches the strand that its callbacks are slow.
+  for (int i = 0; i < 3; ++i) {
+    recorder->due = true;
+    strand.dispatch();
+    EXPECT_TRUE(eventually([&] { return !recorder->due; }));
+  }
+  std::lock_guard lock(recorder->mutex);
+  ASSERT_EQ(recorder->threads.size(), 3u);
+  EXPECT_EQ(recorder->threads[0], std::this_thread::get_id());
+  EXPECT_NE(recorder->threads[2], std::this_thread::get_id());
+}
+
+TEST(Executor, StopWaitsForACallbackRunningOnAnotherThread) {
+  Executor executor(1);
+  Logger logger("test");
+  Strand strand(executor, logger);
+  auto recorder = std::make_shared<Recorder>(std::chrono::milliseconds(200));
+  strand.add(recorder);
+  strand.enable();
+  executor.start();
+  recorder->due = true;
+  std::thread transport([&] { strand.dispatch(); });
+  EXPECT_TRUE(eventually([&] { return !recorder->due; }));  // the callback has begun
+  executor.stop();
+  {
+    std::lock_guard lock(recorder->mutex);
+    EXPECT_EQ(recorder->threads.size(), 1u);  // and had ended when stop() returned
+  }
+  transport.join();
+  recorder->due = true;
+  strand.dispatch();  // stopped: nothing runs
+  EXPECT_TRUE(recorder->due);
 }
 
 TEST(Timers, FireOnTheirStrand) {

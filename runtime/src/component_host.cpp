@@ -189,8 +189,10 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     auto subscription =
         std::make_shared<HostSubscription>("subscription to " + endpoint.topic, std::move(callback));
     for (auto& transport : host_.transports) {
-      subscription->sources_.push_back(
-          transport->subscribe(endpoint, [strand = &strand_] { strand->notify(); }));
+      auto on_data = transport->calls_on_own_threads()
+                         ? std::function<void()>([strand = &strand_] { strand->dispatch(); })
+                         : std::function<void()>([strand = &strand_] { strand->notify(); });
+      subscription->sources_.push_back(transport->subscribe(endpoint, std::move(on_data)));
     }
     waitables_.push_back(subscription);
     strand_.add(subscription);

@@ -13,7 +13,8 @@ Executor::~Executor() { stop(); }
 
 void Executor::start() {
   std::lock_guard lock(mutex_);
-  if (!threads_.empty() || stopping_) return;
+  if (started_ || stopping_) return;
+  started_ = true;
   for (int i = 0; i < thread_count_; ++i) threads_.emplace_back([this] { work(); });
 }
 
@@ -28,6 +29,23 @@ void Executor::stop() {
     if (thread.joinable()) thread.join();
   }
   threads_.clear();
+  std::unique_lock lock(mutex_);
+  foreign_runs_done_.wait(lock, [this] { return foreign_runs_ == 0; });
+}
+
+bool Executor::begin_foreign_run() {
+  std::lock_guard lock(mutex_);
+  if (!started_ || stopping_) return false;
+  ++foreign_runs_;
+  return true;
+}
+
+void Executor::end_foreign_run() {
+  {
+    std::lock_guard lock(mutex_);
+    --foreign_runs_;
+  }
+  foreign_runs_done_.notify_all();
 }
 
 void Executor::schedule(Strand* strand) {
@@ -66,6 +84,21 @@ void Strand::notify() {
   if (enabled_.load() && !scheduled_.exchange(true)) executor_.schedule(this);
 }
 
+void Strand::dispatch() {
+  if (mean_callback_ns_.load() > kQuickCallbackNanoseconds) {
+    notify();
+    return;
+  }
+  pending_.store(true);
+  if (!enabled_.load() || scheduled_.exchange(true)) return;  // queued or running already
+  if (executor_.begin_foreign_run()) {
+    run(kDispatchBudget);
+    executor_.end_foreign_run();
+  } else {
+    executor_.schedule(this);  // not started yet; when stopping, this does nothing
+  }
+}
+
 void Strand::enable() {
   enabled_.store(true);
   if (pending_.load() && !scheduled_.exchange(true)) executor_.schedule(this);
@@ -73,7 +106,14 @@ void Strand::enable() {
 
 bool Strand::execute(Waitable& waitable) {
   try {
-    return waitable.execute_one();
+    auto start = std::chrono::steady_clock::now();
+    if (!waitable.execute_one()) return false;
+    int64_t took = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::steady_clock::now() - start)
+                       .count();
+    int64_t mean = mean_callback_ns_.load();
+    mean_callback_ns_.store(mean + (took - mean) / 16);
+    return true;
   } catch (const std::exception& e) {
     callback_errors_.fetch_add(1);
     if (auto count = waitable.error_log_.count()) {
@@ -90,8 +130,7 @@ bool Strand::execute(Waitable& waitable) {
   return true;
 }
 
-void Strand::run() {
-  int budget = kBudget;
+void Strand::run(int budget) {
   for (;;) {
     pending_.store(false);
     bool did_work = false;

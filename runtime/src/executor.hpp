@@ -43,10 +43,15 @@ class Executor {
   Executor& operator=(const Executor&) = delete;
 
   void start();
-  // Lets running callbacks finish, then joins the threads. Later schedule() calls are ignored.
+  // Lets running callbacks finish (those run by other threads through Strand::dispatch()
+  // too), then joins the threads. Later schedule() and dispatch() calls run nothing.
   void stop();
   void schedule(Strand* strand);
   int threads() const { return thread_count_; }
+
+  // Brackets a strand run on a thread of another's (Strand::dispatch()); false once stopping.
+  bool begin_foreign_run();
+  void end_foreign_run();
 
  private:
   void work();
@@ -54,8 +59,11 @@ class Executor {
   int thread_count_;
   std::mutex mutex_;
   std::condition_variable ready_cv_;
+  std::condition_variable foreign_runs_done_;
   std::deque<Strand*> ready_;
+  bool started_ = false;
   bool stopping_ = false;
+  int foreign_runs_ = 0;
   std::vector<std::thread> threads_;
 };
 
@@ -70,16 +78,26 @@ class Strand {
   void remove(const Waitable* waitable);
   // Thread-safe; called by transports and timers when a waitable may have work.
   void notify();
+  // For transports that call from threads of their own (DDS listeners): runs the ready
+  // callbacks right here when the strand is idle and its callbacks have been quick, which
+  // saves the thread wake-up of a hand-off; otherwise as notify(). Never used for in-process
+  // delivery, so that publishing never runs a subscriber's code. Quick callbacks keep the
+  // transport's thread free for its other work.
+  void dispatch();
   // A strand runs nothing before it is enabled, so that a component's subscriptions cannot
   // call into it before its constructor has returned. Notifications are kept until then.
   void enable();
   // Called by the executor.
-  void run();
+  void run(int budget = kBudget);
   uint64_t callback_errors() const { return callback_errors_.load(); }
 
  private:
   // Callbacks before the strand yields its thread to other strands.
   static constexpr int kBudget = 64;
+  // Callbacks run on a transport's thread before the rest goes to the executor.
+  static constexpr int kDispatchBudget = 8;
+  // Mean callback duration up to which dispatch() runs callbacks on the caller's thread.
+  static constexpr int64_t kQuickCallbackNanoseconds = 100000;
 
   bool execute(Waitable& waitable);
 
@@ -90,6 +108,7 @@ class Strand {
   std::atomic<bool> scheduled_{false};
   std::atomic<bool> pending_{false};
   std::atomic<uint64_t> callback_errors_{0};
+  std::atomic<int64_t> mean_callback_ns_{0};  // moving average over about 16 callbacks
 };
 
 }  // namespace mocap

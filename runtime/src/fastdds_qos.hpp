@@ -13,6 +13,9 @@
 
 namespace mocap {
 
+// Shared memory of each participant for messages to processes on the same host.
+constexpr uint32_t kSharedMemorySegmentBytes = 8 * 1024 * 1024;
+
 eprosima::fastdds::dds::DataWriterQos to_writer_qos(const Qos& qos);
 eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);
 eprosima::fastdds::dds::DomainParticipantQos to_participant_qos(const DdsOptions& options,

@@ -136,11 +136,15 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
         endpoint_(endpoint),
         own_prefix_(transport.participant_->guid().guidPrefix),
         drops_(endpoint, "publisher") {
-    topic_ = transport.acquire_topic(endpoint);
+    const TopicUse& use = transport.acquire_topic(endpoint);
+    topic_ = use.topic;
+    local_writers_ = use.local_writers;
+    local_writers_->fetch_add(1);
     writer_ = transport.publisher_->create_datawriter(topic_, to_writer_qos(endpoint.qos), this,
                                                       dds::StatusMask::publication_matched() <<
                                                           dds::StatusMask::offered_incompatible_qos());
     if (writer_ == nullptr) {
+      local_writers_->fetch_sub(1);
       transport.release_topic(topic_);
       throw std::runtime_error(fmt::format("cannot create a DDS writer for {}", endpoint.topic));
     }
@@ -149,6 +153,7 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   ~Writer() override {
     writer_->set_listener(nullptr);
     transport_.publisher_->delete_datawriter(writer_);
+    local_writers_->fetch_sub(1);
     transport_.release_topic(topic_);
   }
 
@@ -203,6 +208,7 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   rtps::GuidPrefix_t own_prefix_;
   DropReport drops_;
   dds::Topic* topic_ = nullptr;
+  std::shared_ptr<std::atomic<int>> local_writers_;
   dds::DataWriter* writer_ = nullptr;
   std::atomic<int> remote_readers_{0};
 };
@@ -218,7 +224,9 @@ class FastDdsTransport::Reader final : public TransportSubscription,
         on_data_(std::move(on_data)),
         own_prefix_(transport.participant_->guid().guidPrefix),
         drops_(endpoint, "subscriber") {
-    topic_ = transport.acquire_topic(endpoint);
+    const TopicUse& use = transport.acquire_topic(endpoint);
+    topic_ = use.topic;
+    local_writers_ = use.local_writers;
     reader_ = transport.subscriber_->create_datareader(
         topic_, to_reader_qos(endpoint.qos), this,
         dds::StatusMask::data_available() << dds::StatusMask::sample_lost()
@@ -238,9 +246,15 @@ class FastDdsTransport::Reader final : public TransportSubscription,
 
   bool take(ReceivedMessage& out) override {
     dds::SampleInfo info;
-    while (reader_->get_first_untaken_info(&info) == ReturnCode_t::RETCODE_OK) {
+    for (;;) {
       DdsSample sample;
-      sample.skip = is_own(info);
+      // Only when this process writes the topic too can the next sample be our own; then a
+      // peek lets it be dropped without deserializing it.
+      if (local_writers_->load() > 0) {
+        if (reader_->get_first_untaken_info(&info) != ReturnCode_t::RETCODE_OK) return false;
+        sample.skip = is_own(info);
+      }
+      if (!sample.skip) sample.message = reusable_message();
       if (reader_->take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return false;
       // A sample can arrive between peeking and taking; judge what was actually taken.
       if (!info.valid_data || is_own(info)) continue;
@@ -250,13 +264,14 @@ class FastDdsTransport::Reader final : public TransportSubscription,
       }
       if (sample.malformed) {
         drops_.count(1, "malformed serialized data");
+        sample.message = nullptr;  // not back to the pool: it may be half-written
+        std::erase_if(pool_, [](const auto& m) { return m.use_count() == 1; });
         continue;
       }
       out.message = std::move(sample.message);
       out.source_time = to_time_point(info.source_timestamp);
       return true;
     }
-    return false;
   }
 
   void on_data_available(dds::DataReader*) override { on_data_(); }
@@ -266,9 +281,12 @@ class FastDdsTransport::Reader final : public TransportSubscription,
                  "lost in transit (best effort)");
   }
 
+  // A reliable reader's rejected samples are sent again; only a best-effort reader's are lost.
   void on_sample_rejected(dds::DataReader*, const dds::SampleRejectedStatus& status) override {
-    drops_.count(static_cast<uint64_t>(status.total_count_change),
-                 "rejected: the subscriber's queue is full");
+    if (endpoint_.qos.reliability == Reliability::BestEffort) {
+      drops_.count(static_cast<uint64_t>(status.total_count_change),
+                   "rejected: the subscriber's queue is full");
+    }
   }
 
   void on_requested_incompatible_qos(dds::DataReader*,
@@ -284,12 +302,28 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     return info.sample_identity.writer_guid().guidPrefix == own_prefix_;
   }
 
+  // A message object no subscriber holds any more, or a new one. Deserializing into a used
+  // object keeps its buffers: no allocation and no page faults for each image.
+  std::shared_ptr<void> reusable_message() {
+    for (const auto& message : pool_) {
+      // Only the pool holds it, so no other thread can take a new reference meanwhile.
+      if (message.use_count() == 1) return message;
+    }
+    auto message = endpoint_.type->create();
+    if (pool_.size() < kPoolSize) pool_.push_back(message);
+    return message;
+  }
+
+  static constexpr size_t kPoolSize = 4;
+  std::vector<std::shared_ptr<void>> pool_;
+
   FastDdsTransport& transport_;
   Endpoint endpoint_;
   std::function<void()> on_data_;
   rtps::GuidPrefix_t own_prefix_;
   DropReport drops_;
   dds::Topic* topic_ = nullptr;
+  std::shared_ptr<std::atomic<int>> local_writers_;
   dds::DataReader* reader_ = nullptr;
 };
 
@@ -333,7 +367,7 @@ std::vector<DiscoveredEndpoint> FastDdsTransport::discovered_endpoints() const {
   return listener_->endpoints();
 }
 
-dds::Topic* FastDdsTransport::acquire_topic(const Endpoint& endpoint) {
+const FastDdsTransport::TopicUse& FastDdsTransport::acquire_topic(const Endpoint& endpoint) {
   std::lock_guard lock(mutex_);
   std::string name = dds_topic_name(endpoint.topic);
   if (auto it = topics_.find(name); it != topics_.end()) {
@@ -345,7 +379,7 @@ dds::Topic* FastDdsTransport::acquire_topic(const Endpoint& endpoint) {
                                               endpoint.type->name()));
     }
     ++it->second.users;
-    return it->second.topic;
+    return it->second;
   }
   if (participant_->find_type(endpoint.type->dds_name()).empty()) {
     dds::TypeSupport support(new DdsTypeAdapter(*endpoint.type));
@@ -359,8 +393,10 @@ dds::Topic* FastDdsTransport::acquire_topic(const Endpoint& endpoint) {
   if (topic == nullptr) {
     throw std::runtime_error(fmt::format("cannot create DDS topic {}", name));
   }
-  topics_[name] = {topic, 1};
-  return topic;
+  TopicUse& use = topics_[name];
+  use.topic = topic;
+  use.users = 1;
+  return use;
 }
 
 void FastDdsTransport::release_topic(dds::Topic* topic) {

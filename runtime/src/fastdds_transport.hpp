@@ -7,6 +7,7 @@
 // when no reader of another participant is matched.
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -44,6 +45,7 @@ class FastDdsTransport final : public Transport {
   std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) override;
   std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
                                                    std::function<void()> on_data) override;
+  bool calls_on_own_threads() const override { return true; }
 
   int domain_id() const { return domain_id_; }
   // Endpoints of other participants seen so far (alive ones only).
@@ -56,7 +58,13 @@ class FastDdsTransport final : public Transport {
  private:
   friend class Writer;
   friend class Reader;
-  eprosima::fastdds::dds::Topic* acquire_topic(const Endpoint& endpoint);
+  struct TopicUse {
+    eprosima::fastdds::dds::Topic* topic = nullptr;
+    int users = 0;
+    // Writers of this process on the topic: only then can its readers see their own samples.
+    std::shared_ptr<std::atomic<int>> local_writers = std::make_shared<std::atomic<int>>(0);
+  };
+  const TopicUse& acquire_topic(const Endpoint& endpoint);
   void release_topic(eprosima::fastdds::dds::Topic* topic);
 
   int domain_id_;
@@ -65,10 +73,6 @@ class FastDdsTransport final : public Transport {
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::mutex mutex_;
-  struct TopicUse {
-    eprosima::fastdds::dds::Topic* topic;
-    int users;
-  };
   std::map<std::string, TopicUse> topics_;
 };
 

@@ -29,7 +29,7 @@ bool DdsTypeAdapter::deserialize(SerializedPayload_t* payload, void* data) {
   auto* sample = static_cast<DdsSample*>(data);
   if (sample->skip) return true;
   try {
-    sample->message = type_.create();
+    if (sample->message == nullptr) sample->message = type_.create();
     type_.deserialize({payload->data, payload->length}, sample->message.get());
   } catch (const SerializationError&) {
     sample->malformed = true;

@@ -12,6 +12,8 @@ namespace mocap {
 
 // What a DataReader deserializes into. Writers are given the message object itself.
 struct DdsSample {
+  // Set before taking: an object to deserialize into, reused so that large messages do not
+  // cost an allocation each; the adapter creates one when null.
   std::shared_ptr<void> message;
   bool skip = false;       // set before taking: drop without deserializing
   bool malformed = false;  // set by deserialization

@@ -48,9 +48,11 @@ class Transport {
  public:
   virtual ~Transport() = default;
   virtual std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) = 0;
-  // `on_data` may be called from any thread, whenever a message may be ready to take.
+  // `on_data` may be called from any thread, whenever a message may be ready to take. When
+  // calls_on_own_threads(), only from the transport's own threads, never a publisher's.
   virtual std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
                                                            std::function<void()> on_data) = 0;
+  virtual bool calls_on_own_threads() const { return false; }
 };
 
 // Counts dropped samples of one endpoint and logs them at most every two seconds.

@@ -1,0 +1,556 @@
+// Latency and throughput of one hop: in-process through the runtime, between processes
+// through the runtime, and between processes through raw Fast DDS with the same type (its
+// fastddsgen type support) and the same QoS, all measured in this run.
+//
+//   build/bin/transport_bench [--quick]
+//
+// One-way latency: the publisher stamps each message with CLOCK_MONOTONIC just before
+// publishing, the subscriber subtracts it from its own reading on arrival (processes of one
+// host share the clock). Throughput: reliable QoS, publishing as fast as flow control allows,
+// from the first publication to the last arrival.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fmt/format.h>
+
+#include <mocap/component_host.hpp>
+#include <mocap_msgs/msg/FiducialArrayPubSubTypes.h>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+#include <sensor_msgs/msg/ImagePubSubTypes.h>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "fastdds_qos.hpp"
+#include "fastdds_transport.hpp"
+
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+using Steady = std::chrono::steady_clock;
+
+constexpr const char* kTopic = "/bench/hop";
+constexpr int kWarmup = 50;
+
+int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Steady::now().time_since_epoch())
+      .count();
+}
+
+template <class T>
+void stamp(T& message) {
+  int64_t ns = steady_ns();
+  message.header().stamp().sec(static_cast<int32_t>(ns / 1000000000));
+  message.header().stamp().nanosec(static_cast<uint32_t>(ns % 1000000000));
+}
+
+template <class T>
+int64_t stamp_ns(const T& message) {
+  return int64_t(message.header().stamp().sec()) * 1000000000 + message.header().stamp().nanosec();
+}
+
+// What a subscriber saw: one-way latencies (after the warm-up) and arrival times.
+struct Received {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::vector<double> latencies_us;
+  int count = 0;
+  int64_t first_ns = 0, last_ns = 0;
+
+  template <class T>
+  void add(const T& message) {
+    int64_t now = steady_ns();
+    std::lock_guard lock(mutex);
+    if (count == 0) first_ns = now;
+    last_ns = now;
+    if (++count > kWarmup) latencies_us.push_back(double(now - stamp_ns(message)) / 1e3);
+    changed.notify_all();
+  }
+
+  bool wait_for(int total, std::chrono::seconds timeout) {
+    std::unique_lock lock(mutex);
+    return changed.wait_for(lock, timeout, [&] { return count >= total; });
+  }
+};
+
+Received received;  // in whichever process subscribes
+
+// --- messages -------------------------------------------------------------------------
+
+struct Size {
+  std::string label;
+  bool image;
+  uint32_t width, height;  // image size, or fiducial count in width
+  int latency_rate_hz;
+  int latency_count;
+  int throughput_count;
+};
+
+template <class T>
+T prototype(const Size& size);
+
+template <>
+mocap_msgs::msg::FiducialArray prototype(const Size& size) {
+  mocap_msgs::msg::FiducialArray array;
+  array.header().frame_id("camera");
+  for (uint32_t i = 0; i < size.width; ++i) {
+    mocap_msgs::msg::Fiducial f;
+    f.x(100.0f + float(i));
+    f.y(200.0f - float(i));
+    f.size(12);
+    f.uncertainty(0.1f);
+    array.fiducials().push_back(f);
+  }
+  return array;
+}
+
+template <>
+sensor_msgs::msg::Image prototype(const Size& size) {
+  sensor_msgs::msg::Image image;
+  image.header().frame_id("camera");
+  image.width(size.width);
+  image.height(size.height);
+  image.encoding("mono8");
+  image.step(size.width);
+  image.data(std::vector<uint8_t>(size_t(size.width) * size.height, 17));
+  return image;
+}
+
+template <class T>
+size_t serialized_bytes(const T& message) {
+  return mocap::message_type<T>().serialized_size(&message);
+}
+
+// --- the runtime's side -----------------------------------------------------------------
+
+template <class T>
+class BenchPublisher final : public mocap::Component {
+ public:
+  static void declare(mocap::ComponentSpec& spec) {
+    spec.publishes<T>(kTopic, mocap::Qos::reliable(), "");
+  }
+  explicit BenchPublisher(mocap::Context& context) : Component(context) {
+    publisher = create_publisher<T>(kTopic);
+  }
+  mocap::Publisher<T> publisher;
+};
+
+template <class T>
+class BenchSubscriber final : public mocap::Component {
+ public:
+  static void declare(mocap::ComponentSpec& spec) {
+    spec.subscribes<T>(kTopic, mocap::Qos::reliable(), "");
+  }
+  explicit BenchSubscriber(mocap::Context& context) : Component(context) {
+    create_subscription<T>(kTopic, [](const T& message) { received.add(message); });
+  }
+};
+
+template <class T>
+constexpr mocap::ComponentFactory kPublisherFactory =
+    mocap::make_component_factory<BenchPublisher<T>>("bench_publisher");
+template <class T>
+constexpr mocap::ComponentFactory kSubscriberFactory =
+    mocap::make_component_factory<BenchSubscriber<T>>("bench_subscriber");
+
+// --- raw Fast DDS -------------------------------------------------------------------------
+
+template <class T>
+struct PubSubTypeOf;
+template <>
+struct PubSubTypeOf<mocap_msgs::msg::FiducialArray> {
+  using type = mocap_msgs::msg::FiducialArrayPubSubType;
+};
+template <>
+struct PubSubTypeOf<sensor_msgs::msg::Image> {
+  using type = sensor_msgs::msg::ImagePubSubType;
+};
+
+// A participant with one topic, as a program using Fast DDS directly would set it up.
+template <class T>
+class RawEndpoint : public dds::DataReaderListener, public dds::DataWriterListener {
+ public:
+  RawEndpoint() {
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    participant_ = factory->create_participant(mocap::resolve_domain_id(0),
+                                               mocap::to_participant_qos({}, "raw"));
+    dds::TypeSupport type(new typename PubSubTypeOf<T>::type());
+    type.register_type(participant_);
+    topic_ = participant_->create_topic(mocap::dds_topic_name(kTopic), type.get_type_name(),
+                                        dds::TOPIC_QOS_DEFAULT);
+  }
+  ~RawEndpoint() override {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+
+  dds::DataWriter* make_writer() {
+    auto* publisher = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    writer_ = publisher->create_datawriter(topic_, mocap::to_writer_qos(mocap::Qos::reliable()),
+                                           this);
+    return writer_;
+  }
+
+  void make_reader() {
+    auto* subscriber = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    subscriber->create_datareader(topic_, mocap::to_reader_qos(mocap::Qos::reliable()), this);
+  }
+
+  void on_data_available(dds::DataReader* reader) override {
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data) received.add(sample_);
+    }
+  }
+
+  void on_publication_matched(dds::DataWriter*,
+                              const dds::PublicationMatchedStatus& status) override {
+    matched = status.current_count;
+  }
+
+  // Fast DDS 2.9 reports spurious timeouts on full keep-all histories; the runtime retries
+  // within the blocking time, and so does this reference, so both deliver everything.
+  void write(T& message) {
+    auto deadline = Steady::now() + std::chrono::milliseconds(mocap::kReliableBlockingMilliseconds);
+    while (writer_->write(&message, dds::HANDLE_NIL) == ReturnCode_t::RETCODE_TIMEOUT &&
+           Steady::now() < deadline) {
+    }
+  }
+
+  std::atomic<int> matched{0};
+
+ private:
+  dds::DomainParticipant* participant_ = nullptr;
+  dds::Topic* topic_ = nullptr;
+  dds::DataWriter* writer_ = nullptr;
+  T sample_;
+};
+
+// --- the subscriber process -------------------------------------------------------------
+
+template <class T>
+int run_subscriber(const std::string& path, int total, const std::string& out) {
+  auto report = [&] {
+    std::ofstream file(out);
+    file << received.count << " " << received.first_ns << " " << received.last_ns << "\n";
+    for (double l : received.latencies_us) file << l << "\n";
+  };
+  if (path == "raw") {
+    RawEndpoint<T> endpoint;
+    endpoint.make_reader();
+    received.wait_for(total, std::chrono::seconds(120));
+    std::lock_guard lock(received.mutex);
+    report();
+    return 0;
+  }
+  mocap::ComponentHost host({.name = "bench_subscriber", .threads = 2, .dds = {}});
+  host.add(kSubscriberFactory<T>, {.name = "subscriber"});
+  host.start();
+  received.wait_for(total, std::chrono::seconds(120));
+  host.stop();
+  std::lock_guard lock(received.mutex);
+  report();
+  return 0;
+}
+
+// --- the publisher's side ---------------------------------------------------------------
+
+struct Result {
+  std::vector<double> latencies_us;   // pooled over rounds
+  std::vector<double> msgs_per_s;     // one per round
+  double bytes = 0;
+  int delivered = 0, expected = 0;    // summed over rounds
+
+  void merge(const Result& round) {
+    latencies_us.insert(latencies_us.end(), round.latencies_us.begin(), round.latencies_us.end());
+    msgs_per_s.insert(msgs_per_s.end(), round.msgs_per_s.begin(), round.msgs_per_s.end());
+    bytes = round.bytes;
+    delivered += round.delivered;
+    expected += round.expected;
+  }
+};
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, size_t(q * double(values.size())))];
+}
+
+// Calls `publish` for the warm-up and `count` messages, at `rate_hz` or as fast as possible
+// when 0. `publish` makes, stamps and publishes one message, and returns its stamp.
+template <class Publish>
+int64_t publish_all(int count, int rate_hz, Publish publish) {
+  auto period = rate_hz > 0 ? std::chrono::nanoseconds(1000000000 / rate_hz)
+                            : std::chrono::nanoseconds(0);
+  auto next = Steady::now();
+  int64_t first = 0;
+  for (int i = 0; i < kWarmup + count; ++i) {
+    if (rate_hz > 0) {
+      next += period;
+      std::this_thread::sleep_until(next);
+    }
+    int64_t stamped = publish();
+    if (i == 0) first = stamped;
+  }
+  return first;
+}
+
+Result make_result(int delivered, int count, int64_t first_publish_ns, int64_t last_ns,
+                   std::vector<double> latencies, size_t bytes, bool throughput) {
+  Result r;
+  r.delivered = delivered;
+  r.expected = kWarmup + count;
+  r.bytes = double(bytes);
+  if (throughput) {
+    if (last_ns > first_publish_ns) {
+      r.msgs_per_s.push_back(delivered / (double(last_ns - first_publish_ns) / 1e9));
+    }
+  } else {
+    r.latencies_us = std::move(latencies);
+  }
+  return r;
+}
+
+Result result_from(const std::string& file, int count, int64_t first_publish_ns, size_t bytes,
+                   bool throughput) {
+  std::ifstream in(file);
+  int delivered = 0;
+  int64_t first_ns = 0, last_ns = 0;
+  in >> delivered >> first_ns >> last_ns;
+  std::vector<double> latencies;
+  for (double l; in >> l;) latencies.push_back(l);
+  return make_result(delivered, count, first_publish_ns, last_ns, std::move(latencies), bytes,
+                     throughput);
+}
+
+Result from_received(int count, int64_t first_publish_ns, size_t bytes, bool throughput) {
+  std::lock_guard lock(received.mutex);
+  return make_result(received.count, count, first_publish_ns, received.last_ns,
+                     received.latencies_us, bytes, throughput);
+}
+
+void reset_received() {
+  std::lock_guard lock(received.mutex);
+  received.latencies_us.clear();
+  received.count = 0;
+  received.first_ns = received.last_ns = 0;
+}
+
+template <class T>
+Result run_intra(const Size& size, bool throughput) {
+  reset_received();
+  int count = throughput ? size.throughput_count : size.latency_count;
+  mocap::ComponentHost host({.name = "bench", .threads = 2, .dds = {.enabled = false}});
+  auto& publisher = static_cast<BenchPublisher<T>&>(host.add(kPublisherFactory<T>, {.name = "pub"}));
+  host.add(kSubscriberFactory<T>, {.name = "sub"});
+  host.start();
+  T message = prototype<T>(size);
+  // In-process subscribers receive the object itself, so each message needs one of its own:
+  // taken from a few made beforehand (as a camera driver fills frame buffers) when no
+  // subscriber holds it any more, so that making it is not part of the hop.
+  std::vector<std::shared_ptr<T>> pool;
+  for (int i = 0; i < 8; ++i) pool.push_back(std::make_shared<T>(message));
+  size_t next = 0;
+  int64_t first = publish_all(count, throughput ? 0 : size.latency_rate_hz, [&] {
+    std::shared_ptr<T>& slot = pool[next++ % pool.size()];
+    if (slot.use_count() > 1) slot = std::make_shared<T>(message);
+    stamp(*slot);
+    publisher.publisher.publish(slot);
+    return stamp_ns(*slot);
+  });
+  received.wait_for(kWarmup + count, std::chrono::seconds(60));
+  host.stop();
+  return from_received(count, first, serialized_bytes(message), throughput);
+}
+
+template <class T>
+Result run_between_processes(const std::string& self, const std::string& path, const Size& size,
+                             bool throughput) {
+  int count = throughput ? size.throughput_count : size.latency_count;
+  std::string out = fmt::format("/tmp/transport_bench_{}.txt", getpid());
+  pid_t child = fork();
+  if (child == 0) {
+    execl(self.c_str(), self.c_str(), "--subscriber", path.c_str(), size.image ? "image" : "fiducials",
+          std::to_string(kWarmup + count).c_str(), out.c_str(), nullptr);
+    _exit(127);
+  }
+  T message = prototype<T>(size);
+  int64_t first = 0;
+  int rate = throughput ? 0 : size.latency_rate_hz;
+  auto wait_matched = [](auto matched) {
+    for (int i = 0; i < 1000 && !matched(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // let discovery settle
+  };
+  if (path == "raw") {
+    RawEndpoint<T> endpoint;
+    endpoint.make_writer();
+    wait_matched([&] { return endpoint.matched > 0; });
+    first = publish_all(count, rate, [&] {
+      stamp(message);
+      endpoint.write(message);
+      return stamp_ns(message);
+    });
+    waitpid(child, nullptr, 0);
+  } else {
+    mocap::ComponentHost host({.name = "bench_publisher", .threads = 2, .dds = {}});
+    auto& publisher =
+        static_cast<BenchPublisher<T>&>(host.add(kPublisherFactory<T>, {.name = "pub"}));
+    host.start();
+    wait_matched([&] { return publisher.publisher.matched_subscribers() > 0; });
+    // Serialized during publish(): one object can be reused, as the raw reference does.
+    auto shared = std::make_shared<T>(message);
+    first = publish_all(count, rate, [&] {
+      stamp(*shared);
+      publisher.publisher.publish(shared);
+      return stamp_ns(*shared);
+    });
+    waitpid(child, nullptr, 0);
+  }
+  Result r = result_from(out, count, first, serialized_bytes(message), throughput);
+  std::remove(out.c_str());
+  return r;
+}
+
+// The floor under any hand-off between threads on this machine: a condition variable
+// waking a waiting thread, at the same message rate (the idle time before each wake-up
+// matters on virtual machines).
+Result measure_thread_wakeup(int rate_hz, int count) {
+  std::mutex mutex;
+  std::condition_variable cv;
+  int64_t sent = 0;
+  bool done = false;
+  Result r;
+  std::thread waiter([&] {
+    std::unique_lock lock(mutex);
+    for (int i = 0; i < kWarmup + count; ++i) {
+      cv.wait(lock, [&] { return sent != 0 || done; });
+      if (done) return;
+      if (i >= kWarmup) r.latencies_us.push_back(double(steady_ns() - sent) / 1e3);
+      sent = 0;
+    }
+  });
+  publish_all(count, rate_hz, [&] {
+    int64_t now;
+    {
+      std::lock_guard lock(mutex);
+      sent = now = steady_ns();
+    }
+    cv.notify_one();
+    return now;
+  });
+  {
+    std::lock_guard lock(mutex);
+    done = true;
+  }
+  cv.notify_one();
+  waiter.join();
+  r.delivered = r.expected = kWarmup + count;
+  return r;
+}
+
+double median(std::vector<double> values) { return quantile(std::move(values), 0.5); }
+
+void print_row(const std::string& size, const std::string& path, const Result& latency,
+               const Result* throughput) {
+  std::string notes;
+  int delivered = latency.delivered + (throughput ? throughput->delivered : 0);
+  int expected = latency.expected + (throughput ? throughput->expected : 0);
+  if (delivered != expected) notes = fmt::format("  (delivered {} of {})", delivered, expected);
+  std::string msgs = "", mb = "";
+  if (throughput) {
+    double rate = median(throughput->msgs_per_s);
+    msgs = fmt::format("{:.0f}", rate);
+    mb = fmt::format("{:.1f}", rate * throughput->bytes / 1e6);
+  }
+  fmt::print("| {:<22} | {:<30} | {:>9.1f} | {:>9.1f} | {:>10} | {:>8} |{}\n", size, path,
+             quantile(latency.latencies_us, 0.5), quantile(latency.latencies_us, 0.99), msgs, mb,
+             notes);
+}
+
+template <class T>
+void measure(const std::string& self, const Size& size, int rounds) {
+  Result floor, intra_latency, intra_throughput, runtime_latency, raw_latency, runtime_throughput,
+      raw_throughput;
+  Size part = size;
+  part.latency_count = std::max(1, size.latency_count / rounds);
+  for (int round = 0; round < rounds; ++round) {
+    // Alternate the order, so that drift in the machine's load favours neither path.
+    bool runtime_first = round % 2 == 0;
+    floor.merge(measure_thread_wakeup(size.latency_rate_hz, part.latency_count));
+    intra_latency.merge(run_intra<T>(part, false));
+    intra_throughput.merge(run_intra<T>(part, true));
+    for (int turn = 0; turn < 2; ++turn) {
+      if ((turn == 0) == runtime_first) {
+        runtime_latency.merge(run_between_processes<T>(self, "runtime", part, false));
+        runtime_throughput.merge(run_between_processes<T>(self, "runtime", part, true));
+      } else {
+        raw_latency.merge(run_between_processes<T>(self, "raw", part, false));
+        raw_throughput.merge(run_between_processes<T>(self, "raw", part, true));
+      }
+    }
+  }
+  std::string label = fmt::format("{} @{} Hz", size.label, size.latency_rate_hz);
+  print_row(label, "thread wake-up (floor)", floor, nullptr);
+  print_row("", "intra-process (runtime)", intra_latency, &intra_throughput);
+  print_row("", "inter-process (runtime)", runtime_latency, &runtime_throughput);
+  print_row("", "inter-process (raw Fast DDS)", raw_latency, &raw_throughput);
+  fmt::print("| {:<22} | {:<30} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "",
+             "runtime / raw Fast DDS",
+             quantile(runtime_latency.latencies_us, 0.5) / quantile(raw_latency.latencies_us, 0.5),
+             quantile(runtime_latency.latencies_us, 0.99) / quantile(raw_latency.latencies_us, 0.99),
+             median(runtime_throughput.msgs_per_s) / median(raw_throughput.msgs_per_s), "");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.size() == 5 && args[0] == "--subscriber") {
+    int total = std::stoi(args[3]);
+    if (args[2] == "image") return run_subscriber<sensor_msgs::msg::Image>(args[1], total, args[4]);
+    return run_subscriber<mocap_msgs::msg::FiducialArray>(args[1], total, args[4]);
+  }
+  bool quick = !args.empty() && args[0] == "--quick";
+  if (getenv("MOCAP_DOMAIN_ID") == nullptr) {
+    setenv("MOCAP_DOMAIN_ID", std::to_string(200 + getpid() % 30).c_str(), 1);
+  }
+  int rounds = quick ? 2 : 6;
+  int scale = quick ? 4 : 1;
+  std::vector<Size> sizes = {
+      {"FiducialArray (12)", false, 12, 0, 1000, 6000 / scale, 20000 / scale},
+      {"Image 64 KiB", true, 256, 256, 500, 3000 / scale, 3000 / scale},
+      {"Image 1280x720 mono8", true, 1280, 720, 100, 1200 / scale, 500 / scale},
+  };
+  std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  fmt::print("transport_bench: one hop, reliable QoS, {} cores, {} rounds with the paths "
+             "interleaved.\nLatency: one-way, at the rate shown, pooled over rounds. Throughput: "
+             "publishing as fast as flow control allows, median of rounds.\n\n",
+             std::thread::hardware_concurrency(), rounds);
+  fmt::print("| {:<22} | {:<30} | {:>9} | {:>9} | {:>10} | {:>8} |\n", "message", "path",
+             "median us", "p99 us", "msgs/s", "MB/s");
+  fmt::print("|{:-<24}|{:-<32}|{:-<11}|{:-<11}|{:-<12}|{:-<10}|\n", "", "", "", "", "", "");
+  measure<mocap_msgs::msg::FiducialArray>(self, sizes[0], rounds);
+  measure<sensor_msgs::msg::Image>(self, sizes[1], rounds);
+  measure<sensor_msgs::msg::Image>(self, sizes[2], rounds);
+  fmt::print("\ntargets: intra-process hop <= 10 us median; runtime inter-process hop <= 1.10 x "
+             "raw Fast DDS\n");
+  return 0;
+}
