@@ -21,6 +21,7 @@
 #include <mutex>
 #include <thread>
 
+#include <fmt/format.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -31,12 +32,11 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
-#include <fmt/format.h>
 
-#include <mocap/component_host.hpp>
 #include <mocap_msgs/msg/FiducialArrayPubSubTypes.h>
-#include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/ImagePubSubTypes.h>
+#include <mocap/component_host.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
 #include "fastdds_qos.hpp"
@@ -204,8 +204,8 @@ class RawEndpoint : public dds::DataReaderListener, public dds::DataWriterListen
 
   dds::DataWriter* make_writer() {
     auto* publisher = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-    writer_ = publisher->create_datawriter(topic_, mocap::to_writer_qos(mocap::Qos::reliable()),
-                                           this);
+    writer_ =
+        publisher->create_datawriter(topic_, mocap::to_writer_qos(mocap::Qos::reliable()), this);
     return writer_;
   }
 
@@ -274,10 +274,10 @@ int run_subscriber(const std::string& path, int total, const std::string& out) {
 // --- the publisher's side ---------------------------------------------------------------
 
 struct Result {
-  std::vector<double> latencies_us;   // pooled over rounds
-  std::vector<double> msgs_per_s;     // one per round
+  std::vector<double> latencies_us;  // pooled over rounds
+  std::vector<double> msgs_per_s;    // one per round
   double bytes = 0;
-  int delivered = 0, expected = 0;    // summed over rounds
+  int delivered = 0, expected = 0;  // summed over rounds
 
   void merge(const Result& round) {
     latencies_us.insert(latencies_us.end(), round.latencies_us.begin(), round.latencies_us.end());
@@ -298,8 +298,8 @@ double quantile(std::vector<double> values, double q) {
 // when 0. `publish` makes, stamps and publishes one message, and returns its stamp.
 template <class Publish>
 int64_t publish_all(int count, int rate_hz, Publish publish) {
-  auto period = rate_hz > 0 ? std::chrono::nanoseconds(1000000000 / rate_hz)
-                            : std::chrono::nanoseconds(0);
+  auto period =
+      rate_hz > 0 ? std::chrono::nanoseconds(1000000000 / rate_hz) : std::chrono::nanoseconds(0);
   auto next = Steady::now();
   int64_t first = 0;
   for (int i = 0; i < kWarmup + count; ++i) {
@@ -359,7 +359,8 @@ Result run_intra(const Size& size, bool throughput) {
   reset_received();
   int count = throughput ? size.throughput_count : size.latency_count;
   mocap::ComponentHost host({.name = "bench", .threads = 2, .dds = {.enabled = false}});
-  auto& publisher = static_cast<BenchPublisher<T>&>(host.add(kPublisherFactory<T>, {.name = "pub"}));
+  auto& publisher =
+      static_cast<BenchPublisher<T>&>(host.add(kPublisherFactory<T>, {.name = "pub"}));
   host.add(kSubscriberFactory<T>, {.name = "sub"});
   host.start();
   T message = prototype<T>(size);
@@ -388,15 +389,17 @@ Result run_between_processes(const std::string& self, const std::string& path, c
   std::string out = fmt::format("/tmp/transport_bench_{}.txt", getpid());
   pid_t child = fork();
   if (child == 0) {
-    execl(self.c_str(), self.c_str(), "--subscriber", path.c_str(), size.image ? "image" : "fiducials",
-          std::to_string(kWarmup + count).c_str(), out.c_str(), nullptr);
+    execl(self.c_str(), self.c_str(), "--subscriber", path.c_str(),
+          size.image ? "image" : "fiducials", std::to_string(kWarmup + count).c_str(), out.c_str(),
+          nullptr);
     _exit(127);
   }
   T message = prototype<T>(size);
   int64_t first = 0;
   int rate = throughput ? 0 : size.latency_rate_hz;
   auto wait_matched = [](auto matched) {
-    for (int i = 0; i < 1000 && !matched(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    for (int i = 0; i < 1000 && !matched(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     std::this_thread::sleep_for(std::chrono::milliseconds(200));  // let discovery settle
   };
   if (path == "raw") {
@@ -512,11 +515,12 @@ void measure(const std::string& self, const Size& size, int rounds) {
   print_row("", "intra-process (runtime)", intra_latency, &intra_throughput);
   print_row("", "inter-process (runtime)", runtime_latency, &runtime_throughput);
   print_row("", "inter-process (raw Fast DDS)", raw_latency, &raw_throughput);
-  fmt::print("| {:<22} | {:<30} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "",
-             "runtime / raw Fast DDS",
-             quantile(runtime_latency.latencies_us, 0.5) / quantile(raw_latency.latencies_us, 0.5),
-             quantile(runtime_latency.latencies_us, 0.99) / quantile(raw_latency.latencies_us, 0.99),
-             median(runtime_throughput.msgs_per_s) / median(raw_throughput.msgs_per_s), "");
+  fmt::print(
+      "| {:<22} | {:<30} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "",
+      "runtime / raw Fast DDS",
+      quantile(runtime_latency.latencies_us, 0.5) / quantile(raw_latency.latencies_us, 0.5),
+      quantile(runtime_latency.latencies_us, 0.99) / quantile(raw_latency.latencies_us, 0.99),
+      median(runtime_throughput.msgs_per_s) / median(raw_throughput.msgs_per_s), "");
 }
 
 }  // namespace
@@ -540,17 +544,19 @@ int main(int argc, char** argv) {
       {"Image 1280x720 mono8", true, 1280, 720, 100, 1200 / scale, 500 / scale},
   };
   std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  fmt::print("transport_bench: one hop, reliable QoS, {} cores, {} rounds with the paths "
-             "interleaved.\nLatency: one-way, at the rate shown, pooled over rounds. Throughput: "
-             "publishing as fast as flow control allows, median of rounds.\n\n",
-             std::thread::hardware_concurrency(), rounds);
+  fmt::print(
+      "transport_bench: one hop, reliable QoS, {} cores, {} rounds with the paths "
+      "interleaved.\nLatency: one-way, at the rate shown, pooled over rounds. Throughput: "
+      "publishing as fast as flow control allows, median of rounds.\n\n",
+      std::thread::hardware_concurrency(), rounds);
   fmt::print("| {:<22} | {:<30} | {:>9} | {:>9} | {:>10} | {:>8} |\n", "message", "path",
              "median us", "p99 us", "msgs/s", "MB/s");
   fmt::print("|{:-<24}|{:-<32}|{:-<11}|{:-<11}|{:-<12}|{:-<10}|\n", "", "", "", "", "", "");
   measure<mocap_msgs::msg::FiducialArray>(self, sizes[0], rounds);
   measure<sensor_msgs::msg::Image>(self, sizes[1], rounds);
   measure<sensor_msgs::msg::Image>(self, sizes[2], rounds);
-  fmt::print("\ntargets: intra-process hop <= 10 us median; runtime inter-process hop <= 1.10 x "
-             "raw Fast DDS\n");
+  fmt::print(
+      "\ntargets: intra-process hop <= 10 us median; runtime inter-process hop <= 1.10 x "
+      "raw Fast DDS\n");
   return 0;
 }

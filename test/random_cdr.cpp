@@ -63,7 +63,8 @@ class Writer {
       case IdlKind::String: {
         uint32_t length = random_() % 9;
         put<uint32_t>(length + 1);
-        for (uint32_t i = 0; i < length; ++i) bytes.push_back(static_cast<uint8_t>('A' + random_() % 58));
+        for (uint32_t i = 0; i < length; ++i)
+          bytes.push_back(static_cast<uint8_t>('A' + random_() % 58));
         bytes.push_back(0);
         break;
       }

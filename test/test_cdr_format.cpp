@@ -37,9 +37,9 @@ TEST(CdrFormat, NestedStructsListsAndArrays) {
   pose.reprojection_rms_px(0.5f);
   pose.points_used(12);
   array.poses().push_back(pose);
-  std::string text = format_cdr(schema_of<mocap_msgs::msg::ConstellationPoseArray>(),
-                                "mocap_msgs/msg/ConstellationPoseArray", serialize(array),
-                                {.max_items = 4});
+  std::string text =
+      format_cdr(schema_of<mocap_msgs::msg::ConstellationPoseArray>(),
+                 "mocap_msgs/msg/ConstellationPoseArray", serialize(array), {.max_items = 4});
   EXPECT_EQ(text, R"(header:
   stamp:
     sec: 5

@@ -107,7 +107,9 @@ TEST_F(ComponentHostTest, QosOverrideThatCannotMatchDeliversNothing) {
 
 class Latcher final : public Component {
  public:
-  static void declare(ComponentSpec& spec) { spec.publishes<Array>("/numbers", Qos::latched(), ""); }
+  static void declare(ComponentSpec& spec) {
+    spec.publishes<Array>("/numbers", Qos::latched(), "");
+  }
   explicit Latcher(Context& context) : Component(context) {
     auto message = std::make_shared<Array>();
     record.published.push_back(message.get());
@@ -129,7 +131,9 @@ TEST_F(ComponentHostTest, LatchedSampleReachesALateComponentByPointer) {
 
 class Undeclared final : public Component {
  public:
-  static void declare(ComponentSpec& spec) { spec.publishes<Array>("/declared", Qos::reliable(), ""); }
+  static void declare(ComponentSpec& spec) {
+    spec.publishes<Array>("/declared", Qos::reliable(), "");
+  }
   explicit Undeclared(Context& context) : Component(context) {
     create_publisher<Array>("/undeclared");
   }
@@ -149,9 +153,10 @@ TEST_F(ComponentHostTest, StartErrorsNameTheComponent) {
     host.add(make_component_factory<Undeclared>("undeclared"), {.name = "u"});
     FAIL();
   } catch (const ComponentError& e) {
-    EXPECT_STREQ(e.what(), "component 'u' (undeclared) failed to start: component 'u' publishes "
-                           "to '/undeclared', which its declare() does not declare (declared: "
-                           "/declared)");
+    EXPECT_STREQ(e.what(),
+                 "component 'u' (undeclared) failed to start: component 'u' publishes "
+                 "to '/undeclared', which its declare() does not declare (declared: "
+                 "/declared)");
   }
   try {
     host.add(make_component_factory<Throwing>("throwing"), {.name = "t"});
@@ -208,8 +213,8 @@ class Ticker final : public Component {
 
 TEST_F(ComponentHostTest, OneComponentsCallbacksNeverOverlapAndErrorsAreCounted) {
   ComponentHost host({.name = "test", .threads = 4, .dds = {.enabled = false}});
-  host.add(make_component_factory<Ticker>("ticker"), {.name = "ticker",
-                                                      .parameters = {{"fail", true}}});
+  host.add(make_component_factory<Ticker>("ticker"),
+           {.name = "ticker", .parameters = {{"fail", true}}});
   EXPECT_EQ(host.run(std::chrono::seconds(60)), 7);  // the requested exit code
   EXPECT_GE(record.ticks, 300);
   EXPECT_EQ(record.max_active, 1);

@@ -46,7 +46,8 @@ std::string sink_yaml(const std::string& parameters, const std::string& qos = "r
 TEST(Dds, ARestartedSubscriberProcessReceivesAgain) {
   test::TempDir dir;
   auto env = environment(10);
-  test::write_file(dir / "source.yaml", source_yaml("count: 0, batch: 1, period_s: 0.01, subscribers: 0"));
+  test::write_file(dir / "source.yaml",
+                   source_yaml("count: 0, batch: 1, period_s: 0.01, subscribers: 0"));
   test::write_file(dir / "sink.yaml", sink_yaml("expect: 0, log_every: 20, timeout_s: 120"));
   test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
 
@@ -134,10 +135,9 @@ TEST(Dds, ALatchedSampleReachesAProcessStartedLater) {
   test::TempDir dir;
   auto env = environment(13);
   test::write_file(dir / "source.yaml", source_yaml("count: 1, subscribers: 0", "latched"));
-  test::write_file(dir / "sink.yaml",
-                   sink_yaml(fmt::format("expect: 1, summary_file: \"{}\"",
-                                         (dir / "summary").string()),
-                             "latched"));
+  test::write_file(dir / "sink.yaml", sink_yaml(fmt::format("expect: 1, summary_file: \"{}\"",
+                                                            (dir / "summary").string()),
+                                                "latched"));
   test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
   ASSERT_TRUE(source.wait_for_output("published 1 messages", std::chrono::seconds(30)));
   auto [code, output] = test::run_command({launcher(), (dir / "sink.yaml").string()}, env);
@@ -167,7 +167,8 @@ TEST(Dds, TopicToolListsEchoesAndMeasures) {
   EXPECT_NE(echo.find("    uncertainty: 0.5\n"), std::string::npos) << echo;
   EXPECT_EQ(std::count(echo.begin(), echo.end(), '-') >= 2, true);
 
-  auto [hz_code, hz] = test::run_command({topic_tool(), "hz", "/test/sequence", "--count", "2"}, env);
+  auto [hz_code, hz] =
+      test::run_command({topic_tool(), "hz", "/test/sequence", "--count", "2"}, env);
   EXPECT_EQ(hz_code, 0) << hz;
   EXPECT_NE(hz.find("average rate: "), std::string::npos) << hz;
   source.signal(SIGTERM);
@@ -176,8 +177,8 @@ TEST(Dds, TopicToolListsEchoesAndMeasures) {
 TEST(Launcher, CheckReportsProblemsAndStartsNothing) {
   test::TempDir dir;
   test::write_file(dir / "bad.yaml", sink_yaml("expect: -1, colour: red"));
-  auto [code, output] = test::run_command({launcher(), (dir / "bad.yaml").string(), "--check"},
-                                          environment(15));
+  auto [code, output] =
+      test::run_command({launcher(), (dir / "bad.yaml").string(), "--check"}, environment(15));
   EXPECT_EQ(code, 1);
   EXPECT_NE(output.find("bad.yaml:6: component 'sink' (sequence_sink): unknown parameter 'colour'"),
             std::string::npos)
@@ -191,8 +192,8 @@ TEST(Launcher, CheckReportsProblemsAndStartsNothing) {
   EXPECT_EQ(run_output.find("[INFO]"), std::string::npos) << run_output;
 
   test::write_file(dir / "good.yaml", sink_yaml("expect: 1"));
-  auto [good_code, good] = test::run_command({launcher(), (dir / "good.yaml").string(), "--check"},
-                                             environment(15));
+  auto [good_code, good] =
+      test::run_command({launcher(), (dir / "good.yaml").string(), "--check"}, environment(15));
   EXPECT_EQ(good_code, 0) << good;
   EXPECT_NE(good.find("valid (1 group(s), 1 component(s))"), std::string::npos);
 
@@ -209,8 +210,8 @@ TEST(Launcher, DescribeListsParametersAndTopics) {
   EXPECT_NE(output.find("subscribes /test/sequence [mocap_msgs/msg/FiducialArray] reliable"),
             std::string::npos)
       << output;
-  auto [missing_code, missing] = test::run_command({launcher(), "--describe", "sequence_snk"},
-                                                   environment(16));
+  auto [missing_code, missing] =
+      test::run_command({launcher(), "--describe", "sequence_snk"}, environment(16));
   EXPECT_EQ(missing_code, 1);
   EXPECT_NE(missing.find("did you mean 'sequence_sink'?"), std::string::npos) << missing;
 }
@@ -229,8 +230,8 @@ TEST(Launcher, AGroupThatFailsToStartStopsTheOthers) {
       - plugin: failing_start
         name: servo
 )");
-  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
-                                          environment(17));
+  auto [code, output] =
+      test::run_command({launcher(), (dir / "graph.yaml").string()}, environment(17));
   EXPECT_EQ(code, 1) << output;
   EXPECT_NE(output.find("[broken] " + (dir / "graph.yaml").string() +
                         ":10: component 'servo' (failing_start) failed to start: cannot open "

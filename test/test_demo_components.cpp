@@ -10,7 +10,10 @@ namespace mocap::demo {
 namespace {
 
 TEST(FiducialPattern, PointsOnATurningCircle) {
-  PatternOptions options{.count = 4, .image_width = 100, .image_height = 50, .radius_px = 10,
+  PatternOptions options{.count = 4,
+                         .image_width = 100,
+                         .image_height = 50,
+                         .radius_px = 10,
                          .turns_per_second = 0.25};
   auto points = fiducial_pattern(options, 0.0);
   ASSERT_EQ(points.size(), 4u);

@@ -97,7 +97,8 @@ TEST(Executor, ACallbackThatThrowsIsCountedAndTheStrandGoesOn) {
 // A waitable that records the thread of each callback and takes `duration` to run.
 class Recorder final : public Waitable {
  public:
-  explicit Recorder(std::chrono::microseconds duration) : Waitable("recorder"), duration_(duration) {}
+  explicit Recorder(std::chrono::microseconds duration)
+      : Waitable("recorder"), duration_(duration) {}
   bool execute_one() override {
     if (!due.exchange(false)) return false;
     std::this_thread::sleep_for(duration_);
@@ -182,7 +183,8 @@ TEST(Timers, FireOnTheirStrand) {
   Strand strand(executor, logger);
   TimerService timers;
   std::atomic<int> ticks{0};
-  auto timer = std::make_shared<Timer>("t", std::chrono::milliseconds(1), [&] { ++ticks; }, strand);
+  auto timer = std::make_shared<Timer>(
+      "t", std::chrono::milliseconds(1), [&] { ++ticks; }, strand);
   strand.add(timer);
   strand.enable();
   timers.add(timer);

@@ -50,8 +50,8 @@ void expect_complete_stream(const std::map<std::string, long long>& summary) {
 TEST(Graph, OneProcessDeliversByPointer) {
   test::TempDir dir;
   test::write_file(dir / "graph.yaml", graph(dir / "summary.yaml", false));
-  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
-                                          environment(1));
+  auto [code, output] =
+      test::run_command({launcher(), (dir / "graph.yaml").string()}, environment(1));
   ASSERT_EQ(code, 0) << output;
   auto summary = test::read_summary(dir / "summary.yaml");
   expect_complete_stream(summary);
@@ -61,8 +61,8 @@ TEST(Graph, OneProcessDeliversByPointer) {
 TEST(Graph, TwoProcessesOverDds) {
   test::TempDir dir;
   test::write_file(dir / "graph.yaml", graph(dir / "summary.yaml", true));
-  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
-                                          environment(2));
+  auto [code, output] =
+      test::run_command({launcher(), (dir / "graph.yaml").string()}, environment(2));
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("[sink] "), std::string::npos) << output;  // the sink ran in its group
   EXPECT_NE(output.find("[source] "), std::string::npos) << output;
@@ -110,8 +110,12 @@ class TwoHosts {
   // Empty when the hosts are up; otherwise why not (no privileges, no `ip`).
   const std::string& error() const { return error_; }
 
-  std::vector<std::string> on_a(std::vector<std::string> command) const { return on(host_a_, command); }
-  std::vector<std::string> on_b(std::vector<std::string> command) const { return on(host_b_, command); }
+  std::vector<std::string> on_a(std::vector<std::string> command) const {
+    return on(host_a_, command);
+  }
+  std::vector<std::string> on_b(std::vector<std::string> command) const {
+    return on(host_b_, command);
+  }
 
   long long bytes_received_by_a() const {
     auto [code, output] =

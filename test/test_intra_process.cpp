@@ -14,7 +14,8 @@ namespace {
 
 using Array = mocap_msgs::msg::FiducialArray;
 
-Endpoint endpoint(const std::string& topic, Qos qos, const MessageType& type = message_type<Array>()) {
+Endpoint endpoint(const std::string& topic, Qos qos,
+                  const MessageType& type = message_type<Array>()) {
   return {topic, &type, qos, "test"};
 }
 
@@ -118,7 +119,8 @@ TEST(IntraProcess, ReliablePublisherGivesUpOnAStalledSubscriber) {
   qos.depth = 2;
   auto publisher = transport.advertise(endpoint("/a", qos));
   auto subscription = transport.subscribe(endpoint("/a", qos), [] {});
-  for (int i = 0; i < 3; ++i) publisher->publish(numbered(i), Clock::now());  // the 3rd waits, drops
+  for (int i = 0; i < 3; ++i)
+    publisher->publish(numbered(i), Clock::now());  // the 3rd waits, drops
   EXPECT_EQ(number(take(*subscription)), 0);
   EXPECT_EQ(number(take(*subscription)), 1);
   EXPECT_EQ(take(*subscription), nullptr);

@@ -30,7 +30,8 @@ class LaunchFileTest : public ::testing::Test {
       std::string path = (dir / "launch.yaml").string();
       for (std::string p : e.problems()) {
         EXPECT_EQ(p.find('\n'), std::string::npos) << "one line per problem: " << p;
-        for (size_t at; (at = p.find(path)) != std::string::npos;) p.replace(at, path.size(), "launch.yaml");
+        for (size_t at; (at = p.find(path)) != std::string::npos;)
+          p.replace(at, path.size(), "launch.yaml");
         out.push_back(p);
       }
       return out;
@@ -84,7 +85,8 @@ TEST_F(LaunchFileTest, ReadsAValidFile) {
 
 TEST_F(LaunchFileTest, SetOverridesAParameter) {
   LaunchFile file = load(kValid, {"sink.expect=5", "source.period_s=0.5"});
-  EXPECT_EQ(file.groups[1].components[0].config.parameters.at("expect"), ParameterValue(int64_t{5}));
+  EXPECT_EQ(file.groups[1].components[0].config.parameters.at("expect"),
+            ParameterValue(int64_t{5}));
   EXPECT_EQ(file.groups[0].components[0].config.parameters.at("period_s"), ParameterValue(0.5));
 }
 
@@ -106,7 +108,8 @@ TEST_F(LaunchFileTest, MissingFile) {
 TEST_F(LaunchFileTest, Structure) {
   EXPECT_EQ(only_problem("- a\n"),
             "launch.yaml:1: a launch file is a map with 'groups' (and optionally 'dds')");
-  EXPECT_EQ(only_problem("dds: {}\n"), "launch.yaml:1: 'groups' must be a non-empty list of groups");
+  EXPECT_EQ(only_problem("dds: {}\n"),
+            "launch.yaml:1: 'groups' must be a non-empty list of groups");
   EXPECT_EQ(only_problem("groups: []\n"),
             "launch.yaml:1: 'groups' must be a non-empty list of groups");
   EXPECT_EQ(only_problem("groups:\n  - name: g\n"),
@@ -161,16 +164,21 @@ TEST_F(LaunchFileTest, ParameterNamesTypesAndRanges) {
           subscribers: "1"
 )");
   ASSERT_EQ(list.size(), 5u);
-  EXPECT_EQ(list[0], "launch.yaml:7: component 'source' (sequence_source): parameter 'count' "
-                     "expects int >= 0, got string \"many\"");
-  EXPECT_EQ(list[1], "launch.yaml:8: component 'source' (sequence_source): parameter 'period_s' "
-                     "expects double in [1e-05, 60], got -1");
-  EXPECT_EQ(list[2], "launch.yaml:9: component 'source' (sequence_source): parameter 'batch' "
-                     "expects int >= 1, got double 2.5");
-  EXPECT_EQ(list[3], "launch.yaml:10: component 'source' (sequence_source): unknown parameter "
-                     "'colour' (parameters: count, batch, period_s, subscribers)");
-  EXPECT_EQ(list[4], "launch.yaml:11: component 'source' (sequence_source): parameter "
-                     "'subscribers' expects int >= 0, got string \"1\"");
+  EXPECT_EQ(list[0],
+            "launch.yaml:7: component 'source' (sequence_source): parameter 'count' "
+            "expects int >= 0, got string \"many\"");
+  EXPECT_EQ(list[1],
+            "launch.yaml:8: component 'source' (sequence_source): parameter 'period_s' "
+            "expects double in [1e-05, 60], got -1");
+  EXPECT_EQ(list[2],
+            "launch.yaml:9: component 'source' (sequence_source): parameter 'batch' "
+            "expects int >= 1, got double 2.5");
+  EXPECT_EQ(list[3],
+            "launch.yaml:10: component 'source' (sequence_source): unknown parameter "
+            "'colour' (parameters: count, batch, period_s, subscribers)");
+  EXPECT_EQ(list[4],
+            "launch.yaml:11: component 'source' (sequence_source): parameter "
+            "'subscribers' expects int >= 0, got string \"1\"");
 }
 
 TEST_F(LaunchFileTest, DuplicateNamesAndKeys) {
@@ -244,14 +252,18 @@ TEST_F(LaunchFileTest, RemapsAndQos) {
         qos: {/test/sequence: fast, /nothing: reliable}
 )");
   ASSERT_EQ(list.size(), 4u);
-  EXPECT_EQ(list[0], "launch.yaml:6: component 'sink' (sequence_sink): remap target 'not a "
-                     "topic' is not a topic name (like /a/b_c)");
-  EXPECT_EQ(list[1], "launch.yaml:6: component 'sink' (sequence_sink): remap of unknown topic "
-                     "'/test/sequense' (did you mean '/test/sequence'?)");
-  EXPECT_EQ(list[2], "launch.yaml:7: QoS for '/test/sequence': unknown profile 'fast' (profiles: "
-                     "sensor_data, reliable, latched)");
-  EXPECT_EQ(list[3], "launch.yaml:7: component 'sink' (sequence_sink): QoS for unknown topic "
-                     "'/nothing' (topics: /test/sequence)");
+  EXPECT_EQ(list[0],
+            "launch.yaml:6: component 'sink' (sequence_sink): remap target 'not a "
+            "topic' is not a topic name (like /a/b_c)");
+  EXPECT_EQ(list[1],
+            "launch.yaml:6: component 'sink' (sequence_sink): remap of unknown topic "
+            "'/test/sequense' (did you mean '/test/sequence'?)");
+  EXPECT_EQ(list[2],
+            "launch.yaml:7: QoS for '/test/sequence': unknown profile 'fast' (profiles: "
+            "sensor_data, reliable, latched)");
+  EXPECT_EQ(list[3],
+            "launch.yaml:7: component 'sink' (sequence_sink): QoS for unknown topic "
+            "'/nothing' (topics: /test/sequence)");
 }
 
 TEST_F(LaunchFileTest, DdsAndGroupSettings) {
@@ -269,8 +281,7 @@ groups:
   EXPECT_EQ(list[2], "launch.yaml:1: 'shared_memory' must be true or false");
   EXPECT_EQ(list[3], "launch.yaml:3: group name 'bad name' must use letters, digits, '_' and '-'");
   EXPECT_EQ(list[4], "launch.yaml:4: 'threads' must be an integer in [1, 256]");
-  EXPECT_EQ(list[5],
-            "launch.yaml:7: component name 'sink!' must use letters, digits, '_' and '-'");
+  EXPECT_EQ(list[5], "launch.yaml:7: component name 'sink!' must use letters, digits, '_' and '-'");
 }
 
 TEST_F(LaunchFileTest, SetOptions) {
@@ -281,8 +292,9 @@ TEST_F(LaunchFileTest, SetOptions) {
   ASSERT_EQ(list.size(), 3u);
   EXPECT_EQ(list[0], "--set nobody.expect=1: no component named 'nobody' in launch.yaml");
   EXPECT_EQ(list[1].rfind("--set sink.expect=[1: the value is not valid: ", 0), 0u) << list[1];
-  EXPECT_EQ(list[2], "--set sink.expect=lots: component 'sink' (sequence_sink): parameter 'expect' "
-                     "expects int >= 0, got string \"lots\"");
+  EXPECT_EQ(list[2],
+            "--set sink.expect=lots: component 'sink' (sequence_sink): parameter 'expect' "
+            "expects int >= 0, got string \"lots\"");
 }
 
 }  // namespace

@@ -34,7 +34,8 @@ std::vector<uint8_t> serialize(const MessageType& type, const void* message) {
 
 TEST(Messages, EveryIdlFileHasTypeSupport) {
   std::set<std::string> from_files;
-  for (const auto& entry : std::filesystem::recursive_directory_iterator(test::source_dir() / "idl")) {
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(test::source_dir() / "idl")) {
     if (entry.path().extension() != ".idl") continue;
     auto relative = std::filesystem::relative(entry.path(), test::source_dir() / "idl");
     from_files.insert(relative.replace_extension().string());
@@ -68,8 +69,8 @@ TEST(Messages, HeaderHasTheXcdr1Layout) {
   header.stamp().sec(1);
   header.stamp().nanosec(2);
   header.frame_id("ab");
-  std::vector<uint8_t> expected = {0x00, 0x01, 0x00, 0x00, 1, 0, 0, 0, 2, 0, 0, 0,
-                                   3,    0,    0,    0,    'a', 'b', 0};
+  std::vector<uint8_t> expected = {0x00, 0x01, 0x00, 0x00, 1, 0, 0,   0,   2, 0,
+                                   0,    0,    3,    0,    0, 0, 'a', 'b', 0};
   EXPECT_EQ(serialize(message_type<std_msgs::msg::Header>(), &header), expected);
 }
 
@@ -111,8 +112,8 @@ TEST(Messages, EveryTypeRoundTripsAndMatchesFastddsgen) {
 TEST(Messages, TypedValuesSurviveTheRoundTrip) {
   mocap_msgs::msg::FiducialArray array;
   array.header().frame_id("camera");
-  array.header().stamp(to_time_msg(std::chrono::system_clock::time_point(
-      std::chrono::nanoseconds(1732180000123456789))));
+  array.header().stamp(to_time_msg(
+      std::chrono::system_clock::time_point(std::chrono::nanoseconds(1732180000123456789))));
   for (int i = 0; i < 12; ++i) {
     mocap_msgs::msg::Fiducial f;
     f.x(10.5f * i);

@@ -20,8 +20,8 @@ fs::path source_dir() { return MOCAP_TEST_SOURCE_DIR; }
 
 TempDir::TempDir() {
   std::random_device random;
-  path_ = fs::temp_directory_path() / ("mocap_test_" + std::to_string(getpid()) + "_" +
-                                       std::to_string(random()));
+  path_ = fs::temp_directory_path() /
+          ("mocap_test_" + std::to_string(getpid()) + "_" + std::to_string(random()));
   fs::create_directories(path_);
 }
 
@@ -45,8 +45,7 @@ std::string read_file(const fs::path& path) {
 int test_domain(int slot) { return 100 + (slot + getpid() * 7) % 130; }
 
 ChildProcess::ChildProcess(std::vector<std::string> argv,
-                           std::map<std::string, std::string> environment,
-                           fs::path output_file)
+                           std::map<std::string, std::string> environment, fs::path output_file)
     : output_file_(std::move(output_file)) {
   int fd = open(output_file_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw std::runtime_error("cannot create " + output_file_.string());

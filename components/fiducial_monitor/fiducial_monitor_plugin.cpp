@@ -25,9 +25,8 @@ class FiducialMonitor final : public Component {
     period_s_ = param<double>("report_period_s");
     create_subscription<mocap_msgs::msg::FiducialArray>(
         kTopic, [this](const mocap_msgs::msg::FiducialArray& array) {
-          double latency = std::chrono::duration<double>(now() -
-                                                         from_time_msg(array.header().stamp()))
-                               .count();
+          double latency =
+              std::chrono::duration<double>(now() - from_time_msg(array.header().stamp())).count();
           statistics_.add(latency, array.fiducials().size());
         });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -46,10 +45,11 @@ class FiducialMonitor final : public Component {
       log().info("nothing received in the last {} s", period_s_);
       return;
     }
-    log().info("{} arrays ({:.1f}/s), {:.1f} fiducials each, latency median {:.3f} ms, "
-               "p99 {:.3f} ms, max {:.3f} ms",
-               r->messages, static_cast<double>(r->messages) / period_s_, r->mean_items,
-               r->latency_median_s * 1e3, r->latency_p99_s * 1e3, r->latency_max_s * 1e3);
+    log().info(
+        "{} arrays ({:.1f}/s), {:.1f} fiducials each, latency median {:.3f} ms, "
+        "p99 {:.3f} ms, max {:.3f} ms",
+        r->messages, static_cast<double>(r->messages) / period_s_, r->mean_items,
+        r->latency_median_s * 1e3, r->latency_p99_s * 1e3, r->latency_max_s * 1e3);
   }
 
   double period_s_;

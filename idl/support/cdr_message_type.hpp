@@ -37,8 +37,8 @@ class CdrMessageType final : public MessageType {
 
   void deserialize(std::span<const uint8_t> data, void* message) const override {
     // Fast CDR reads through a non-const pointer but does not write.
-    eprosima::fastcdr::FastBuffer buffer(
-        reinterpret_cast<char*>(const_cast<uint8_t*>(data.data())), data.size());
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(const_cast<uint8_t*>(data.data())),
+                                         data.size());
     eprosima::fastcdr::Cdr cdr(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
                                eprosima::fastcdr::Cdr::DDS_CDR);
     try {

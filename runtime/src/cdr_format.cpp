@@ -41,9 +41,9 @@ class Cursor {
   explicit Cursor(std::span<const uint8_t> data) : data_(data) {
     if (data.size() < 4) throw SerializationError("shorter than the 4-byte encapsulation header");
     if (data[0] != 0 || data[1] > 1) {
-      throw SerializationError(fmt::format(
-          "encapsulation {:02x}{:02x} is not plain CDR (only XCDR1 data can be shown)", data[0],
-          data[1]));
+      throw SerializationError(
+          fmt::format("encapsulation {:02x}{:02x} is not plain CDR (only XCDR1 data can be shown)",
+                      data[0], data[1]));
     }
     little_ = data[1] == 1;
   }
@@ -86,8 +86,8 @@ class Cursor {
   void align(size_t n) { pos_ = 4 + (pos_ - 4 + n - 1) / n * n; }
   void need(size_t n) const {
     if (pos_ + n > data_.size()) {
-      throw SerializationError(fmt::format("data ends at byte {}, {} more needed at byte {}",
-                                           data_.size(), n, pos_));
+      throw SerializationError(
+          fmt::format("data ends at byte {}, {} more needed at byte {}", data_.size(), n, pos_));
     }
   }
 

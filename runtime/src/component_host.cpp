@@ -8,8 +8,8 @@
 #include "executor.hpp"
 #include "fastdds_transport.hpp"
 #include "intra_process_transport.hpp"
-#include "shutdown_signal.hpp"
 #include "names.hpp"
+#include "shutdown_signal.hpp"
 #include "timer_service.hpp"
 
 namespace mocap {
@@ -186,8 +186,8 @@ class ComponentHost::Impl::ComponentContext final : public Context {
   void subscribe(std::string_view topic, const MessageType& type,
                  MessageCallback callback) override {
     Endpoint endpoint = resolve(topic, type, TopicDirection::Subscribe);
-    auto subscription =
-        std::make_shared<HostSubscription>("subscription to " + endpoint.topic, std::move(callback));
+    auto subscription = std::make_shared<HostSubscription>("subscription to " + endpoint.topic,
+                                                           std::move(callback));
     for (auto& transport : host_.transports) {
       auto on_data = transport->calls_on_own_threads()
                          ? std::function<void()>([strand = &strand_] { strand->dispatch(); })
@@ -200,8 +200,8 @@ class ComponentHost::Impl::ComponentContext final : public Context {
 
   void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) override {
     if (period <= std::chrono::nanoseconds::zero()) {
-      throw std::invalid_argument(fmt::format("timer period must be positive, got {} ns",
-                                              period.count()));
+      throw std::invalid_argument(
+          fmt::format("timer period must be positive, got {} ns", period.count()));
     }
     auto timer = std::make_shared<Timer>("timer every " + format_period(period), period,
                                          std::move(callback), strand_);
@@ -220,15 +220,16 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     const TopicSpec* declared = spec_.find_topic(topic);
     std::string_view verb = direction == TopicDirection::Publish ? "publishes" : "subscribes";
     if (declared == nullptr) {
-      throw std::logic_error(fmt::format("component '{}' {} to '{}', which its declare() does not "
-                                         "declare (declared: {})",
-                                         config_.name, verb, topic, declared_topics(spec_)));
+      throw std::logic_error(
+          fmt::format("component '{}' {} to '{}', which its declare() does not "
+                      "declare (declared: {})",
+                      config_.name, verb, topic, declared_topics(spec_)));
     }
     if (declared->type != &type || declared->direction != direction) {
-      throw std::logic_error(fmt::format(
-          "component '{}' {} to '{}' with {}, but declares it as {} ({})", config_.name, verb,
-          topic, type.name(), declared->type->name(),
-          declared->direction == TopicDirection::Publish ? "published" : "subscribed"));
+      throw std::logic_error(
+          fmt::format("component '{}' {} to '{}' with {}, but declares it as {} ({})", config_.name,
+                      verb, topic, type.name(), declared->type->name(),
+                      declared->direction == TopicDirection::Publish ? "published" : "subscribed"));
     }
     Endpoint endpoint{declared->topic, &type, declared->qos, config_.name};
     if (auto it = config_.remaps.find(declared->topic); it != config_.remaps.end()) {
@@ -282,12 +283,12 @@ Component& ComponentHost::add(const ComponentFactory& factory, ComponentConfig c
   std::map<std::string, ParameterValue, std::less<>> values;
   for (const ParameterSpec& parameter : spec.parameters()) {
     auto given = config.parameters.find(parameter.name);
-    values[parameter.name] =
-        given == config.parameters.end() ? parameter.default_value : parameter.coerce(given->second);
+    values[parameter.name] = given == config.parameters.end() ? parameter.default_value
+                                                              : parameter.coerce(given->second);
   }
 
-  auto context = std::make_unique<Impl::ComponentContext>(*impl_, std::move(spec), std::move(config),
-                                                          Parameters(std::move(values)));
+  auto context = std::make_unique<Impl::ComponentContext>(
+      *impl_, std::move(spec), std::move(config), Parameters(std::move(values)));
   std::unique_ptr<Component> component;
   try {
     component = factory.create(*context);

@@ -6,8 +6,9 @@
 namespace mocap {
 
 Executor::Executor(int threads)
-    : thread_count_(threads > 0 ? threads
-                                : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {}
+    : thread_count_(threads > 0
+                        ? threads
+                        : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))) {}
 
 Executor::~Executor() { stop(); }
 
@@ -71,9 +72,7 @@ void Executor::work() {
   }
 }
 
-void Strand::add(std::shared_ptr<Waitable> waitable) {
-  waitables_.push_back(std::move(waitable));
-}
+void Strand::add(std::shared_ptr<Waitable> waitable) { waitables_.push_back(std::move(waitable)); }
 
 void Strand::remove(const Waitable* waitable) {
   std::erase_if(waitables_, [&](const auto& w) { return w.get() == waitable; });
@@ -123,8 +122,8 @@ bool Strand::execute(Waitable& waitable) {
   } catch (...) {
     callback_errors_.fetch_add(1);
     if (auto count = waitable.error_log_.count()) {
-      logger_.error("callback for {} threw a non-standard exception ({} time(s))",
-                    waitable.label(), *count);
+      logger_.error("callback for {} threw a non-standard exception ({} time(s))", waitable.label(),
+                    *count);
     }
   }
   return true;

@@ -5,6 +5,10 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include <fastdds/rtps/common/InstanceHandle.h>
+#include <fastrtps/rtps/builtin/data/ReaderProxyData.h>
+#include <fastrtps/rtps/builtin/data/WriterProxyData.h>
+#include <fmt/format.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -17,10 +21,6 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <fastdds/rtps/common/InstanceHandle.h>
-#include <fastrtps/rtps/builtin/data/ReaderProxyData.h>
-#include <fastrtps/rtps/builtin/data/WriterProxyData.h>
-#include <fmt/format.h>
 
 #include "fastdds_qos.hpp"
 #include "fastdds_type_adapter.hpp"
@@ -70,8 +70,7 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
            data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS);
   }
 
-  void on_subscriber_discovery(dds::DomainParticipant*,
-                               rtps::ReaderDiscoveryInfo&& info) override {
+  void on_subscriber_discovery(dds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
     const auto& data = info.info;
     bool alive = info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
                  info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER;
@@ -89,7 +88,8 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
     } else if (info.status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT ||
                info.status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
       participants_.erase(prefix);
-      std::erase_if(endpoints_, [&](const auto& entry) { return entry.first.guidPrefix == prefix; });
+      std::erase_if(endpoints_,
+                    [&](const auto& entry) { return entry.first.guidPrefix == prefix; });
     }
   }
 
@@ -140,9 +140,9 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
     topic_ = use.topic;
     local_writers_ = use.local_writers;
     local_writers_->fetch_add(1);
-    writer_ = transport.publisher_->create_datawriter(topic_, to_writer_qos(endpoint.qos), this,
-                                                      dds::StatusMask::publication_matched() <<
-                                                          dds::StatusMask::offered_incompatible_qos());
+    writer_ = transport.publisher_->create_datawriter(
+        topic_, to_writer_qos(endpoint.qos), this,
+        dds::StatusMask::publication_matched() << dds::StatusMask::offered_incompatible_qos());
     if (writer_ == nullptr) {
       local_writers_->fetch_sub(1);
       transport.release_topic(topic_);
@@ -170,15 +170,17 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
     }
   }
 
-  size_t matched_subscribers() const override { return static_cast<size_t>(remote_readers_.load()); }
+  size_t matched_subscribers() const override {
+    return static_cast<size_t>(remote_readers_.load());
+  }
 
   // Fast DDS 2.9 can report a timeout long before the blocking time has passed: when acks
   // free a full keep-all history, a volatile writer removes the acknowledged samples itself,
   // and the waiting write, finding no sample left to remove, gives up although there is room
   // now. Writing again within the blocking time succeeds at once.
   ReturnCode_t write(const void* message) {
-    auto deadline = std::chrono::steady_clock::now() +
-                    std::chrono::milliseconds(kReliableBlockingMilliseconds);
+    auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(kReliableBlockingMilliseconds);
     for (;;) {
       auto result = writer_->write(const_cast<void*>(message), dds::HANDLE_NIL);
       if (result != ReturnCode_t::RETCODE_TIMEOUT || std::chrono::steady_clock::now() >= deadline) {
@@ -197,9 +199,10 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   void on_offered_incompatible_qos(dds::DataWriter*,
                                    const dds::OfferedIncompatibleQosStatus& status) override {
     Logger(endpoint_.owner)
-        .warn("{}: a subscriber in another process requests QoS this publisher ({}) does not "
-              "offer (policy id {}); it receives nothing",
-              endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
+        .warn(
+            "{}: a subscriber in another process requests QoS this publisher ({}) does not "
+            "offer (policy id {}); it receives nothing",
+            endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
   }
 
  private:
@@ -229,9 +232,9 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     local_writers_ = use.local_writers;
     reader_ = transport.subscriber_->create_datareader(
         topic_, to_reader_qos(endpoint.qos), this,
-        dds::StatusMask::data_available() << dds::StatusMask::sample_lost()
-                                          << dds::StatusMask::sample_rejected()
-                                          << dds::StatusMask::requested_incompatible_qos());
+        dds::StatusMask::data_available()
+            << dds::StatusMask::sample_lost() << dds::StatusMask::sample_rejected()
+            << dds::StatusMask::requested_incompatible_qos());
     if (reader_ == nullptr) {
       transport.release_topic(topic_);
       throw std::runtime_error(fmt::format("cannot create a DDS reader for {}", endpoint.topic));
@@ -277,8 +280,7 @@ class FastDdsTransport::Reader final : public TransportSubscription,
   void on_data_available(dds::DataReader*) override { on_data_(); }
 
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override {
-    drops_.count(static_cast<uint64_t>(status.total_count_change),
-                 "lost in transit (best effort)");
+    drops_.count(static_cast<uint64_t>(status.total_count_change), "lost in transit (best effort)");
   }
 
   // A reliable reader's rejected samples are sent again; only a best-effort reader's are lost.
@@ -292,9 +294,10 @@ class FastDdsTransport::Reader final : public TransportSubscription,
   void on_requested_incompatible_qos(dds::DataReader*,
                                      const dds::RequestedIncompatibleQosStatus& status) override {
     Logger(endpoint_.owner)
-        .warn("{}: a publisher in another process does not offer the QoS this subscriber "
-              "requests ({}; policy id {}); nothing arrives from it",
-              endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
+        .warn(
+            "{}: a publisher in another process does not offer the QoS this subscriber "
+            "requests ({}; policy id {}); nothing arrives from it",
+            endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
   }
 
  private:
@@ -332,9 +335,9 @@ class FastDdsTransport::Reader final : public TransportSubscription,
 FastDdsTransport::FastDdsTransport(const DdsOptions& options, const std::string& participant_name)
     : domain_id_(resolve_domain_id(options.domain_id)), listener_(std::make_unique<Listener>()) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
-  participant_ = factory->create_participant(
-      domain_id_, to_participant_qos(options, participant_name), listener_.get(),
-      dds::StatusMask::none());
+  participant_ =
+      factory->create_participant(domain_id_, to_participant_qos(options, participant_name),
+                                  listener_.get(), dds::StatusMask::none());
   if (participant_ == nullptr) {
     throw std::runtime_error(
         fmt::format("cannot create a DDS participant on domain {}", domain_id_));
@@ -373,10 +376,10 @@ const FastDdsTransport::TopicUse& FastDdsTransport::acquire_topic(const Endpoint
   if (auto it = topics_.find(name); it != topics_.end()) {
     std::string used = it->second.topic->get_type_name();
     if (used != endpoint.type->dds_name()) {
-      throw std::invalid_argument(fmt::format("topic '{}' is already used with type {} here; '{}' "
-                                              "uses it with {}",
-                                              endpoint.topic, ros_type_name(used), endpoint.owner,
-                                              endpoint.type->name()));
+      throw std::invalid_argument(
+          fmt::format("topic '{}' is already used with type {} here; '{}' "
+                      "uses it with {}",
+                      endpoint.topic, ros_type_name(used), endpoint.owner, endpoint.type->name()));
     }
     ++it->second.users;
     return it->second;

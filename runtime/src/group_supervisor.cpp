@@ -26,11 +26,13 @@ void write_all(int fd, std::string_view text) {
   }
 }
 
-void say(std::string_view message) { write_all(STDERR_FILENO, fmt::format("[launch] {}\n", message)); }
+void say(std::string_view message) {
+  write_all(STDERR_FILENO, fmt::format("[launch] {}\n", message));
+}
 
 struct Stream {
-  int fd = -1;        // read end of the child's pipe
-  int target = -1;    // our stdout or stderr
+  int fd = -1;      // read end of the child's pipe
+  int target = -1;  // our stdout or stderr
   std::string partial;
 };
 
@@ -163,11 +165,11 @@ int supervise(const std::vector<ChildProcess>& specs,
       if (!stopping) {
         stop_all(child.exit_code == 0
                      ? fmt::format("group '{}' finished; stopping the others", child.spec->name)
-                     : WIFSIGNALED(status)
-                           ? fmt::format("group '{}' was killed by signal {}; stopping the others",
-                                         child.spec->name, WTERMSIG(status))
-                           : fmt::format("group '{}' exited with code {}; stopping the others",
-                                         child.spec->name, child.exit_code));
+                 : WIFSIGNALED(status)
+                     ? fmt::format("group '{}' was killed by signal {}; stopping the others",
+                                   child.spec->name, WTERMSIG(status))
+                     : fmt::format("group '{}' exited with code {}; stopping the others",
+                                   child.spec->name, child.exit_code));
       }
     }
 

@@ -36,7 +36,8 @@ std::vector<Token> tokenize(std::string_view text) {
       while (i < text.size() && text[i] != '\n') ++i;
     } else if (text.substr(i, 2) == "/*") {
       size_t end = text.find("*/", i + 2);
-      if (end == std::string_view::npos) throw IdlError(fmt::format("line {}: unclosed comment", line));
+      if (end == std::string_view::npos)
+        throw IdlError(fmt::format("line {}: unclosed comment", line));
       for (size_t k = i; k < end; ++k) line += text[k] == '\n';
       i = end + 2;
     } else if (c == '"') {  // string literal (in annotations and constants)
@@ -65,16 +66,26 @@ std::vector<Token> tokenize(std::string_view text) {
 
 const std::map<std::string, IdlKind, std::less<>>& primitive_names() {
   static const std::map<std::string, IdlKind, std::less<>> names = {
-      {"boolean", IdlKind::Bool},        {"char", IdlKind::Char},
-      {"octet", IdlKind::Octet},         {"int8", IdlKind::Int8},
-      {"uint8", IdlKind::UInt8},         {"int16", IdlKind::Int16},
-      {"uint16", IdlKind::UInt16},       {"int32", IdlKind::Int32},
-      {"uint32", IdlKind::UInt32},       {"int64", IdlKind::Int64},
-      {"uint64", IdlKind::UInt64},       {"float", IdlKind::Float},
-      {"double", IdlKind::Double},       {"short", IdlKind::Int16},
-      {"long", IdlKind::Int32},          {"string", IdlKind::String},
-      {"unsigned short", IdlKind::UInt16}, {"unsigned long", IdlKind::UInt32},
-      {"long long", IdlKind::Int64},     {"unsigned long long", IdlKind::UInt64},
+      {"boolean", IdlKind::Bool},
+      {"char", IdlKind::Char},
+      {"octet", IdlKind::Octet},
+      {"int8", IdlKind::Int8},
+      {"uint8", IdlKind::UInt8},
+      {"int16", IdlKind::Int16},
+      {"uint16", IdlKind::UInt16},
+      {"int32", IdlKind::Int32},
+      {"uint32", IdlKind::UInt32},
+      {"int64", IdlKind::Int64},
+      {"uint64", IdlKind::UInt64},
+      {"float", IdlKind::Float},
+      {"double", IdlKind::Double},
+      {"short", IdlKind::Int16},
+      {"long", IdlKind::Int32},
+      {"string", IdlKind::String},
+      {"unsigned short", IdlKind::UInt16},
+      {"unsigned long", IdlKind::UInt32},
+      {"long long", IdlKind::Int64},
+      {"unsigned long long", IdlKind::UInt64},
   };
   return names;
 }
@@ -204,8 +215,10 @@ class IdlParser {
       if (schema_.structs_.contains(candidate)) return {IdlKind::Struct, candidate, nullptr, {}};
     }
     // Defined elsewhere (another file): qualified names are taken as they are.
-    return {IdlKind::Struct, name.find("::") == std::string::npos ? qualified(name) : name,
-            nullptr, {}};
+    return {IdlKind::Struct,
+            name.find("::") == std::string::npos ? qualified(name) : name,
+            nullptr,
+            {}};
   }
 
   std::vector<uint32_t> dimensions() {
@@ -286,7 +299,9 @@ class IdlParser {
   std::vector<std::string> scope_;
 };
 
-void IdlSchema::parse(std::string_view text) { IdlParser(*this, tokenize(text)).definitions(false); }
+void IdlSchema::parse(std::string_view text) {
+  IdlParser(*this, tokenize(text)).definitions(false);
+}
 
 const IdlStruct* IdlSchema::find(std::string_view name) const {
   std::string key(name);

@@ -42,9 +42,9 @@ enum class IdlKind {
 
 struct IdlType {
   IdlKind kind = IdlKind::Int32;
-  std::string name;                      // Struct and Enum: fully qualified ("a::msg::T")
+  std::string name;                        // Struct and Enum: fully qualified ("a::msg::T")
   std::shared_ptr<const IdlType> element;  // Sequence
-  std::vector<uint32_t> array;           // dimensions when the member is an array
+  std::vector<uint32_t> array;             // dimensions when the member is an array
 };
 
 struct IdlMember {

@@ -40,8 +40,7 @@ class IntraProcessTransport::Subscription final : public TransportSubscription {
         if (endpoint_.qos.history == History::KeepLast) {
           queue_.pop_front();
           drops_.count(1, "the subscriber is slower than the publisher (keep_last queue full)");
-        } else if (!room_.wait_for(lock,
-                                   std::chrono::milliseconds(kReliableBlockingMilliseconds),
+        } else if (!room_.wait_for(lock, std::chrono::milliseconds(kReliableBlockingMilliseconds),
                                    [&] { return queue_.size() < depth; })) {
           drops_.count(1, fmt::format("the subscriber is {} samples behind and did not catch up "
                                       "within {} ms",
@@ -110,10 +109,9 @@ IntraProcessTransport::Topic& IntraProcessTransport::topic_for(const Endpoint& e
     topic.type = endpoint.type;
     topic.first_user = endpoint.owner;
   } else if (topic.type != endpoint.type) {
-    throw std::invalid_argument(
-        fmt::format("topic '{}' carries {} (as used by '{}'), but '{}' uses it with {}",
-                    endpoint.topic, topic.type->name(), topic.first_user, endpoint.owner,
-                    endpoint.type->name()));
+    throw std::invalid_argument(fmt::format(
+        "topic '{}' carries {} (as used by '{}'), but '{}' uses it with {}", endpoint.topic,
+        topic.type->name(), topic.first_user, endpoint.owner, endpoint.type->name()));
   }
   return topic;
 }

@@ -76,8 +76,8 @@ std::optional<int64_t> int_value(const YAML::Node& node, std::string_view key, i
                                  int64_t max, Problems& problems) {
   try {
     ParameterValue value = parameter_value_from_yaml(node);
-    if (const int64_t* number = std::get_if<int64_t>(&value); number && *number >= min &&
-                                                             *number <= max) {
+    if (const int64_t* number = std::get_if<int64_t>(&value);
+        number && *number >= min && *number <= max) {
       return *number;
     }
   } catch (const std::invalid_argument&) {
@@ -107,11 +107,12 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
     return std::nullopt;
   }
   if (!node.IsMap()) {
-    problems.add(node, fmt::format("QoS for '{}' must be a profile name or {{profile, depth}}",
-                                   topic));
+    problems.add(node,
+                 fmt::format("QoS for '{}' must be a profile name or {{profile, depth}}", topic));
     return std::nullopt;
   }
-  check_keys(node, std::vector<std::string>{"profile", "depth"}, fmt::format("the QoS of '{}'", topic), problems);
+  check_keys(node, std::vector<std::string>{"profile", "depth"},
+             fmt::format("the QoS of '{}'", topic), problems);
   std::optional<Qos> qos;
   if (YAML::Node profile = node["profile"]) {
     if (!profile.IsScalar() || !(qos = Qos::from_profile(profile.Scalar()))) {
@@ -219,7 +220,8 @@ class Reader {
       problems_.add(dds, "'dds' must be a map (enabled, domain_id, shared_memory)");
       return;
     }
-    check_keys(dds, std::vector<std::string>{"enabled", "domain_id", "shared_memory"}, "'dds'", problems_);
+    check_keys(dds, std::vector<std::string>{"enabled", "domain_id", "shared_memory"}, "'dds'",
+               problems_);
     if (YAML::Node n = dds["enabled"]) {
       if (auto v = bool_value(n, "enabled", problems_)) result_.dds.enabled = *v;
     }
@@ -238,12 +240,13 @@ class Reader {
     }
     LaunchGroup group;
     group.line = line_of(node);
-    check_keys(node, std::vector<std::string>{"name", "threads", "components"}, "a group", problems_);
+    check_keys(node, std::vector<std::string>{"name", "threads", "components"}, "a group",
+               problems_);
     if (YAML::Node name = node["name"]) {
       group.name = string_value(name, "name", problems_).value_or("");
       if (!valid_component_name(group.name)) {
-        problems_.add(name, fmt::format("group name '{}' must use letters, digits, '_' and '-'",
-                                        group.name));
+        problems_.add(
+            name, fmt::format("group name '{}' must use letters, digits, '_' and '-'", group.name));
       }
       for (const LaunchGroup& other : result_.groups) {
         if (other.name == group.name) {
@@ -255,7 +258,8 @@ class Reader {
       problems_.add(node, "a group needs a 'name'");
     }
     if (YAML::Node threads = node["threads"]) {
-      group.threads = static_cast<int>(int_value(threads, "threads", 1, 256, problems_).value_or(0));
+      group.threads =
+          static_cast<int>(int_value(threads, "threads", 1, 256, problems_).value_or(0));
     }
     YAML::Node components = node["components"];
     if (!components || !components.IsSequence() || components.size() == 0) {
@@ -274,8 +278,8 @@ class Reader {
       problems_.add(node, "a component is a map with 'plugin' and 'name'");
       return;
     }
-    check_keys(node, std::vector<std::string>{"plugin", "name", "parameters", "remap", "qos"}, "a component",
-               problems_);
+    check_keys(node, std::vector<std::string>{"plugin", "name", "parameters", "remap", "qos"},
+               "a component", problems_);
     LaunchComponent component;
     component.line = line_of(node);
     YAML::Node name = node["name"];
@@ -290,8 +294,8 @@ class Reader {
                                         *text));
       }
       if (auto [it, fresh] = component_lines_.emplace(*text, component.line); !fresh) {
-        problems_.add(name, fmt::format("duplicate component name '{}' (first at line {})",
-                                        *text, it->second));
+        problems_.add(name, fmt::format("duplicate component name '{}' (first at line {})", *text,
+                                        it->second));
       }
     }
     YAML::Node plugin = node["plugin"];
@@ -323,24 +327,27 @@ class Reader {
       }
     }
     if (YAML::Node remap = node["remap"]) {
-      read_topic_map(remap, "remap", component.remap_lines, [&](const std::string& from, const YAML::Node& to) {
-        if (auto text = string_value(to, "remap target", problems_)) {
-          component.config.remaps[from] = *text;
-        }
-      });
+      read_topic_map(remap, "remap", component.remap_lines,
+                     [&](const std::string& from, const YAML::Node& to) {
+                       if (auto text = string_value(to, "remap target", problems_)) {
+                         component.config.remaps[from] = *text;
+                       }
+                     });
     }
     if (YAML::Node qos = node["qos"]) {
-      read_topic_map(qos, "qos", component.qos_lines, [&](const std::string& topic, const YAML::Node& value) {
-        if (auto parsed = qos_value(value, topic, problems_)) component.config.qos[topic] = *parsed;
-      });
+      read_topic_map(qos, "qos", component.qos_lines,
+                     [&](const std::string& topic, const YAML::Node& value) {
+                       if (auto parsed = qos_value(value, topic, problems_))
+                         component.config.qos[topic] = *parsed;
+                     });
     }
     if (result_.groups.empty()) return;
     result_.groups.back().components.push_back(std::move(component));
   }
 
   template <class Each>
-  void read_topic_map(const YAML::Node& map, std::string_view key, std::map<std::string, int>& lines,
-                      Each each) {
+  void read_topic_map(const YAML::Node& map, std::string_view key,
+                      std::map<std::string, int>& lines, Each each) {
     if (!map.IsMap()) {
       problems_.add(map, fmt::format("'{}' must be a map of topic: value", key));
       return;
@@ -367,8 +374,7 @@ class Reader {
         continue;
       }
       try {
-        target->config.parameters[o.parameter] =
-            parameter_value_from_yaml(YAML::Load(o.value));
+        target->config.parameters[o.parameter] = parameter_value_from_yaml(YAML::Load(o.value));
         target->parameter_lines[o.parameter] = -1;
         set_texts_[{target, o.parameter}] = o.text;
       } catch (const std::exception& e) {
@@ -456,8 +462,8 @@ LaunchFile load_launch_file(const std::filesystem::path& path, PluginLoader& plu
                             const std::vector<ParameterOverride>& overrides) {
   std::ifstream stream(path);
   if (!stream) {
-    throw LaunchError({fmt::format("{}: cannot read the launch file: {}", path.string(),
-                                   std::strerror(errno))});
+    throw LaunchError(
+        {fmt::format("{}: cannot read the launch file: {}", path.string(), std::strerror(errno))});
   }
   std::stringstream text;
   text << stream.rdbuf();

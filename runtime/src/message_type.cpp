@@ -50,7 +50,8 @@ std::vector<const MessageType*> registered_message_types() {
 }
 
 std::string full_definition(const MessageType& type) {
-  static const std::regex include_line(R"re(#include\s+"([A-Za-z0-9_]+/msg/[A-Za-z0-9_]+)\.idl")re");
+  static const std::regex include_line(
+      R"re(#include\s+"([A-Za-z0-9_]+/msg/[A-Za-z0-9_]+)\.idl")re");
   std::string text = type.definition();
   std::set<std::string> done{type.name()};
   std::vector<std::string> pending;

@@ -36,7 +36,7 @@ std::string format_list(const std::vector<T>& values, Format format) {
 
 std::string format_bound(double value) {
   return value == std::floor(value) && std::fabs(value) < 1e15 ? fmt::format("{}", int64_t(value))
-                                                                : fmt::format("{}", value);
+                                                               : fmt::format("{}", value);
 }
 
 }  // namespace
@@ -134,16 +134,16 @@ std::optional<std::string> ParameterSpec::check(const ParameterValue& value) con
   if (const auto* xs = std::get_if<std::vector<double>>(&coerced)) {
     for (double x : *xs) {
       if (out_of_range(x)) {
-        return fmt::format("expects {}, got {} (element {})", type_description(),
-                           to_string(value), format_number(x));
+        return fmt::format("expects {}, got {} (element {})", type_description(), to_string(value),
+                           format_number(x));
       }
     }
   }
   if (const auto* xs = std::get_if<std::vector<int64_t>>(&coerced)) {
     for (int64_t x : *xs) {
       if (out_of_range(double(x))) {
-        return fmt::format("expects {}, got {} (element {})", type_description(),
-                           to_string(value), x);
+        return fmt::format("expects {}, got {} (element {})", type_description(), to_string(value),
+                           x);
       }
     }
   }

@@ -86,7 +86,8 @@ const LoadedPlugin& PluginLoader::load_library(const fs::path& library,
   // internal names.
   void* handle = dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
-    throw PluginError(fmt::format("cannot load plugin library {}: {}", library.string(), dlerror()));
+    throw PluginError(
+        fmt::format("cannot load plugin library {}: {}", library.string(), dlerror()));
   }
   dlerror();
   void* symbol = dlsym(handle, ComponentFactory::kSymbol);
@@ -99,10 +100,10 @@ const LoadedPlugin& PluginLoader::load_library(const fs::path& library,
   auto get_factory = reinterpret_cast<const ComponentFactory* (*)()>(symbol);
   const ComponentFactory* factory = get_factory();
   if (factory == nullptr || factory->abi_version != ComponentFactory::kAbiVersion) {
-    throw PluginError(fmt::format("{} was built for component ABI {}, this runtime has ABI {}; "
-                                  "rebuild the plugin",
-                                  library.string(), factory ? factory->abi_version : 0,
-                                  ComponentFactory::kAbiVersion));
+    throw PluginError(fmt::format(
+        "{} was built for component ABI {}, this runtime has ABI {}; "
+        "rebuild the plugin",
+        library.string(), factory ? factory->abi_version : 0, ComponentFactory::kAbiVersion));
   }
   if (!expected_name.empty() && expected_name != factory->name) {
     throw PluginError(fmt::format("{} registers plugin '{}', not '{}'", library.string(),
@@ -115,8 +116,8 @@ const LoadedPlugin& PluginLoader::load_library(const fs::path& library,
   try {
     factory->declare(plugin->spec);
   } catch (const std::exception& e) {
-    throw PluginError(fmt::format("plugin '{}' ({}) has an invalid declaration: {}",
-                                  factory->name, library.string(), e.what()));
+    throw PluginError(fmt::format("plugin '{}' ({}) has an invalid declaration: {}", factory->name,
+                                  library.string(), e.what()));
   }
   std::string key = expected_name.empty() ? library.string() : std::string(expected_name);
   return *(loaded_[key] = std::move(plugin));

@@ -8,7 +8,9 @@ Qos Qos::sensor_data() {
   return {Reliability::BestEffort, Durability::Volatile, History::KeepLast, 5};
 }
 
-Qos Qos::reliable() { return {Reliability::Reliable, Durability::Volatile, History::KeepAll, 1000}; }
+Qos Qos::reliable() {
+  return {Reliability::Reliable, Durability::Volatile, History::KeepAll, 1000};
+}
 
 Qos Qos::latched() {
   return {Reliability::Reliable, Durability::TransientLocal, History::KeepLast, 1};
@@ -25,7 +27,8 @@ std::string Qos::to_string() const {
   if (*this == sensor_data()) return "sensor_data";
   if (*this == reliable()) return "reliable";
   if (*this == latched()) return "latched";
-  return fmt::format("{}, {}, {} {}", reliability == Reliability::Reliable ? "reliable" : "best_effort",
+  return fmt::format("{}, {}, {} {}",
+                     reliability == Reliability::Reliable ? "reliable" : "best_effort",
                      durability == Durability::Volatile ? "volatile" : "transient_local",
                      history == History::KeepLast ? "keep_last" : "keep_all", depth);
 }

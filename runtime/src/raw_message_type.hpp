@@ -17,12 +17,8 @@ class RawMessageType final : public MessageType {
   explicit RawMessageType(const std::string& dds_type_name)
       : MessageType(ros_type_name(dds_type_name), "") {}
 
-  std::shared_ptr<void> create() const override {
-    return std::make_shared<std::vector<uint8_t>>();
-  }
-  size_t serialized_size(const void* message) const override {
-    return bytes(message).size();
-  }
+  std::shared_ptr<void> create() const override { return std::make_shared<std::vector<uint8_t>>(); }
+  size_t serialized_size(const void* message) const override { return bytes(message).size(); }
   size_t serialize(const void* message, std::span<uint8_t> out) const override {
     const auto& data = bytes(message);
     if (data.size() > out.size()) throw SerializationError("buffer too small for raw message");

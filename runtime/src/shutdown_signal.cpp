@@ -56,8 +56,7 @@ bool ShutdownSignal::wait(std::optional<std::chrono::steady_clock::duration> tim
     if (timeout) {
       auto left = deadline - std::chrono::steady_clock::now();
       if (left <= std::chrono::steady_clock::duration::zero()) return false;
-      wait_ms = static_cast<int>(
-          std::chrono::ceil<std::chrono::milliseconds>(left).count());
+      wait_ms = static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(left).count());
     }
     pollfd fd = {pipe_fds[0], POLLIN, 0};
     int ready = poll(&fd, 1, wait_ms);

@@ -42,9 +42,10 @@ Environment: MOCAP_DOMAIN_ID overrides the DDS domain, MOCAP_LOG_LEVEL=debug|inf
 
 std::string describe(const mocap::LoadedPlugin& plugin) {
   const mocap::ComponentSpec& spec = plugin.spec;
-  std::string out = fmt::format("{}: {}\nlibrary: {}\n", plugin.name,
-                                spec.description().empty() ? "(no description)" : spec.description(),
-                                plugin.library.string());
+  std::string out =
+      fmt::format("{}: {}\nlibrary: {}\n", plugin.name,
+                  spec.description().empty() ? "(no description)" : spec.description(),
+                  plugin.library.string());
   out += "\nparameters:\n";
   if (spec.parameters().empty()) out += "  (none)\n";
   for (const mocap::ParameterSpec& p : spec.parameters()) {

@@ -113,12 +113,11 @@ int receive(mocap::FastDdsTransport& transport, const std::string& topic,
   std::mutex mutex;
   std::condition_variable arrived;
   bool pending = false;
-  auto subscription =
-      transport.subscribe({topic, &type, qos, "mocap_topic"}, [&] {
-        std::lock_guard lock(mutex);
-        pending = true;
-        arrived.notify_one();
-      });
+  auto subscription = transport.subscribe({topic, &type, qos, "mocap_topic"}, [&] {
+    std::lock_guard lock(mutex);
+    pending = true;
+    arrived.notify_one();
+  });
   mocap::ReceivedMessage received;
   while (!mocap::ShutdownSignal::received()) {
     while (subscription->take(received)) {
@@ -178,8 +177,7 @@ int echo(mocap::FastDdsTransport& transport, const std::string& topic, size_t co
   });
 }
 
-int hz(mocap::FastDdsTransport& transport, const std::string& topic, size_t window,
-       size_t count) {
+int hz(mocap::FastDdsTransport& transport, const std::string& topic, size_t window, size_t count) {
   auto found = find_publishers(transport, topic);
   if (!found) return 1;
   auto [dds_type, qos] = *found;
@@ -192,10 +190,11 @@ int hz(mocap::FastDdsTransport& transport, const std::string& topic, size_t wind
     if (std::chrono::steady_clock::now() < next_report) return true;
     next_report += std::chrono::seconds(1);
     if (auto stats = estimator.stats()) {
-      fmt::print("average rate: {:.3f} Hz\n  min: {:.6f} s  max: {:.6f} s  std dev: {:.6f} s  "
-                 "window: {}\n",
-                 stats->rate_hz, stats->min_period_s, stats->max_period_s,
-                 stats->stddev_period_s, stats->samples);
+      fmt::print(
+          "average rate: {:.3f} Hz\n  min: {:.6f} s  max: {:.6f} s  std dev: {:.6f} s  "
+          "window: {}\n",
+          stats->rate_hz, stats->min_period_s, stats->max_period_s, stats->stddev_period_s,
+          stats->samples);
       std::fflush(stdout);
       return ++reports < count;
     }

@@ -13,7 +13,8 @@ class ImageSink final : public Component {
     spec.subscribes<sensor_msgs::msg::Image>(kSequenceTopic, Qos::sensor_data(), "images");
   }
   explicit ImageSink(Context& context) : Component(context) {
-    create_subscription<sensor_msgs::msg::Image>(kSequenceTopic, [](const sensor_msgs::msg::Image&) {});
+    create_subscription<sensor_msgs::msg::Image>(kSequenceTopic,
+                                                 [](const sensor_msgs::msg::Image&) {});
   }
 };
 

@@ -14,8 +14,10 @@ class SequenceSink final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Test sink: checks the numbered stream, writes a summary, then stops.");
-    spec.parameter("expect", 1000, "messages after which the summary is written and the process "
-                                   "stops; 0 for never").min(0);
+    spec.parameter("expect", 1000,
+                   "messages after which the summary is written and the process "
+                   "stops; 0 for never")
+        .min(0);
     spec.parameter("summary_file", std::string(), "where the summary goes (YAML)");
     spec.parameter("timeout_s", 60.0, "give up after this long: summary, then exit code 3")
         .min(0.1);
@@ -68,9 +70,10 @@ class SequenceSink final : public Component {
           "same_object: {}\n",
           received_, first_, last_, missing_, out_of_order_, corrupt_, same_object_);
     }
-    log().info("received {} messages (first {}, last {}, {} missing, {} out of order, {} corrupt, "
-               "{} by pointer)",
-               received_, first_, last_, missing_, out_of_order_, corrupt_, same_object_);
+    log().info(
+        "received {} messages (first {}, last {}, {} missing, {} out of order, {} corrupt, "
+        "{} by pointer)",
+        received_, first_, last_, missing_, out_of_order_, corrupt_, same_object_);
     if (stop_when_done_ || exit_code != 0) request_shutdown(exit_code);
   }
 

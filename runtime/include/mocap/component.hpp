@@ -108,16 +108,16 @@ class Component {
   // shared pointer to hold on to a message without copying it.
   template <class Message, class Callback>
   void create_subscription(std::string_view topic, Callback&& callback) {
-    context_.subscribe(topic, message_type<Message>(),
-                       [cb = std::forward<Callback>(callback)](const std::shared_ptr<const void>& m) {
-                         auto typed = std::static_pointer_cast<const Message>(m);
-                         if constexpr (std::is_invocable_v<Callback&,
-                                                           const std::shared_ptr<const Message>&>) {
-                           cb(typed);
-                         } else {
-                           cb(*typed);
-                         }
-                       });
+    context_.subscribe(
+        topic, message_type<Message>(),
+        [cb = std::forward<Callback>(callback)](const std::shared_ptr<const void>& m) {
+          auto typed = std::static_pointer_cast<const Message>(m);
+          if constexpr (std::is_invocable_v<Callback&, const std::shared_ptr<const Message>&>) {
+            cb(typed);
+          } else {
+            cb(*typed);
+          }
+        });
   }
 
   // Runs `callback` every `period` (steady clock). Late ticks are not queued: a callback
@@ -165,10 +165,10 @@ constexpr ComponentFactory make_component_factory(const char* name) {
 
 // Makes the enclosing shared library a plugin named `plugin_name` (the launch files'
 // `plugin:` value). One component per library.
-#define MOCAP_REGISTER_COMPONENT(ComponentClass, plugin_name)                                  \
-  extern "C" __attribute__((visibility("default"))) const ::mocap::ComponentFactory*           \
-  mocap_component_factory() {                                                                   \
-    static constexpr ::mocap::ComponentFactory factory =                                        \
-        ::mocap::make_component_factory<ComponentClass>(plugin_name);                           \
-    return &factory;                                                                            \
+#define MOCAP_REGISTER_COMPONENT(ComponentClass, plugin_name)                        \
+  extern "C" __attribute__((visibility("default"))) const ::mocap::ComponentFactory* \
+  mocap_component_factory() {                                                        \
+    static constexpr ::mocap::ComponentFactory factory =                             \
+        ::mocap::make_component_factory<ComponentClass>(plugin_name);                \
+    return &factory;                                                                 \
   }

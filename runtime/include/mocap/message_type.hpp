@@ -72,8 +72,8 @@ std::vector<const MessageType*> registered_message_types();
 std::string full_definition(const MessageType& type);
 
 // ROS 2 name mangling for DDS.
-std::string dds_type_name(std::string_view ros_type_name);   // a/msg/T -> a::msg::dds_::T_
-std::string ros_type_name(std::string_view dds_type_name);   // inverse; unchanged if not ROS
+std::string dds_type_name(std::string_view ros_type_name);    // a/msg/T -> a::msg::dds_::T_
+std::string ros_type_name(std::string_view dds_type_name);    // inverse; unchanged if not ROS
 std::string dds_topic_name(std::string_view ros_topic_name);  // /a/b -> rt/a/b
 std::string ros_topic_name(std::string_view dds_topic_name);  // inverse; unchanged if not ROS
 

@@ -25,8 +25,8 @@ builtin_interfaces::msg::Time to_time_msg(std::chrono::time_point<Clock, Duratio
 template <class Clock = std::chrono::system_clock>
 typename Clock::time_point from_time_msg(const builtin_interfaces::msg::Time& msg) {
   auto since_epoch = std::chrono::seconds(msg.sec()) + std::chrono::nanoseconds(msg.nanosec());
-  return typename Clock::time_point(
-      std::chrono::duration_cast<typename Clock::duration>(since_epoch));
+  return
+      typename Clock::time_point(std::chrono::duration_cast<typename Clock::duration>(since_epoch));
 }
 
 }  // namespace mocap

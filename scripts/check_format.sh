@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Fails, listing the files, when a C++ source is not formatted as .clang-format says.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+unformatted=$(git ls-files '*.cpp' '*.hpp' '*.h' |
+  while read -r file; do
+    clang-format --dry-run -Werror "$file" > /dev/null 2>&1 || echo "$file"
+  done)
+if [ -n "$unformatted" ]; then
+  echo "not clang-format clean (run: clang-format -i FILE):"
+  echo "$unformatted" | sed 's/^/  /'
+  exit 1
+fi

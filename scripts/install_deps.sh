@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages mocap-graph needs: the one list. Safe to run again: when
+# everything is installed it changes nothing, and it reads the package index only when a
+# package is missing.
+set -euo pipefail
+
+packages=(
+  # build
+  build-essential cmake ninja-build pkg-config
+  # messages and DDS
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  # runtime
+  libyaml-cpp-dev libfmt-dev
+  # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
+  libgtest-dev libgmock-dev iproute2 clang-format
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  sudo="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+echo "install_deps: installing ${missing[*]}"
+# An index that is missing or a day old is read again first; a failed install once more.
+if [ -z "$(find /var/lib/apt/lists -maxdepth 1 -name '*Packages*' -mtime -1 2>/dev/null | head -1)" ]; then
+  $sudo apt-get update -q
+fi
+if ! $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"; then
+  $sudo apt-get update -q
+  $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Sets everything up, builds with warnings as errors, checks formatting and runs every test.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install_deps.sh
+scripts/build.sh -DMOCAP_WERROR=ON
+scripts/check_format.sh
+cd build
+ctest --output-on-failure --parallel "$(nproc)"
