@@ -9,6 +9,8 @@
 #include <mocap/component_host.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
+#include "fastdds_transport.hpp"
+
 namespace mocap {
 namespace {
 
@@ -219,6 +221,31 @@ TEST_F(ComponentHostTest, OneComponentsCallbacksNeverOverlapAndErrorsAreCounted)
   EXPECT_GE(record.ticks, 300);
   EXPECT_EQ(record.max_active, 1);
   EXPECT_GE(host.callback_errors(), 150u);
+}
+
+}  // namespace
+}  // namespace mocap
+
+namespace mocap {
+namespace {
+
+TEST(DomainId, TheEnvironmentOverridesTheLaunchFile) {
+  unsetenv("MOCAP_DOMAIN_ID");
+  EXPECT_EQ(resolve_domain_id(7), 7);
+  setenv("MOCAP_DOMAIN_ID", "42", 1);
+  EXPECT_EQ(resolve_domain_id(7), 42);
+  for (const char* bad : {"233", "-1", "4x", "many"}) {
+    setenv("MOCAP_DOMAIN_ID", bad, 1);
+    try {
+      resolve_domain_id(7);
+      ADD_FAILURE() << bad;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), fmt::format("MOCAP_DOMAIN_ID='{}' is not a DDS domain id "
+                                                   "(an integer 0..232)",
+                                                   bad));
+    }
+  }
+  unsetenv("MOCAP_DOMAIN_ID");
 }
 
 }  // namespace

@@ -216,6 +216,31 @@ TEST(Launcher, DescribeListsParametersAndTopics) {
   EXPECT_NE(missing.find("did you mean 'sequence_sink'?"), std::string::npos) << missing;
 }
 
+TEST(Launcher, CtrlCStopsEveryGroupCleanly) {
+  test::TempDir dir;
+  test::write_file(dir / "graph.yaml", R"(groups:
+  - name: one
+    components:
+      - plugin: sequence_sink
+        name: a
+        parameters: {expect: 0}
+  - name: two
+    components:
+      - plugin: sequence_source
+        name: b
+        parameters: {count: 0, subscribers: 0}
+)");
+  test::ChildProcess launch({launcher(), (dir / "graph.yaml").string()}, environment(18),
+                            dir / "launch.log");
+  ASSERT_TRUE(launch.wait_for_output("[two] ", std::chrono::seconds(30))) << launch.output();
+  ASSERT_TRUE(launch.wait_for_output("[one] ", std::chrono::seconds(30))) << launch.output();
+  launch.signal(SIGINT);
+  EXPECT_EQ(launch.wait(std::chrono::seconds(30)), 0) << launch.output();
+  EXPECT_NE(launch.output().find("[launch] stopping all groups"), std::string::npos);
+  EXPECT_NE(launch.output().find("[one] [INFO]"), std::string::npos) << launch.output();
+  EXPECT_NE(launch.output().find("[two] [INFO]"), std::string::npos) << launch.output();
+}
+
 // A group whose component cannot start stops the whole deployment, loudly, with its code.
 TEST(Launcher, AGroupThatFailsToStartStopsTheOthers) {
   test::TempDir dir;

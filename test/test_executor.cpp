@@ -101,9 +101,11 @@ class Recorder final : public Waitable {
       : Waitable("recorder"), duration_(duration) {}
   bool execute_one() override {
     if (!due.exchange(false)) return false;
-    std::this_thread::sleep_for(duration_);
-    std::lock_guard lock(mutex);
-    threads.push_back(std::this_thread::get_id());
+    run_callback([&] {
+      std::this_thread::sleep_for(duration_);
+      std::lock_guard lock(mutex);
+      threads.push_back(std::this_thread::get_id());
+    });
     return true;
   }
   std::atomic<bool> due{false};

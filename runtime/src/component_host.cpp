@@ -66,7 +66,7 @@ class HostSubscription final : public Waitable {
       size_t index = (next_ + i) % sources_.size();
       if (sources_[index]->take(received)) {
         next_ = index + 1;
-        callback_(received.message);
+        run_callback([&] { callback_(received.message); });
         return true;
       }
     }
@@ -125,7 +125,9 @@ struct ComponentHost::Impl {
       : options(std::move(host_options)), executor(options.threads), logger(options.name) {
     transports.push_back(std::make_unique<IntraProcessTransport>());
     if (options.dds.enabled) {
-      transports.push_back(std::make_unique<FastDdsTransport>(options.dds, options.name));
+      auto dds = std::make_unique<FastDdsTransport>(options.dds, options.name);
+      dds_domain = dds->domain_id();
+      transports.push_back(std::move(dds));
     }
   }
 
@@ -142,6 +144,7 @@ struct ComponentHost::Impl {
   TimerService timers;
   Logger logger;
   std::vector<std::unique_ptr<Transport>> transports;
+  int dds_domain = -1;
   // Declared after the transports: destroyed before them.
   std::vector<std::unique_ptr<ComponentContext>> contexts;
   std::vector<std::unique_ptr<Component>> components;
@@ -311,6 +314,14 @@ void ComponentHost::start() {
 int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
   ShutdownSignal::install();
   start();
+  std::vector<std::string> names;
+  for (const auto& context : impl_->contexts) names.push_back(context->name());
+  const DdsOptions& dds = impl_->options.dds;
+  impl_->logger.info(
+      "running {} on {} thread(s); {}", fmt::join(names, ", "), impl_->executor.threads(),
+      dds.enabled
+          ? fmt::format("DDS domain {}{}", impl_->dds_domain, dds.shared_memory ? "" : ", UDP only")
+          : std::string("DDS off"));
   auto deadline =
       duration ? std::chrono::steady_clock::now() +
                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(*duration)

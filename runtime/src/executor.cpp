@@ -105,13 +105,9 @@ void Strand::enable() {
 
 bool Strand::execute(Waitable& waitable) {
   try {
-    auto start = std::chrono::steady_clock::now();
     if (!waitable.execute_one()) return false;
-    int64_t took = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                       std::chrono::steady_clock::now() - start)
-                       .count();
     int64_t mean = mean_callback_ns_.load();
-    mean_callback_ns_.store(mean + (took - mean) / 16);
+    mean_callback_ns_.store(mean + (waitable.callback_ns_ - mean) / 16);
     return true;
   } catch (const std::exception& e) {
     callback_errors_.fetch_add(1);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -24,14 +25,27 @@ class Waitable {
  public:
   explicit Waitable(std::string label) : label_(std::move(label)) {}
   virtual ~Waitable() = default;
-  // Runs at most one callback; false when there was nothing to do.
+  // Runs at most one callback, through run_callback(); false when there was nothing to do.
   virtual bool execute_one() = 0;
   const std::string& label() const { return label_; }
 
+ protected:
+  // Runs the component's code and times it: the strand learns how long its component's
+  // callbacks take, without the transport's work (taking, deserializing) around them.
+  template <class Callback>
+  void run_callback(Callback&& callback) {
+    auto start = std::chrono::steady_clock::now();
+    callback();
+    callback_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::steady_clock::now() - start)
+                       .count();
+  }
+
  private:
-  std::string label_;
   friend class Strand;
+  std::string label_;
   Throttle error_log_;
+  int64_t callback_ns_ = 0;  // of the last callback
 };
 
 // A fixed pool of threads that runs ready strands in FIFO order.

@@ -6,7 +6,7 @@ namespace mocap {
 
 bool Timer::execute_one() {
   if (!due_.exchange(false)) return false;
-  callback_();
+  run_callback(callback_);
   return true;
 }
 
