@@ -62,21 +62,13 @@ int resolve_domain_id(int configured) {
 class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
  public:
   void on_publisher_discovery(dds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
-    const auto& data = info.info;
-    bool alive = info.status == rtps::WriterDiscoveryInfo::DISCOVERED_WRITER ||
-                 info.status == rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER;
-    update(data.guid(), alive, data.topicName().to_string(), data.typeName().to_string(), true,
-           data.m_qos.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS,
-           data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS);
+    update(info.info, info.status == rtps::WriterDiscoveryInfo::DISCOVERED_WRITER ||
+                          info.status == rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER);
   }
 
   void on_subscriber_discovery(dds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
-    const auto& data = info.info;
-    bool alive = info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
-                 info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER;
-    update(data.guid(), alive, data.topicName().to_string(), data.typeName().to_string(), false,
-           data.m_qos.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS,
-           data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS);
+    update(info.info, info.status == rtps::ReaderDiscoveryInfo::DISCOVERED_READER ||
+                          info.status == rtps::ReaderDiscoveryInfo::CHANGED_QOS_READER);
   }
 
   void on_participant_discovery(dds::DomainParticipant*,
@@ -107,19 +99,24 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
   }
 
  private:
-  void update(const rtps::GUID_t& guid, bool alive, const std::string& topic,
-              const std::string& type, bool is_publisher, bool reliable, bool transient_local) {
+  // `data`: a WriterProxyData or a ReaderProxyData.
+  template <class ProxyData>
+  void update(const ProxyData& data, bool alive) {
     std::lock_guard lock(mutex_);
     if (!alive) {
-      endpoints_.erase(guid);
+      endpoints_.erase(data.guid());
       return;
     }
-    DiscoveredEndpoint& endpoint = endpoints_[guid];
-    endpoint.topic = ros_topic_name(topic);
-    endpoint.type = type;
-    endpoint.is_publisher = is_publisher;
-    endpoint.qos.reliability = reliable ? Reliability::Reliable : Reliability::BestEffort;
-    endpoint.qos.durability = transient_local ? Durability::TransientLocal : Durability::Volatile;
+    DiscoveredEndpoint& endpoint = endpoints_[data.guid()];
+    endpoint.topic = ros_topic_name(data.topicName().to_string());
+    endpoint.type = data.typeName().to_string();
+    endpoint.is_publisher = std::is_same_v<ProxyData, rtps::WriterProxyData>;
+    endpoint.qos.reliability = data.m_qos.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS
+                                   ? Reliability::Reliable
+                                   : Reliability::BestEffort;
+    endpoint.qos.durability = data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS
+                                  ? Durability::TransientLocal
+                                  : Durability::Volatile;
   }
 
   mutable std::mutex mutex_;

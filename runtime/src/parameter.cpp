@@ -39,6 +39,12 @@ std::string format_bound(double value) {
                                                                : fmt::format("{}", value);
 }
 
+// YAML's [] reads as an empty list of int, and fits a list of any type.
+bool is_empty_list(const ParameterValue& value) {
+  const auto* numbers = std::get_if<std::vector<int64_t>>(&value);
+  return numbers != nullptr && numbers->empty();
+}
+
 }  // namespace
 
 std::string_view to_string(ParameterType type) {
@@ -105,19 +111,8 @@ std::optional<std::string> ParameterSpec::check(const ParameterValue& value) con
   ParameterType given = type_of(value);
   bool int_for_double = (expected == ParameterType::Double && given == ParameterType::Int) ||
                         (expected == ParameterType::DoubleList && given == ParameterType::IntList);
-  // An empty YAML list carries no element type; it fits every list.
-  bool empty_list = given >= ParameterType::IntList && expected >= ParameterType::IntList &&
-                    std::visit(
-                        [](const auto& v) {
-                          if constexpr (requires { v.empty(); } &&
-                                        !std::is_same_v<std::decay_t<decltype(v)>, std::string>) {
-                            return v.empty();
-                          } else {
-                            return false;
-                          }
-                        },
-                        value);
-  if (given != expected && !int_for_double && !empty_list) {
+  bool empty_list_for_list = expected >= ParameterType::IntList && is_empty_list(value);
+  if (given != expected && !int_for_double && !empty_list_for_list) {
     return fmt::format("expects {}, got {} {}", type_description(), to_string(given),
                        to_string(value));
   }
@@ -151,26 +146,19 @@ std::optional<std::string> ParameterSpec::check(const ParameterValue& value) con
 }
 
 ParameterValue ParameterSpec::coerce(const ParameterValue& value) const {
-  ParameterType expected = type();
-  if (expected == ParameterType::Double) {
-    if (const int64_t* x = std::get_if<int64_t>(&value)) return static_cast<double>(*x);
+  const int64_t* number = std::get_if<int64_t>(&value);
+  const auto* numbers = std::get_if<std::vector<int64_t>>(&value);
+  switch (type()) {
+    case ParameterType::Double:
+      return number ? ParameterValue(static_cast<double>(*number)) : value;
+    case ParameterType::DoubleList:
+      return numbers ? ParameterValue(std::vector<double>(numbers->begin(), numbers->end()))
+                     : value;
+    case ParameterType::StringList:
+      return is_empty_list(value) ? ParameterValue(std::vector<std::string>{}) : value;
+    default:
+      return value;
   }
-  if (expected == ParameterType::DoubleList) {
-    if (const auto* xs = std::get_if<std::vector<int64_t>>(&value)) {
-      return std::vector<double>(xs->begin(), xs->end());
-    }
-  }
-  if (expected >= ParameterType::IntList && type_of(value) != expected) {
-    // An empty list of another element type.
-    ParameterValue empty = default_value;
-    std::visit(
-        [](auto& v) {
-          if constexpr (requires { v.clear(); }) v.clear();
-        },
-        empty);
-    return empty;
-  }
-  return value;
 }
 
 const ParameterValue& Parameters::find(std::string_view name) const {
