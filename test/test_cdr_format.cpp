@@ -123,6 +123,22 @@ module geometry_msgs {
   EXPECT_EQ(type->members[4].type.kind, IdlKind::UInt64);
 }
 
+TEST(IdlSchema, TruncatedTextIsAnError) {
+  for (const char* text :
+       {"module a { enum E { X", "module a { const long X = 1", "module a { struct S {"}) {
+    IdlSchema schema;
+    EXPECT_THROW(schema.parse(text), IdlError) << text;
+  }
+}
+
+TEST(CdrFormat, AStructContainingItselfIsAnError) {
+  IdlSchema schema;
+  schema.parse("module a { struct S { long x; a::S s; }; };");
+  std::vector<uint8_t> bytes(4096, 0);
+  bytes[1] = 1;
+  EXPECT_THROW(format_cdr(schema, "a::S", bytes), IdlError);
+}
+
 TEST(IdlSchema, ErrorsNameTheLine) {
   IdlSchema schema;
   try {

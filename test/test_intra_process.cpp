@@ -38,8 +38,15 @@ TEST(IntraProcess, SubscribersReceiveThePublishersPointer) {
   IntraProcessTransport transport;
   int notified = 0;
   auto publisher = transport.advertise(endpoint("/a", Qos::reliable()));
-  auto first = transport.subscribe(endpoint("/a", Qos::reliable()), [&] { ++notified; });
-  auto second = transport.subscribe(endpoint("/a", Qos::sensor_data()), [&] { ++notified; });
+  auto first = transport.subscribe(endpoint("/a", Qos::reliable()), [&](bool may_run_callbacks) {
+    EXPECT_FALSE(may_run_callbacks);  // publishing never runs subscriber code
+    ++notified;
+  });
+  auto second =
+      transport.subscribe(endpoint("/a", Qos::sensor_data()), [&](bool may_run_callbacks) {
+        EXPECT_FALSE(may_run_callbacks);  // publishing never runs subscriber code
+        ++notified;
+      });
   EXPECT_EQ(publisher->matched_subscribers(), 2u);
   auto message = numbered(1);
   publisher->publish(message, Clock::now());
@@ -53,7 +60,7 @@ TEST(IntraProcess, SubscribersReceiveThePublishersPointer) {
 TEST(IntraProcess, OtherTopicsAreSeparate) {
   IntraProcessTransport transport;
   auto publisher = transport.advertise(endpoint("/a", Qos::reliable()));
-  auto other = transport.subscribe(endpoint("/b", Qos::reliable()), [] {});
+  auto other = transport.subscribe(endpoint("/b", Qos::reliable()), [](bool) {});
   publisher->publish(numbered(1), Clock::now());
   EXPECT_EQ(take(*other), nullptr);
 }
@@ -63,7 +70,7 @@ TEST(IntraProcess, ATopicHasOneType) {
   auto publisher = transport.advertise(endpoint("/a", Qos::reliable()));
   try {
     transport.subscribe(endpoint("/a", Qos::reliable(), message_type<sensor_msgs::msg::Image>()),
-                        [] {});
+                        [](bool) {});
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
@@ -75,8 +82,9 @@ TEST(IntraProcess, ATopicHasOneType) {
 TEST(IntraProcess, ReliableSubscriberDoesNotMatchBestEffortPublisher) {
   IntraProcessTransport transport;
   auto best_effort = transport.advertise(endpoint("/a", Qos::sensor_data()));
-  auto reliable_subscriber = transport.subscribe(endpoint("/a", Qos::reliable()), [] {});
-  auto best_effort_subscriber = transport.subscribe(endpoint("/a", Qos::sensor_data()), [] {});
+  auto reliable_subscriber = transport.subscribe(endpoint("/a", Qos::reliable()), [](bool) {});
+  auto best_effort_subscriber =
+      transport.subscribe(endpoint("/a", Qos::sensor_data()), [](bool) {});
   EXPECT_EQ(best_effort->matched_subscribers(), 1u);
   best_effort->publish(numbered(1), Clock::now());
   EXPECT_EQ(take(*reliable_subscriber), nullptr);
@@ -88,7 +96,7 @@ TEST(IntraProcess, KeepLastDropsTheOldest) {
   Qos qos = Qos::sensor_data();
   qos.depth = 2;
   auto publisher = transport.advertise(endpoint("/a", Qos::sensor_data()));
-  auto subscription = transport.subscribe(endpoint("/a", qos), [] {});
+  auto subscription = transport.subscribe(endpoint("/a", qos), [](bool) {});
   for (int i = 0; i < 5; ++i) publisher->publish(numbered(i), Clock::now());
   EXPECT_EQ(number(take(*subscription)), 3);
   EXPECT_EQ(number(take(*subscription)), 4);
@@ -100,7 +108,7 @@ TEST(IntraProcess, ReliablePublisherWaitsForASubscriberThatKeepsUp) {
   Qos qos = Qos::reliable();
   qos.depth = 1;
   auto publisher = transport.advertise(endpoint("/a", qos));
-  auto subscription = transport.subscribe(endpoint("/a", qos), [] {});
+  auto subscription = transport.subscribe(endpoint("/a", qos), [](bool) {});
   constexpr int kCount = 300;
   std::thread producer([&] {
     for (int i = 0; i < kCount; ++i) publisher->publish(numbered(i), Clock::now());
@@ -118,7 +126,7 @@ TEST(IntraProcess, ReliablePublisherGivesUpOnAStalledSubscriber) {
   Qos qos = Qos::reliable();
   qos.depth = 2;
   auto publisher = transport.advertise(endpoint("/a", qos));
-  auto subscription = transport.subscribe(endpoint("/a", qos), [] {});
+  auto subscription = transport.subscribe(endpoint("/a", qos), [](bool) {});
   for (int i = 0; i < 3; ++i)
     publisher->publish(numbered(i), Clock::now());  // the 3rd waits, drops
   EXPECT_EQ(number(take(*subscription)), 0);
@@ -134,15 +142,18 @@ TEST(IntraProcess, LatchedSamplesReachLateSubscribersByPointer) {
   publisher->publish(old_message, Clock::now());
   publisher->publish(last_message, Clock::now());
   int notified = 0;
-  auto late = transport.subscribe(endpoint("/map", Qos::latched()), [&] { ++notified; });
+  auto late = transport.subscribe(endpoint("/map", Qos::latched()), [&](bool may_run_callbacks) {
+    EXPECT_FALSE(may_run_callbacks);  // publishing never runs subscriber code
+    ++notified;
+  });
   EXPECT_EQ(notified, 1);
   EXPECT_EQ(take(*late).get(), last_message.get());
   EXPECT_EQ(take(*late), nullptr);
-  auto late_volatile = transport.subscribe(endpoint("/map", Qos::reliable()), [] {});
+  auto late_volatile = transport.subscribe(endpoint("/map", Qos::reliable()), [](bool) {});
   EXPECT_EQ(take(*late_volatile), nullptr);
   // A transient-local subscriber does not match a volatile publisher.
   auto volatile_publisher = transport.advertise(endpoint("/v", Qos::reliable()));
-  auto wants_history = transport.subscribe(endpoint("/v", Qos::latched()), [] {});
+  auto wants_history = transport.subscribe(endpoint("/v", Qos::latched()), [](bool) {});
   EXPECT_EQ(volatile_publisher->matched_subscribers(), 0u);
 }
 
@@ -150,7 +161,7 @@ TEST(IntraProcess, EndpointsLeaveCleanly) {
   IntraProcessTransport transport;
   auto publisher = transport.advertise(endpoint("/a", Qos::reliable()));
   {
-    auto subscription = transport.subscribe(endpoint("/a", Qos::reliable()), [] {});
+    auto subscription = transport.subscribe(endpoint("/a", Qos::reliable()), [](bool) {});
     EXPECT_EQ(publisher->matched_subscribers(), 1u);
   }
   EXPECT_EQ(publisher->matched_subscribers(), 0u);

@@ -92,7 +92,24 @@ TEST_F(LaunchFileTest, SetOverridesAParameter) {
 
 TEST_F(LaunchFileTest, YamlSyntax) {
   EXPECT_EQ(only_problem("groups:\n  - name: a\n    components: [\n"),
-            "launch.yaml:4:1: YAML syntax error: end of sequence flow not found");
+            "launch.yaml:4:1: YAML error: end of sequence flow not found");
+}
+
+TEST_F(LaunchFileTest, OddValuesAreProblemsNotCrashes) {
+  auto list = problems(R"(groups:
+  - name: g
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {period_s: 1e400, [count]: 3}
+        remap: {[a]: /b}
+)");
+  ASSERT_EQ(list.size(), 3u) << ::testing::PrintToString(list);
+  EXPECT_EQ(list[0], "launch.yaml:6: a key in 'parameters' is not a name");
+  EXPECT_EQ(list[1],
+            "launch.yaml:6: component 'source': parameter 'period_s' has number 1e400 is "
+            "out of range");
+  EXPECT_EQ(list[2], "launch.yaml:7: a key in 'remap' is not a name");
 }
 
 TEST_F(LaunchFileTest, MissingFile) {

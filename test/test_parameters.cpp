@@ -75,6 +75,7 @@ TEST(ParameterSpec, ChecksRangesOfNumbersAndListElements) {
   EXPECT_FALSE(declared(0.5, 0.0, 1.0).check(1.0));
   EXPECT_EQ(*declared(0.5, 0.0, 1.0).check(1.5), "expects double in [0, 1], got 1.5");
   EXPECT_TRUE(declared(0.5, 0.0, 1.0).check(NAN));
+  EXPECT_FALSE(declared(0.5).check(NAN));
   EXPECT_EQ(*declared(int64_t{5}, 1).check(int64_t{0}), "expects int >= 1, got 0");
   EXPECT_EQ(*declared(std::vector<double>{}, 0.0).check(std::vector<double>{1, -2}),
             "expects list of double >= 0, got [1.0, -2.0] (element -2.0)");

@@ -32,8 +32,8 @@ class TempDir {
 void write_file(const std::filesystem::path& path, std::string_view text);
 std::string read_file(const std::filesystem::path& path);
 
-// A DDS domain no other test of this run uses at the same time: each test passes its own
-// `slot` (0..99); the process id spreads concurrent runs of the suite.
+// The DDS domain of a test: each test that talks DDS passes its own `slot` (0..99), so tests
+// running at the same time never see each other's topics.
 int test_domain(int slot);
 
 // A child process whose stdout and stderr go to a file. Killed (SIGKILL) if still running

@@ -118,6 +118,7 @@ class Formatter {
 
   // One "name: value" line per member, nested structs indented below their name.
   void block(const IdlStruct& type, int indent, std::string& out) {
+    Nesting nesting(depth_);
     for (const IdlMember& member : type.members) {
       std::string pad(static_cast<size_t>(indent), ' ');
       if (member.type.kind == IdlKind::Struct && member.type.array.empty()) {
@@ -171,12 +172,28 @@ class Formatter {
   // Reads the length of a sequence, or computes that of an array.
   size_t element_count(const IdlType& type) {
     if (!type.array.empty()) {
-      size_t count = 1;
-      for (uint32_t d : type.array) count *= d;
-      return count;
+      uint64_t count = 1;
+      for (uint32_t d : type.array) {
+        count *= d;
+        if (count > (uint64_t(1) << 32)) throw IdlError("an array with more than 2^32 elements");
+      }
+      return static_cast<size_t>(count);
     }
     return cursor_.length();
   }
+
+  // Counts struct nesting: a struct that contains itself would recurse without end.
+  class Nesting {
+   public:
+    explicit Nesting(int& depth) : depth_(depth) {
+      if (++depth_ > kMaxNesting) throw IdlError("structs nested deeper than 100 levels");
+    }
+    ~Nesting() { --depth_; }
+
+   private:
+    static constexpr int kMaxNesting = 100;
+    int& depth_;
+  };
 
   std::string inline_value(const IdlType& type) {
     if (!type.array.empty() || type.kind == IdlKind::Sequence) {
@@ -227,6 +244,7 @@ class Formatter {
       case IdlKind::String:
         return quote(cursor_.string());
       case IdlKind::Struct: {
+        Nesting nesting(depth_);
         const IdlStruct& s = structure(type.name);
         std::string out = "{";
         for (size_t i = 0; i < s.members.size(); ++i) {
@@ -243,6 +261,7 @@ class Formatter {
   const IdlSchema& schema_;
   Cursor& cursor_;
   const CdrFormatOptions& options_;
+  int depth_ = 0;
 };
 
 }  // namespace

@@ -166,6 +166,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
   ~ComponentContext() override {
     for (const auto& timer : timers_) host_.timers.remove(timer.get());
     // Transport endpoints go first, so that nothing notifies the strand once it is gone.
+    strand_.clear();
     publishers_.clear();
     waitables_.clear();
   }
@@ -192,10 +193,10 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     auto subscription = std::make_shared<HostSubscription>("subscription to " + endpoint.topic,
                                                            std::move(callback));
     for (auto& transport : host_.transports) {
-      auto on_data = transport->calls_on_own_threads()
-                         ? std::function<void()>([strand = &strand_] { strand->dispatch(); })
-                         : std::function<void()>([strand = &strand_] { strand->notify(); });
-      subscription->sources_.push_back(transport->subscribe(endpoint, std::move(on_data)));
+      subscription->sources_.push_back(
+          transport->subscribe(endpoint, [strand = &strand_](bool may_run_callbacks) {
+            may_run_callbacks ? strand->dispatch() : strand->notify();
+          }));
     }
     waitables_.push_back(subscription);
     strand_.add(subscription);

@@ -57,6 +57,10 @@ void ComponentSpec::add_topic(TopicSpec topic) {
   if (!topic.topic.starts_with('/')) {
     throw std::logic_error(fmt::format("topic '{}' must start with '/'", topic.topic));
   }
+  if (topic.qos.depth < 1) {
+    throw std::logic_error(fmt::format("topic '{}' has QoS depth {}; it must be at least 1",
+                                       topic.topic, topic.qos.depth));
+  }
   topics_.push_back(std::move(topic));
 }
 

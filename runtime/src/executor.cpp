@@ -74,10 +74,6 @@ void Executor::work() {
 
 void Strand::add(std::shared_ptr<Waitable> waitable) { waitables_.push_back(std::move(waitable)); }
 
-void Strand::remove(const Waitable* waitable) {
-  std::erase_if(waitables_, [&](const auto& w) { return w.get() == waitable; });
-}
-
 void Strand::notify() {
   pending_.store(true);
   if (enabled_.load() && !scheduled_.exchange(true)) executor_.schedule(this);

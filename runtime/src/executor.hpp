@@ -89,7 +89,8 @@ class Strand {
 
   // Not thread-safe against run(): call while the strand cannot run, or from its callbacks.
   void add(std::shared_ptr<Waitable> waitable);
-  void remove(const Waitable* waitable);
+  // Lets go of every waitable; for the owner's destruction.
+  void clear() { waitables_.clear(); }
   // Thread-safe; called by transports and timers when a waitable may have work.
   void notify();
   // For transports that call from threads of their own (DDS listeners): runs the ready
@@ -122,7 +123,9 @@ class Strand {
   std::atomic<bool> scheduled_{false};
   std::atomic<bool> pending_{false};
   std::atomic<uint64_t> callback_errors_{0};
-  std::atomic<int64_t> mean_callback_ns_{0};  // moving average over about 16 callbacks
+  // Moving average over about 16 callbacks; starts slow, so that a component's callbacks
+  // run on a transport's thread only once they have shown to be quick.
+  std::atomic<int64_t> mean_callback_ns_{2 * kQuickCallbackNanoseconds};
 };
 
 }  // namespace mocap

@@ -37,6 +37,11 @@ rtps::GuidPrefix_t prefix_of(const rtps::InstanceHandle_t& handle) {
   return guid.guidPrefix;
 }
 
+// Set while this thread is inside one of our own DDS writes. Fast DDS hands a sample to the
+// readers of the writer's own participant synchronously, on the writing thread; those
+// notifications must not run subscriber code inside the publisher's publish().
+thread_local bool writing = false;
+
 Clock::time_point to_time_point(const rtps::Time_t& time) {
   return Clock::time_point(std::chrono::duration_cast<Clock::duration>(
       std::chrono::seconds(time.seconds()) + std::chrono::nanoseconds(time.nanosec())));
@@ -126,6 +131,42 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
 
 // ---------------------------------------------------------------------------------------
 
+// Message objects for a reader to deserialize into. An object comes back when its last user
+// lets go of it: deserializing into a used object keeps its buffers, so large messages cost
+// no allocation and no page faults each.
+class FastDdsTransport::MessagePool : public std::enable_shared_from_this<MessagePool> {
+ public:
+  explicit MessagePool(const MessageType& type) : type_(type) {}
+
+  std::shared_ptr<void> get() {
+    std::shared_ptr<void> object;
+    {
+      std::lock_guard lock(mutex_);
+      if (!free_.empty()) {
+        object = std::move(free_.back());
+        free_.pop_back();
+      }
+    }
+    if (object == nullptr) object = type_.create();
+    void* raw = object.get();
+    return std::shared_ptr<void>(
+        raw, [pool = shared_from_this(), object](void*) mutable { pool->put(std::move(object)); });
+  }
+
+ private:
+  void put(std::shared_ptr<void> object) {
+    std::lock_guard lock(mutex_);
+    if (free_.size() < kKept) free_.push_back(std::move(object));
+  }
+
+  static constexpr size_t kKept = 4;
+  const MessageType& type_;
+  std::mutex mutex_;
+  std::vector<std::shared_ptr<void>> free_;
+};
+
+// ---------------------------------------------------------------------------------------
+
 class FastDdsTransport::Writer final : public TransportPublisher, public dds::DataWriterListener {
  public:
   Writer(FastDdsTransport& transport, const Endpoint& endpoint)
@@ -159,8 +200,8 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
     if (remote_readers_.load() == 0 && endpoint_.qos.durability == Durability::Volatile) return;
     auto result = write(message.get());
     if (result == ReturnCode_t::RETCODE_TIMEOUT) {
-      drops_.count(1, fmt::format("a reliable subscriber in another process is {} samples behind "
-                                  "and did not catch up within {} ms",
+      drops_.count(1, fmt::format("a reliable DDS subscriber is {} samples behind and did not "
+                                  "catch up within {} ms",
                                   endpoint_.qos.depth, kReliableBlockingMilliseconds));
     } else if (result != ReturnCode_t::RETCODE_OK) {
       drops_.count(1, fmt::format("DDS write failed (code {})", result()));
@@ -178,12 +219,14 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   ReturnCode_t write(const void* message) {
     auto deadline =
         std::chrono::steady_clock::now() + std::chrono::milliseconds(kReliableBlockingMilliseconds);
-    for (;;) {
-      auto result = writer_->write(const_cast<void*>(message), dds::HANDLE_NIL);
-      if (result != ReturnCode_t::RETCODE_TIMEOUT || std::chrono::steady_clock::now() >= deadline) {
-        return result;
-      }
-    }
+    writing = true;
+    ReturnCode_t result;
+    do {
+      result = writer_->write(const_cast<void*>(message), dds::HANDLE_NIL);
+    } while (result == ReturnCode_t::RETCODE_TIMEOUT &&
+             std::chrono::steady_clock::now() < deadline);
+    writing = false;
+    return result;
   }
 
   void on_publication_matched(dds::DataWriter*,
@@ -218,10 +261,11 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
 class FastDdsTransport::Reader final : public TransportSubscription,
                                        public dds::DataReaderListener {
  public:
-  Reader(FastDdsTransport& transport, const Endpoint& endpoint, std::function<void()> on_data)
+  Reader(FastDdsTransport& transport, const Endpoint& endpoint, DataNotification on_data)
       : transport_(transport),
         endpoint_(endpoint),
         on_data_(std::move(on_data)),
+        pool_(std::make_shared<MessagePool>(*endpoint.type)),
         own_prefix_(transport.participant_->guid().guidPrefix),
         drops_(endpoint, "subscriber") {
     const TopicUse& use = transport.acquire_topic(endpoint);
@@ -254,7 +298,7 @@ class FastDdsTransport::Reader final : public TransportSubscription,
         if (reader_->get_first_untaken_info(&info) != ReturnCode_t::RETCODE_OK) return false;
         sample.skip = is_own(info);
       }
-      if (!sample.skip) sample.message = reusable_message();
+      if (!sample.skip) sample.message = pool_->get();
       if (reader_->take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return false;
       // A sample can arrive between peeking and taking; judge what was actually taken.
       if (!info.valid_data || is_own(info)) continue;
@@ -264,8 +308,6 @@ class FastDdsTransport::Reader final : public TransportSubscription,
       }
       if (sample.malformed) {
         drops_.count(1, "malformed serialized data");
-        sample.message = nullptr;  // not back to the pool: it may be half-written
-        std::erase_if(pool_, [](const auto& m) { return m.use_count() == 1; });
         continue;
       }
       out.message = std::move(sample.message);
@@ -274,7 +316,7 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     }
   }
 
-  void on_data_available(dds::DataReader*) override { on_data_(); }
+  void on_data_available(dds::DataReader*) override { on_data_(!writing); }
 
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override {
     drops_.count(static_cast<uint64_t>(status.total_count_change), "lost in transit (best effort)");
@@ -302,24 +344,10 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     return info.sample_identity.writer_guid().guidPrefix == own_prefix_;
   }
 
-  // A message object no subscriber holds any more, or a new one. Deserializing into a used
-  // object keeps its buffers: no allocation and no page faults for each image.
-  std::shared_ptr<void> reusable_message() {
-    for (const auto& message : pool_) {
-      // Only the pool holds it, so no other thread can take a new reference meanwhile.
-      if (message.use_count() == 1) return message;
-    }
-    auto message = endpoint_.type->create();
-    if (pool_.size() < kPoolSize) pool_.push_back(message);
-    return message;
-  }
-
-  static constexpr size_t kPoolSize = 4;
-  std::vector<std::shared_ptr<void>> pool_;
-
   FastDdsTransport& transport_;
   Endpoint endpoint_;
-  std::function<void()> on_data_;
+  DataNotification on_data_;
+  std::shared_ptr<MessagePool> pool_;
   rtps::GuidPrefix_t own_prefix_;
   DropReport drops_;
   dds::Topic* topic_ = nullptr;
@@ -359,7 +387,7 @@ std::unique_ptr<TransportPublisher> FastDdsTransport::advertise(const Endpoint& 
 }
 
 std::unique_ptr<TransportSubscription> FastDdsTransport::subscribe(const Endpoint& endpoint,
-                                                                   std::function<void()> on_data) {
+                                                                   DataNotification on_data) {
   return std::make_unique<Reader>(*this, endpoint, std::move(on_data));
 }
 

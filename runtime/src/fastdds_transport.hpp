@@ -44,14 +44,14 @@ class FastDdsTransport final : public Transport {
 
   std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) override;
   std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
-                                                   std::function<void()> on_data) override;
-  bool calls_on_own_threads() const override { return true; }
+                                                   DataNotification on_data) override;
 
   int domain_id() const { return domain_id_; }
   // Endpoints of other participants seen so far (alive ones only).
   std::vector<DiscoveredEndpoint> discovered_endpoints() const;
 
   class Listener;  // discovery
+  class MessagePool;
   class Writer;
   class Reader;
 

@@ -78,6 +78,12 @@ bool start(Child& child) {
     close(out[1]);
     return false;
   }
+  // Everything the child needs is made before fork(): between fork() and exec() only
+  // async-signal-safe calls are allowed, since other threads may hold the allocator's locks.
+  std::vector<char*> argv;
+  for (const std::string& arg : child.spec->argv) argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
+  std::string exec_failed = fmt::format("cannot run {}\n", child.spec->argv.front());
   pid_t parent = getpid();
   pid_t pid = fork();
   if (pid < 0) return false;
@@ -89,11 +95,9 @@ bool start(Child& child) {
     if (getppid() != parent) _exit(127);
     dup2(out[1], STDOUT_FILENO);
     dup2(err[1], STDERR_FILENO);
-    std::vector<char*> argv;
-    for (const std::string& arg : child.spec->argv) argv.push_back(const_cast<char*>(arg.c_str()));
-    argv.push_back(nullptr);
     execv(argv[0], argv.data());
-    fmt::print(stderr, "cannot run {}: {}\n", argv[0], std::strerror(errno));
+    [[maybe_unused]] ssize_t ignored =
+        ::write(STDERR_FILENO, exec_failed.data(), exec_failed.size());
     _exit(127);
   }
   close(out[1]);

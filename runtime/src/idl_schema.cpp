@@ -126,10 +126,10 @@ class IdlParser {
         std::string name = identifier();
         schema_.enums_[qualified(name)] = 0;
         expect("{");
-        while (peek() != "}") ++pos_;
+        skip_to("}");
         expect("}");
       } else if (word == "const") {
-        while (peek() != ";") ++pos_;
+        skip_to(";");
       } else {
         fail(fmt::format("unsupported IDL construct '{}'", word));
       }
@@ -144,6 +144,7 @@ class IdlParser {
     expect("{");
     IdlStruct result{name, {}};
     while (peek() != "}") {
+      if (pos_ >= tokens_.size()) fail("expected '}' before the end");
       skip_annotations();
       IdlType type = type_spec();
       for (;;) {
@@ -229,6 +230,13 @@ class IdlParser {
       expect("]");
     }
     return dims;
+  }
+
+  void skip_to(std::string_view token) {
+    while (peek() != token) {
+      if (pos_ >= tokens_.size()) fail(fmt::format("expected '{}' before the end", token));
+      ++pos_;
+    }
   }
 
   void skip_annotations() {

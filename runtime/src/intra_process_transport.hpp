@@ -2,8 +2,8 @@
 // and no serialization, with the same QoS rules as DDS (including transient local).
 #pragma once
 
-#include <deque>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <shared_mutex>
 #include <string>
@@ -17,6 +17,7 @@ class IntraProcessTransport final : public Transport {
  public:
   class Publisher;
   class Subscription;
+  class Queue;
 
   IntraProcessTransport() = default;
   ~IntraProcessTransport() override;
@@ -24,22 +25,22 @@ class IntraProcessTransport final : public Transport {
   // Throws std::invalid_argument when the topic already carries another type.
   std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) override;
   std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
-                                                   std::function<void()> on_data) override;
+                                                   DataNotification on_data) override;
 
  private:
   struct Topic {
     const MessageType* type = nullptr;
     std::string first_user;
     std::vector<Publisher*> publishers;
-    std::vector<Subscription*> subscriptions;
+    std::vector<std::shared_ptr<Queue>> subscriptions;
   };
 
   Topic& topic_for(const Endpoint& endpoint);  // requires the exclusive lock
-  void connect(Publisher& publisher, Subscription& subscription);
+  void connect(Publisher& publisher, const std::shared_ptr<Queue>& subscription);
   void remove(Publisher* publisher);
-  void remove(Subscription* subscription);
+  void remove(const std::shared_ptr<Queue>& subscription);
 
-  // Shared by publish(); exclusive while endpoints come and go.
+  // Guards the topics and who is connected to whom; never held while a publisher waits.
   std::shared_mutex mutex_;
   std::map<std::string, Topic, std::less<>> topics_;
 };

@@ -53,7 +53,11 @@ void check_keys(const YAML::Node& map, const std::optional<std::vector<std::stri
                 std::string_view what, Problems& problems) {
   std::set<std::string> seen;
   for (const auto& entry : map) {
-    std::string key = entry.first.as<std::string>();
+    if (!entry.first.IsScalar()) {
+      problems.add(entry.first, fmt::format("a key in {} is not a name", what));
+      continue;
+    }
+    std::string key = entry.first.Scalar();
     if (!seen.insert(key).second) {
       problems.add(entry.first, fmt::format("duplicate key '{}' in {}", key, what));
     } else if (allowed && std::find(allowed->begin(), allowed->end(), key) == allowed->end()) {
@@ -315,7 +319,8 @@ class Reader {
       } else {
         check_keys(parameters, std::nullopt, "'parameters'", problems_);
         for (const auto& entry : parameters) {
-          std::string key = entry.first.as<std::string>();
+          if (!entry.first.IsScalar()) continue;  // reported by check_keys
+          std::string key = entry.first.Scalar();
           try {
             component.config.parameters[key] = parameter_value_from_yaml(entry.second);
             component.parameter_lines[key] = line_of(entry.first);
@@ -354,7 +359,8 @@ class Reader {
     }
     check_keys(map, std::nullopt, fmt::format("'{}'", key), problems_);
     for (const auto& entry : map) {
-      std::string topic = entry.first.as<std::string>();
+      if (!entry.first.IsScalar()) continue;  // reported by check_keys
+      std::string topic = entry.first.Scalar();
       lines[topic] = line_of(entry.first);
       each(topic, entry.second);
     }
@@ -470,11 +476,12 @@ LaunchFile load_launch_file(const std::filesystem::path& path, PluginLoader& plu
   YAML::Node root;
   try {
     root = YAML::Load(text.str());
+    return Reader(path.string(), plugins).read(root, overrides);
   } catch (const YAML::Exception& e) {
-    throw LaunchError({fmt::format("{}:{}:{}: YAML syntax error: {}", path.string(),
-                                   e.mark.line + 1, e.mark.column + 1, e.msg)});
+    // Syntax errors, and anything else yaml-cpp refuses, with the place it names.
+    throw LaunchError({fmt::format("{}:{}:{}: YAML error: {}", path.string(), e.mark.line + 1,
+                                   e.mark.column + 1, e.msg)});
   }
-  return Reader(path.string(), plugins).read(root, overrides);
 }
 
 }  // namespace mocap

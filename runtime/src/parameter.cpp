@@ -116,9 +116,8 @@ std::optional<std::string> ParameterSpec::check(const ParameterValue& value) con
     return fmt::format("expects {}, got {} {}", type_description(), to_string(given),
                        to_string(value));
   }
-  auto out_of_range = [&](double x) {
-    return (min && x < *min) || (max && x > *max) || std::isnan(x);
-  };
+  // NaN is in no range.
+  auto out_of_range = [&](double x) { return (min && !(x >= *min)) || (max && !(x <= *max)); };
   ParameterValue coerced = coerce(value);
   if (const double* x = std::get_if<double>(&coerced); x && out_of_range(*x)) {
     return fmt::format("expects {}, got {}", type_description(), to_string(value));

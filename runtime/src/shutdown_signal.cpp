@@ -18,8 +18,10 @@ std::atomic<int> signals_received{0};
 
 void handle(int) {
   if (signals_received.fetch_add(1) >= 1) _exit(130);
+  int saved_errno = errno;  // the interrupted code may be about to read it
   char byte = 's';
   [[maybe_unused]] ssize_t ignored = write(pipe_fds[1], &byte, 1);
+  errno = saved_errno;
 }
 
 void open_pipe() {

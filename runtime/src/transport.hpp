@@ -44,15 +44,17 @@ class TransportSubscription {
   virtual bool take(ReceivedMessage& out) = 0;
 };
 
+// Called, from any thread, when a message may be ready to take. `may_run_callbacks` is true
+// only on a transport's own thread (a DDS receive thread) and never inside a publish(): the
+// subscriber's callbacks may then run right there (Strand::dispatch).
+using DataNotification = std::function<void(bool may_run_callbacks)>;
+
 class Transport {
  public:
   virtual ~Transport() = default;
   virtual std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) = 0;
-  // `on_data` may be called from any thread, whenever a message may be ready to take. When
-  // calls_on_own_threads(), only from the transport's own threads, never a publisher's.
   virtual std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
-                                                           std::function<void()> on_data) = 0;
-  virtual bool calls_on_own_threads() const { return false; }
+                                                           DataNotification on_data) = 0;
 };
 
 // Counts dropped samples of one endpoint and logs them at most every two seconds.

@@ -36,7 +36,13 @@ Scalar scalar_value(const YAML::Node& node) {
     }
     return value;
   }
-  if (std::regex_match(text, float_re)) return std::stod(text);
+  if (std::regex_match(text, float_re)) {
+    try {
+      return std::stod(text);
+    } catch (const std::out_of_range&) {
+      throw std::invalid_argument(fmt::format("number {} is out of range", text));
+    }
+  }
   if (std::regex_match(text, inf_re)) {
     return text[0] == '-' ? -INFINITY : INFINITY;
   }

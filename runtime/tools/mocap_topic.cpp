@@ -113,7 +113,7 @@ int receive(mocap::FastDdsTransport& transport, const std::string& topic,
   std::mutex mutex;
   std::condition_variable arrived;
   bool pending = false;
-  auto subscription = transport.subscribe({topic, &type, qos, "mocap_topic"}, [&] {
+  auto subscription = transport.subscribe({topic, &type, qos, "mocap_topic"}, [&](bool) {
     std::lock_guard lock(mutex);
     pending = true;
     arrived.notify_one();
