@@ -107,13 +107,18 @@ class Recorder final : public Waitable {
     });
     return true;
   }
-  // Dispatches one callback from this thread and waits for it; true if it ran right here.
+  // Dispatches one callback from this thread and waits for it to end; true if it ran here.
   bool dispatch_ran_here(Strand& strand) {
+    size_t before = ran();
     due = true;
     strand.dispatch();
-    if (!eventually([&] { return !due; })) return false;
+    if (!eventually([&] { return ran() > before; })) return false;
     std::lock_guard lock(mutex);
     return threads.back() == std::this_thread::get_id();
+  }
+  size_t ran() {
+    std::lock_guard lock(mutex);
+    return threads.size();
   }
   std::atomic<bool> due{false};
   std::atomic<std::chrono::microseconds> duration{std::chrono::microseconds(0)};
