@@ -135,26 +135,21 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
   return qos;
 }
 
-// Where each component sits, for the checks across the file.
-struct Placed {
-  const LaunchComponent* component;
-  const LaunchGroup* group;
-};
-
-void check_topics(const std::vector<Placed>& placed, Problems& problems) {
+// Checks across the whole file (every group): one type per topic, and QoS that can match.
+void check_topics(const std::vector<const LaunchComponent*>& components, Problems& problems) {
   struct Use {
     const TopicSpec* spec;
     Qos qos;
     const LaunchComponent* component;
   };
   std::map<std::string, std::vector<Use>> uses;
-  for (const Placed& p : placed) {
-    const ComponentConfig& config = p.component->config;
-    for (const TopicSpec& topic : p.component->plugin->spec.topics()) {
+  for (const LaunchComponent* component : components) {
+    const ComponentConfig& config = component->config;
+    for (const TopicSpec& topic : component->plugin->spec.topics()) {
       auto remap = config.remaps.find(topic.topic);
       auto qos = config.qos.find(topic.topic);
       uses[remap == config.remaps.end() ? topic.topic : remap->second].push_back(
-          {&topic, qos == config.qos.end() ? topic.qos : qos->second, p.component});
+          {&topic, qos == config.qos.end() ? topic.qos : qos->second, component});
     }
   }
   for (const auto& [topic, list] : uses) {
@@ -207,13 +202,16 @@ class Reader {
       for (const YAML::Node& group : groups) read_group(group);
     }
     apply(overrides);
-    std::vector<Placed> placed;
+    // With every value in place, check each component against its plugin's declaration.
+    std::vector<const LaunchComponent*> loaded;
     for (const LaunchGroup& group : result_.groups) {
       for (const LaunchComponent& component : group.components) {
-        if (component.plugin != nullptr) placed.push_back({&component, &group});
+        if (component.plugin == nullptr) continue;
+        check_component(component);
+        loaded.push_back(&component);
       }
     }
-    check_topics(placed, problems_);
+    check_topics(loaded, problems_);
     if (!problems_.empty()) throw LaunchError(problems_.take());
     return std::move(result_);
   }
@@ -266,15 +264,15 @@ class Reader {
           static_cast<int>(int_value(threads, "threads", 1, 256, problems_).value_or(0));
     }
     YAML::Node components = node["components"];
-    if (!components || !components.IsSequence() || components.size() == 0) {
+    bool has_components = components && components.IsSequence() && components.size() > 0;
+    if (!has_components) {
       problems_.add(components ? components : node,
                     fmt::format("group '{}' needs 'components', a non-empty list", group.name));
-    } else {
-      result_.groups.push_back(std::move(group));
-      for (const YAML::Node& component : components) read_component(component);
-      return;
     }
-    result_.groups.push_back(std::move(group));
+    result_.groups.push_back(std::move(group));  // read_component() adds to the last group
+    if (has_components) {
+      for (const YAML::Node& component : components) read_component(component);
+    }
   }
 
   void read_component(const YAML::Node& node) {
@@ -346,7 +344,6 @@ class Reader {
                          component.config.qos[topic] = *parsed;
                      });
     }
-    if (result_.groups.empty()) return;
     result_.groups.back().components.push_back(std::move(component));
   }
 
@@ -381,17 +378,9 @@ class Reader {
       }
       try {
         target->config.parameters[o.parameter] = parameter_value_from_yaml(YAML::Load(o.value));
-        target->parameter_lines[o.parameter] = -1;
         set_texts_[{target, o.parameter}] = o.text;
       } catch (const std::exception& e) {
         problems_.add_plain(fmt::format("--set {}: the value is not valid: {}", o.text, e.what()));
-      }
-    }
-    // With every value in place, check each component against its plugin's declaration.
-    for (LaunchGroup& group : result_.groups) {
-      for (LaunchComponent& component : group.components) {
-        if (component.plugin == nullptr) continue;
-        check_component(component);
       }
     }
   }
@@ -404,12 +393,10 @@ class Reader {
     for (const auto& [name, value] : config.parameters) {
       ComponentConfig one{config.name, {{name, value}}, {}, {}};
       for (const std::string& problem : check_component_config(spec, one)) {
-        int line = component.parameter_lines.at(name);
-        if (line < 0) {
-          problems_.add_plain(
-              fmt::format("--set {}: {}: {}", set_texts_.at({&component, name}), who, problem));
+        if (auto set = set_texts_.find({&component, name}); set != set_texts_.end()) {
+          problems_.add_plain(fmt::format("--set {}: {}: {}", set->second, who, problem));
         } else {
-          problems_.add(line, fmt::format("{}: {}", who, problem));
+          problems_.add(component.parameter_lines.at(name), fmt::format("{}: {}", who, problem));
         }
       }
     }
@@ -431,6 +418,7 @@ class Reader {
   PluginLoader& plugins_;
   LaunchFile result_;
   std::map<std::string, int> component_lines_;
+  // The --set option behind each overridden parameter.
   std::map<std::pair<const LaunchComponent*, std::string>, std::string> set_texts_;
 };
 

@@ -18,7 +18,7 @@ struct LaunchComponent {
   const LoadedPlugin* plugin = nullptr;  // null when it could not be loaded
   ComponentConfig config;
   int line = 0;  // of its name
-  // Lines of its parameter, remap and QoS keys, for messages; -1 for a --set value.
+  // Lines of its parameter, remap and QoS keys, for messages.
   std::map<std::string, int> parameter_lines;
   std::map<std::string, int> remap_lines;
   std::map<std::string, int> qos_lines;
