@@ -2,8 +2,8 @@
 # Fails, listing the files, when a C++ source is not formatted as .clang-format says.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-unformatted=$(git ls-files '*.cpp' '*.hpp' '*.h' |
-  while read -r file; do
+unformatted=$(find idl runtime components test bench \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' \) |
+  sort | while read -r file; do
     clang-format --dry-run -Werror "$file" > /dev/null 2>&1 || echo "$file"
   done)
 if [ -n "$unformatted" ]; then
