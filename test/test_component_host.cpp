@@ -6,6 +6,12 @@
 #include <mutex>
 #include <set>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
 #include <mocap/component_host.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
@@ -246,6 +252,51 @@ TEST(DomainId, TheEnvironmentOverridesTheLaunchFile) {
     }
   }
   unsetenv("MOCAP_DOMAIN_ID");
+}
+
+}  // namespace
+}  // namespace mocap
+
+#include <sys/file.h>
+
+#include "shared_memory_cleanup.hpp"
+
+namespace mocap {
+namespace {
+
+TEST(SharedMemoryCleanup, RemovesOnlyOldFilesNobodyHolds) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / ("mocap_shm_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  auto make = [&](const std::string& name, bool old) {
+    std::ofstream(dir / name) << std::string(100, 'x');
+    if (old)
+      fs::last_write_time(dir / name, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  };
+  make("fastrtps_0123456789abcdef", true);  // a dead participant's segment
+  make("fastrtps_0123456789abcdef_el", true);
+  make("fastrtps_port7411", true);  // a dead participant's port
+  make("fastrtps_port7411_el", true);
+  make("sem.fastrtps_port7411_mutex", true);
+  make("fastrtps_fedcba9876543210", true);  // alive: its lock is held
+  make("fastrtps_fedcba9876543210_el", true);
+  make("fastrtps_00000000000000aa", false);  // being created: too young to judge
+  make("fastrtps_00000000000000aa_el", false);
+  make("unrelated_el", true);
+  int held = open((dir / "fastrtps_fedcba9876543210_el").c_str(), O_RDWR);
+  ASSERT_EQ(flock(held, LOCK_EX), 0);
+
+  SharedMemoryCleanup done = remove_orphaned_shared_memory(dir);
+  close(held);
+  EXPECT_EQ(done.files, 5);
+  EXPECT_EQ(done.bytes, 500u);
+  std::set<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir)) left.insert(entry.path().filename());
+  EXPECT_EQ(left,
+            (std::set<std::string>{"fastrtps_fedcba9876543210", "fastrtps_fedcba9876543210_el",
+                                   "fastrtps_00000000000000aa", "fastrtps_00000000000000aa_el",
+                                   "unrelated_el"}));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -64,6 +64,11 @@ ChildProcess::ChildProcess(std::vector<std::string> argv,
 }
 
 ChildProcess::~ChildProcess() {
+  // SIGTERM first: a process killed outright leaves its DDS shared memory behind.
+  if (!exit_code_) {
+    kill(pid_, SIGTERM);
+    wait(std::chrono::seconds(10));
+  }
   if (!exit_code_) {
     kill(pid_, SIGKILL);
     wait(std::chrono::seconds(10));
@@ -106,11 +111,7 @@ std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
   TempDir dir;
   ChildProcess child(argv, std::move(environment), dir / "output");
   std::optional<int> code = child.wait(timeout);
-  if (!code) {
-    child.signal(SIGKILL);
-    child.wait(std::chrono::seconds(10));
-    return {-1, child.output() + "\n(timed out)"};
-  }
+  if (!code) return {-1, child.output() + "\n(timed out)"};  // the destructor stops it
   return {*code, child.output()};
 }
 

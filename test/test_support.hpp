@@ -36,8 +36,8 @@ std::string read_file(const std::filesystem::path& path);
 // running at the same time never see each other's topics.
 int test_domain(int slot);
 
-// A child process whose stdout and stderr go to a file. Killed (SIGKILL) if still running
-// when destroyed.
+// A child process whose stdout and stderr go to a file. Stopped (SIGTERM, then SIGKILL after
+// 10 s) if still running when destroyed.
 class ChildProcess {
  public:
   ChildProcess(std::vector<std::string> argv, std::map<std::string, std::string> environment,

@@ -25,6 +25,7 @@
 
 #include "fastdds_qos.hpp"
 #include "fastdds_type_adapter.hpp"
+#include "shared_memory_cleanup.hpp"
 
 namespace mocap {
 namespace dds = eprosima::fastdds::dds;
