@@ -126,30 +126,33 @@ class Recorder final : public Waitable {
   std::vector<std::thread::id> threads;
 };
 
-TEST(Executor, DispatchRunsCallbacksHereOnceTheyHaveShownToBeQuick) {
-  Executor executor(2);
-  Logger logger("test");
-  Strand strand(executor, logger);
-  auto recorder = std::make_shared<Recorder>();
-  strand.add(recorder);
-  strand.enable();
-  executor.start();
+class DispatchTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    strand.add(recorder);
+    strand.enable();
+    executor.start();
+  }
+  // Dispatches quick callbacks until the strand runs them on this thread.
+  void warm_up() {
+    int handed_over = 0;
+    while (!recorder->dispatch_ran_here(strand)) ASSERT_LT(++handed_over, 100);
+  }
+
+  Executor executor{2};
+  Logger logger{"test"};
+  Strand strand{executor, logger};
+  std::shared_ptr<Recorder> recorder = std::make_shared<Recorder>();
+};
+
+TEST_F(DispatchTest, RunsCallbacksHereOnceTheyHaveShownToBeQuick) {
   EXPECT_FALSE(recorder->dispatch_ran_here(strand));  // not known to be quick yet
-  int handed_over = 1;
-  while (!recorder->dispatch_ran_here(strand)) ASSERT_LT(++handed_over, 100);
+  warm_up();
   for (int i = 0; i < 5; ++i) EXPECT_TRUE(recorder->dispatch_ran_here(strand));
 }
 
-TEST(Executor, DispatchHandsSlowCallbacksToTheExecutor) {
-  Executor executor(2);
-  Logger logger("test");
-  Strand strand(executor, logger);
-  auto recorder = std::make_shared<Recorder>();
-  strand.add(recorder);
-  strand.enable();
-  executor.start();
-  int handed_over = 0;
-  while (!recorder->dispatch_ran_here(strand)) ASSERT_LT(++handed_over, 100);
+TEST_F(DispatchTest, HandsSlowCallbacksToTheExecutor) {
+  warm_up();
   // One slow callback still runs here; it teaches the strand that its callbacks are slow.
   recorder->duration = std::chrono::milliseconds(3);
   EXPECT_TRUE(recorder->dispatch_ran_here(strand));
@@ -157,16 +160,8 @@ TEST(Executor, DispatchHandsSlowCallbacksToTheExecutor) {
   EXPECT_FALSE(recorder->dispatch_ran_here(strand));
 }
 
-TEST(Executor, StopWaitsForACallbackRunningOnAnotherThread) {
-  Executor executor(1);
-  Logger logger("test");
-  Strand strand(executor, logger);
-  auto recorder = std::make_shared<Recorder>();
-  strand.add(recorder);
-  strand.enable();
-  executor.start();
-  int handed_over = 0;
-  while (!recorder->dispatch_ran_here(strand)) ASSERT_LT(++handed_over, 100);
+TEST_F(DispatchTest, StopWaitsForACallbackRunningOnAnotherThread) {
+  warm_up();
   recorder->duration = std::chrono::milliseconds(200);
   recorder->due = true;
   std::thread transport([&] { strand.dispatch(); });

@@ -242,8 +242,8 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
                                    const dds::OfferedIncompatibleQosStatus& status) override {
     Logger(endpoint_.owner)
         .warn(
-            "{}: a subscriber in another process requests QoS this publisher ({}) does not "
-            "offer (policy id {}); it receives nothing",
+            "{}: a DDS subscriber requests QoS this publisher ({}) does not offer (policy id "
+            "{}); it receives nothing",
             endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
   }
 
@@ -336,8 +336,8 @@ class FastDdsTransport::Reader final : public TransportSubscription,
                                      const dds::RequestedIncompatibleQosStatus& status) override {
     Logger(endpoint_.owner)
         .warn(
-            "{}: a publisher in another process does not offer the QoS this subscriber "
-            "requests ({}; policy id {}); nothing arrives from it",
+            "{}: a DDS publisher does not offer the QoS this subscriber requests ({}; policy id "
+            "{}); nothing arrives from it",
             endpoint_.topic, endpoint_.qos.to_string(), status.last_policy_id);
   }
 
