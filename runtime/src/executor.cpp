@@ -122,22 +122,21 @@ bool Strand::execute(Waitable& waitable) {
 }
 
 void Strand::run(int budget) {
-  for (;;) {
+  // Each pass drains every waitable; another pass is needed only for notifications that
+  // arrived during this one.
+  do {
     pending_.store(false);
-    bool did_work = false;
     // Index loop: a callback may add waitables to its own strand.
     for (size_t i = 0; i < waitables_.size(); ++i) {
       std::shared_ptr<Waitable> waitable = waitables_[i];
       while (execute(*waitable)) {
-        did_work = true;
         if (--budget == 0) {
           executor_.schedule(this);  // stays scheduled; other strands get the thread first
           return;
         }
       }
     }
-    if (!did_work) break;
-  }
+  } while (pending_.load());
   scheduled_.store(false);
   // A notification that raced with the last pass must not be lost.
   if (pending_.load() && !scheduled_.exchange(true)) executor_.schedule(this);
