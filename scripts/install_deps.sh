@@ -13,6 +13,8 @@ packages=(
   libyaml-cpp-dev libfmt-dev
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
+  # benchmarks: instruction counts
+  valgrind
 )
 
 missing=()
