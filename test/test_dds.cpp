@@ -19,28 +19,26 @@ std::map<std::string, std::string> environment(int slot) {
 std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
 std::string topic_tool() { return (test::bin_dir() / "mocap_topic").string(); }
 
-std::string source_yaml(const std::string& parameters, const std::string& qos = "reliable") {
+// One group holding sequence_source or sequence_sink (`role`), named after its role.
+std::string one_component_yaml(const std::string& role, const std::string& parameters,
+                               const std::string& qos) {
   return fmt::format(R"(groups:
-  - name: source
+  - name: {0}
     components:
-      - plugin: sequence_source
-        name: source
-        parameters: {{{}}}
-        qos: {{/test/sequence: {}}}
+      - plugin: sequence_{0}
+        name: {0}
+        parameters: {{{1}}}
+        qos: {{/test/sequence: {2}}}
 )",
-                     parameters, qos);
+                     role, parameters, qos);
+}
+
+std::string source_yaml(const std::string& parameters, const std::string& qos = "reliable") {
+  return one_component_yaml("source", parameters, qos);
 }
 
 std::string sink_yaml(const std::string& parameters, const std::string& qos = "reliable") {
-  return fmt::format(R"(groups:
-  - name: sink
-    components:
-      - plugin: sequence_sink
-        name: sink
-        parameters: {{{}}}
-        qos: {{/test/sequence: {}}}
-)",
-                     parameters, qos);
+  return one_component_yaml("sink", parameters, qos);
 }
 
 TEST(Dds, ARestartedSubscriberProcessReceivesAgain) {
