@@ -11,6 +11,8 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   # runtime
   libyaml-cpp-dev libfmt-dev
+  # vision: images, geometry
+  libopencv-dev libeigen3-dev
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
   # benchmarks: instruction counts

@@ -25,6 +25,15 @@ ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::max(do
   return *this;
 }
 
+ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::path() {
+  if (parameter().type() != ParameterType::String) {
+    throw std::logic_error(
+        fmt::format("parameter '{}': only a string parameter can be a path", parameter().name));
+  }
+  parameter().is_path = true;
+  return *this;
+}
+
 const ParameterSpec* ComponentSpec::find_parameter(std::string_view name) const {
   for (const ParameterSpec& p : parameters_) {
     if (p.name == name) return &p;

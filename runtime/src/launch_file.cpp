@@ -204,10 +204,11 @@ class Reader {
     apply(overrides);
     // With every value in place, check each component against its plugin's declaration.
     std::vector<const LaunchComponent*> loaded;
-    for (const LaunchGroup& group : result_.groups) {
-      for (const LaunchComponent& component : group.components) {
+    for (LaunchGroup& group : result_.groups) {
+      for (LaunchComponent& component : group.components) {
         if (component.plugin == nullptr) continue;
         check_component(component);
+        resolve_paths(component);
         loaded.push_back(&component);
       }
     }
@@ -382,6 +383,22 @@ class Reader {
       } catch (const std::exception& e) {
         problems_.add_plain(fmt::format("--set {}: the value is not valid: {}", o.text, e.what()));
       }
+    }
+  }
+
+  // Relative paths from the file are relative to the file, from --set to the working directory,
+  // so a launch file works from any directory.
+  void resolve_paths(LaunchComponent& component) {
+    namespace fs = std::filesystem;
+    for (auto& [name, value] : component.config.parameters) {
+      const ParameterSpec* spec = component.plugin->spec.find_parameter(name);
+      auto* text = std::get_if<std::string>(&value);
+      if (spec == nullptr || !spec->is_path || text == nullptr || text->empty()) continue;
+      fs::path path(*text);
+      if (path.is_absolute()) continue;
+      bool from_set = set_texts_.count({&component, name}) > 0;
+      fs::path base = from_set ? fs::current_path() : fs::absolute(result_.path).parent_path();
+      *text = (base / path).lexically_normal().string();
     }
   }
 

@@ -96,6 +96,7 @@ std::string to_string(const ParameterValue& value) {
 
 std::string ParameterSpec::type_description() const {
   std::string text(to_string(type()));
+  if (is_path) text += " (path)";
   if (min && max) {
     text += fmt::format(" in [{}, {}]", format_bound(*min), format_bound(*max));
   } else if (min) {

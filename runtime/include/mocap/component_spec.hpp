@@ -41,6 +41,8 @@ class ComponentSpec {
     ParameterDeclaration& range(double min, double max);
     ParameterDeclaration& min(double min);
     ParameterDeclaration& max(double max);
+    // The string is a file or directory path (see ParameterSpec::is_path).
+    ParameterDeclaration& path();
 
    private:
     friend class ComponentSpec;
