@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include <Eigen/SVD>
 #include <fmt/format.h>
+#include <Eigen/SVD>
 
 #include "cross_ratio.hpp"
 
@@ -85,7 +85,8 @@ double number(const std::string& cell, const std::string& source, int line, cons
 std::string read_text(const std::string& path, const char* what) {
   std::ifstream stream(path);
   if (!stream) {
-    throw DatabaseError(fmt::format("{}: cannot read the {}: {}", path, what, std::strerror(errno)));
+    throw DatabaseError(
+        fmt::format("{}: cannot read the {}: {}", path, what, std::strerror(errno)));
   }
   std::stringstream text;
   text << stream.rdbuf();
@@ -138,9 +139,8 @@ void complete(ConstellationModel& model, const std::vector<LinePattern>& pattern
     std::array<Eigen::Vector3d, 4> p;
     for (int i = 0; i < 4; ++i) {
       p[i] = raw[line.points[i]];
-      auto same = std::find_if(model.points.begin(), model.points.end(), [&](const auto& q) {
-        return (q - p[i]).norm() < kSamePointM;
-      });
+      auto same = std::find_if(model.points.begin(), model.points.end(),
+                               [&](const auto& q) { return (q - p[i]).norm() < kSamePointM; });
       if (same == model.points.end()) {
         line.points[i] = static_cast<int>(model.points.size());
         model.points.push_back(p[i]);
@@ -154,16 +154,18 @@ void complete(ConstellationModel& model, const std::vector<LinePattern>& pattern
       along[i] = direction.dot(p[i] - p[0]);
       double off = (p[i] - p[0] - along[i] * direction).norm();
       if (off > kPlanarityM) {
-        throw DatabaseError(fmt::format("{}: line '{}' is not straight (point {} is {:.1f} mm "
-                                        "off the line)",
-                                        who, line.name, i + 1, off * 1e3));
+        throw DatabaseError(
+            fmt::format("{}: line '{}' is not straight (point {} is {:.1f} mm "
+                        "off the line)",
+                        who, line.name, i + 1, off * 1e3));
       }
     }
     for (int i = 1; i < 4; ++i) {
       if (!(along[i] > along[i - 1] + kSamePointM)) {
-        throw DatabaseError(fmt::format("{}: line '{}': its points must be listed in order along "
-                                        "the line, without repeats",
-                                        who, line.name));
+        throw DatabaseError(
+            fmt::format("{}: line '{}': its points must be listed in order along "
+                        "the line, without repeats",
+                        who, line.name));
       }
     }
     line.cross_ratio = cross_ratio(along[0], along[1], along[2], along[3]);
@@ -189,8 +191,8 @@ void complete(ConstellationModel& model, const std::vector<LinePattern>& pattern
   for (const auto& p : model.points) {
     double off = std::abs(normal.dot(p - mean));
     if (off > kPlanarityM) {
-      throw DatabaseError(fmt::format("{} is not planar: a marker is {:.1f} mm off its plane", who,
-                                      off * 1e3));
+      throw DatabaseError(
+          fmt::format("{} is not planar: a marker is {:.1f} mm off its plane", who, off * 1e3));
     }
     model.plane_points.push_back(model.plane_axes.transpose() * (p - mean));
     for (const auto& q : model.points) model.size_m = std::max(model.size_m, (p - q).norm());
@@ -321,7 +323,8 @@ std::vector<ConstellationModel> parse_constellation_csv(std::string_view text,
   std::vector<ConstellationModel> models;
   size_t r = 0;
   auto expect_label = [&](const char* label, const char* form) -> const CsvRow& {
-    if (r >= rows.size()) fail(source, 0, fmt::format("the file ends where '{}' was expected", form));
+    if (r >= rows.size())
+      fail(source, 0, fmt::format("the file ends where '{}' was expected", form));
     const CsvRow& row = rows[r];
     if (row.cells[0] != label) {
       fail(source, row.line, fmt::format("expected '{}', got '{}'", form, row.cells[0]));
@@ -395,8 +398,9 @@ ConstellationDatabase parse_database_yaml(const std::string& text, const std::st
       pattern.name = yaml_name(node["name"], source, line, "a line pattern");
       YAML::Node positions = node["positions"];
       if (!positions || !positions.IsSequence() || positions.size() != 4) {
-        fail(source, line, fmt::format("line pattern '{}' needs 'positions': 4 distances in metres",
-                                       pattern.name));
+        fail(source, line,
+             fmt::format("line pattern '{}' needs 'positions': 4 distances in metres",
+                         pattern.name));
       }
       std::array<double, 4> p{};
       for (int i = 0; i < 4; ++i) p[i] = yaml_number(positions[i], source, "a position");
@@ -422,7 +426,8 @@ ConstellationDatabase parse_database_yaml(const std::string& text, const std::st
       std::string name = yaml_name(line_node["name"], source, at, "a line");
       YAML::Node points = line_node["points"];
       if (!points || !points.IsSequence() || points.size() != 4) {
-        fail(source, at, fmt::format("line '{}' needs 'points': 4 points [x, y, z] in metres", name));
+        fail(source, at,
+             fmt::format("line '{}' needs 'points': 4 points [x, y, z] in metres", name));
       }
       std::array<Eigen::Vector3d, 4> p;
       for (int i = 0; i < 4; ++i) {
@@ -457,9 +462,8 @@ ConstellationDatabase load_database(const std::string& constellations_file,
     std::vector<ConstellationModel> models = yaml.constellations();
     return ConstellationDatabase(std::move(all), std::move(models), constellations_file);
   }
-  return ConstellationDatabase(std::move(patterns),
-                               parse_constellation_csv(text, constellations_file),
-                               constellations_file);
+  return ConstellationDatabase(
+      std::move(patterns), parse_constellation_csv(text, constellations_file), constellations_file);
 }
 
 }  // namespace mocap::constellations

@@ -66,8 +66,7 @@ class ConstellationDatabase {
   // Checks and completes the models (shared points, planes, cross-ratios); throws
   // DatabaseError naming `source` when a constellation is unusable.
   ConstellationDatabase(std::vector<LinePattern> patterns,
-                        std::vector<ConstellationModel> constellations,
-                        const std::string& source);
+                        std::vector<ConstellationModel> constellations, const std::string& source);
 
   const std::vector<LinePattern>& line_patterns() const { return patterns_; }
   const std::vector<ConstellationModel>& constellations() const { return constellations_; }

@@ -14,15 +14,15 @@ Mono8View view_mono8(const sensor_msgs::msg::Image& image) {
   } else if (image.width() == 0 || image.height() == 0) {
     view.problem = fmt::format("the image is empty ({}x{})", image.width(), image.height());
   } else if (image.step() < image.width()) {
-    view.problem = fmt::format("step {} is shorter than a row of {} pixels", image.step(),
-                               image.width());
+    view.problem =
+        fmt::format("step {} is shorter than a row of {} pixels", image.step(), image.width());
   } else if (image.data().size() < static_cast<size_t>(image.step()) * image.height()) {
     view.problem = fmt::format("{} bytes of data, a {}x{} image with step {} needs {}",
                                image.data().size(), image.width(), image.height(), image.step(),
                                static_cast<size_t>(image.step()) * image.height());
   } else if (image.width() > 1u << 16 || image.height() > 1u << 16) {
-    view.problem = fmt::format("{}x{} is larger than 65536 pixels a side", image.width(),
-                               image.height());
+    view.problem =
+        fmt::format("{}x{} is larger than 65536 pixels a side", image.width(), image.height());
   } else {
     // cv::Mat does not write through a const view, but its constructor takes void*.
     view.pixels = cv::Mat(static_cast<int>(image.height()), static_cast<int>(image.width()),

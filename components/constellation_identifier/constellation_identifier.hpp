@@ -1,0 +1,88 @@
+// Names the constellations in a set of image points (seed 000 §5.9): collinear groups, then
+// lines by cross-ratio, then boards from lines that fit one plane.
+//
+//   ConstellationIdentifier identifier(database, options);
+//   for (const IdentifiedConstellation& found : identifier.identify(points)) ...
+//
+// Done better than the seed: every line of every constellation is looked for in both point
+// orders; a constellation needs `min_lines` of its lines, at the database's shared points and
+// on one plane (a homography from its plane to the image fits every point within
+// `max_fit_error_px`), so chance alignments of distractors are rejected before the pose; and
+// all constellations in view are reported, each image point used by one at most.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "constellation_database.hpp"
+#include "line_search.hpp"
+
+namespace mocap::constellations {
+
+struct IdentifierOptions {
+  LineSearchOptions line_search;
+  // Largest relative difference between a measured and a database cross-ratio (seed eq. 8).
+  // The seed used 0.20 with errors below 0.05; a tighter value tells more line types apart.
+  double cross_ratio_tolerance = 0.03;
+  // Fewest lines of a constellation that identify it; capped at its number of lines. With the
+  // shipped database three lines name a board uniquely.
+  int min_lines = 3;
+  // Largest distance, pixels, of an identified point from where the plane-to-image
+  // homography of all identified points puts it.
+  double max_fit_error_px = 3.0;
+  // A line's four points are taken from at most this many consecutive points of a group, so
+  // a group holding several boards' sides yields a handful of candidates, not C(n, 4).
+  int candidate_window = 6;
+};
+
+struct IdentifiedLine {
+  int model_line = 0;                 // index into ConstellationModel::lines
+  std::array<int, 4> image_points{};  // image point indices in the model's order A..D
+  double cross_ratio = 0;             // as measured
+};
+
+struct IdentifiedConstellation {
+  const ConstellationModel* model = nullptr;
+  std::vector<IdentifiedLine> lines;  // in the model's line order
+  std::vector<int> image_point_of;    // per model point: image point index, or -1 if unseen
+  double fit_rms_px = 0;              // of the plane-to-image homography over all points
+  double fit_max_px = 0;
+  int points_identified() const;
+};
+
+struct IdentificationStats {
+  size_t groups = 0;           // collinear groups of >= 4 points
+  size_t candidates = 0;       // four-point candidates measured
+  size_t matched = 0;          // candidates whose cross-ratio matched a line type
+  size_t rejected_by_fit = 0;  // constellations found by lines but rejected by the plane fit
+  size_t conflicts = 0;        // constellations dropped because a better one took their points
+};
+
+class ConstellationIdentifier {
+ public:
+  // Keeps a reference to `database`, which must outlive the identifier.
+  explicit ConstellationIdentifier(const ConstellationDatabase& database,
+                                   IdentifierOptions options = {});
+
+  // `points` in pixels, free of lens distortion (lines must be straight for the cross-ratio
+  // to hold). Non-finite points are ignored.
+  std::vector<IdentifiedConstellation> identify(const std::vector<Eigen::Vector2d>& points,
+                                                IdentificationStats* stats = nullptr) const;
+
+  const IdentifierOptions& options() const { return options_; }
+
+ private:
+  struct LineType {
+    std::string name;
+    double cross_ratio;
+  };
+  const ConstellationDatabase& database_;
+  IdentifierOptions options_;
+  std::vector<LineType> line_types_;
+  // Per constellation, per line: index into line_types_.
+  std::vector<std::vector<int>> line_type_of_;
+};
+
+}  // namespace mocap::constellations
