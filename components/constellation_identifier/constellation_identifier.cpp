@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include "cross_ratio.hpp"
 #include "plane_homography.hpp"
@@ -69,27 +71,51 @@ class ConstellationSearch {
         options_(options),
         min_lines_(std::min<int>(options.min_lines, static_cast<int>(model.lines.size()))),
         image_of_(model.points.size(), -1),
-        chosen_(model.lines.size()) {}
+        chosen_(model.lines.size()),
+        choices_(model.lines.size()),
+        at_position_(model.lines.size()) {}
 
   std::optional<IdentifiedConstellation> search(IdentificationStats& stats) {
     stats_ = &stats;
     const size_t lines = model_.lines.size();
-    if (lines == 1) {
-      for (const Choice& first : choices(0)) try_seed({{0, first}});
+    for (size_t line = 0; line < lines; ++line) {
+      for (const Candidate& candidate : by_type_[type_of_line_[line]]) {
+        choices_[line].push_back({&candidate, false});
+        choices_[line].push_back({&candidate, true});
+      }
+      for (int k = 0; k < 4; ++k) {
+        auto& index = at_position_[line][k];
+        for (size_t c = 0; c < choices_[line].size(); ++c) {
+          index.emplace_back(choices_[line][c].image_point(k), static_cast<int>(c));
+        }
+        std::sort(index.begin(), index.end());
+      }
     }
-    // Seeds from linked pairs first; pairs without a shared marker only when the model has
-    // no linked pair at all (two separate lines leave the homography underdetermined).
+    if (lines == 1) {
+      for (const Choice& first : choices_[0]) {
+        if (!assign(0, first)) continue;
+        extend_and_evaluate();
+        release(0);
+      }
+    }
+    // Seeds from linked pairs; pairs without a shared marker only when the model has no
+    // linked pair at all (two separate lines leave the homography underdetermined).
     bool linked = false;
     for (size_t a = 0; a < lines; ++a) {
       for (size_t b = a + 1; b < lines; ++b) linked = linked || shared_marker(a, b);
     }
-    for (size_t a = 0; a < lines && best_count_ < static_cast<int>(lines); ++a) {
+    for (size_t a = 0; a < lines && !complete_; ++a) {
       for (size_t b = a + 1; b < lines; ++b) {
-        if (linked && !shared_marker(a, b)) continue;
-        for (const Choice& first : choices(a)) {
+        auto shared = shared_marker(a, b);
+        if (linked && !shared) continue;
+        for (size_t f = 0; f < choices_[a].size() && !complete_; ++f) {
+          const Choice& first = choices_[a][f];
           if (!assign(a, first)) continue;
-          for (const Choice& second : choices(b)) {
-            if (!assign(b, second)) continue;
+          IndexRange seconds{at_position_[b][0].begin(), at_position_[b][0].end()};
+          if (shared)
+            seconds = choices_holding(b, shared->second, first.image_point(shared->first));
+          for (auto it = seconds.first; it != seconds.second && !complete_; ++it) {
+            if (!assign(b, choices_[b][it->second])) continue;
             extend_and_evaluate();
             release(b);
           }
@@ -114,30 +140,25 @@ class ConstellationSearch {
     int image_point(int k) const { return candidate->points[reversed ? 3 - k : k]; }
   };
 
-  std::vector<Choice> choices(size_t line) const {
-    std::vector<Choice> out;
-    for (const Candidate& candidate : by_type_[type_of_line_[line]]) {
-      out.push_back({&candidate, false});
-      out.push_back({&candidate, true});
-    }
-    return out;
+  // The choices for `line` whose image point at position k is `point`, from a sorted index,
+  // so that linked lines are found in logarithmic time rather than by a scan.
+  using IndexRange = std::pair<std::vector<std::pair<int, int>>::const_iterator,
+                               std::vector<std::pair<int, int>>::const_iterator>;
+  IndexRange choices_holding(size_t line, int k, int point) const {
+    const auto& index = at_position_[line][k];
+    return {std::lower_bound(index.begin(), index.end(), std::make_pair(point, -1)),
+            std::upper_bound(index.begin(), index.end(),
+                             std::make_pair(point, std::numeric_limits<int>::max()))};
   }
 
-  bool shared_marker(size_t a, size_t b) const {
-    for (int p : model_.lines[a].points) {
-      for (int q : model_.lines[b].points) {
-        if (p == q) return true;
+  // Positions (in line a, in line b) of a marker both lines hold, if any.
+  std::optional<std::pair<int, int>> shared_marker(size_t a, size_t b) const {
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        if (model_.lines[a].points[i] == model_.lines[b].points[j]) return std::make_pair(i, j);
       }
     }
-    return false;
-  }
-
-  void try_seed(std::initializer_list<std::pair<size_t, Choice>> seed) {
-    for (const auto& [line, choice] : seed) {
-      if (!assign(line, choice)) return;
-    }
-    extend_and_evaluate();
-    for (const auto& [line, choice] : seed) release(line);
+    return std::nullopt;
   }
 
   // Maps a line's markers to a choice's image points, unless that contradicts a marker
@@ -171,34 +192,51 @@ class ConstellationSearch {
     }
   }
 
+  // Adds every other line whose candidate lies where the plane of the lines chosen so far
+  // puts it, then scores the whole.
   void extend_and_evaluate() {
-    auto fit = plane_fit(model_, image_of_, points_);
-    if (!fit || fit->max > options_.max_fit_error_px) {
-      ++stats_->rejected_by_fit;
-      return;
-    }
     std::vector<size_t> added;
+    std::optional<Eigen::Matrix3d> h;
+    bool stale = true;
     for (size_t line = 0; line < model_.lines.size(); ++line) {
       if (chosen_[line].candidate != nullptr) continue;
-      auto h = plane_homography(model_, image_of_, points_);
-      if (!h) break;
-      // The candidate whose points lie closest to where the plane puts this line.
       const ConstellationLine& model_line = model_.lines[line];
+      // A marker of this line already placed narrows the choices to those holding it.
+      IndexRange range{at_position_[line][0].begin(), at_position_[line][0].end()};
+      for (int k = 0; k < 4; ++k) {
+        if (image_of_[model_line.points[k]] >= 0) {
+          range = choices_holding(line, k, image_of_[model_line.points[k]]);
+          break;
+        }
+      }
+      if (range.first == range.second) continue;
+      if (stale) {
+        h = plane_homography(model_, image_of_, points_);
+        stale = false;
+      }
+      if (!h) break;
+      std::array<Eigen::Vector2d, 4> predicted;
+      for (int k = 0; k < 4; ++k) {
+        predicted[k] = apply_homography(*h, model_.plane_points[model_line.points[k]]);
+      }
+      // The candidate whose points lie closest to where the plane puts this line.
       double best_error = options_.max_fit_error_px;
-      std::optional<Choice> best;
-      for (const Choice& choice : choices(line)) {
+      const Choice* best = nullptr;
+      for (auto it = range.first; it != range.second; ++it) {
+        const Choice& choice = choices_[line][it->second];
         double error = 0;
         for (int k = 0; k < 4 && error <= best_error; ++k) {
-          Eigen::Vector2d predicted =
-              apply_homography(*h, model_.plane_points[model_line.points[k]]);
-          error = std::max(error, (predicted - points_[choice.image_point(k)]).norm());
+          error = std::max(error, (predicted[k] - points_[choice.image_point(k)]).norm());
         }
         if (error <= best_error) {
           best_error = error;
-          best = choice;
+          best = &choice;
         }
       }
-      if (best && assign(line, *best)) added.push_back(line);
+      if (best != nullptr && assign(line, *best)) {
+        added.push_back(line);
+        stale = true;
+      }
     }
     evaluate();
     for (auto it = added.rbegin(); it != added.rend(); ++it) release(*it);
@@ -214,6 +252,8 @@ class ConstellationSearch {
       return;
     }
     if (count == best_count_ && fit->rms >= best_fit_.rms) return;
+    // Every line found and on one plane: another seed would find the same points.
+    complete_ = count == static_cast<int>(model_.lines.size());
     best_count_ = count;
     best_fit_ = *fit;
     best_image_of_ = image_of_;
@@ -237,7 +277,11 @@ class ConstellationSearch {
   IdentificationStats* stats_ = nullptr;
   std::vector<int> image_of_;
   std::vector<Choice> chosen_;
+  std::vector<std::vector<Choice>> choices_;  // per line: every candidate, both directions
+  // Per line, per position k: (image point at k, index into choices_), sorted.
+  std::vector<std::array<std::vector<std::pair<int, int>>, 4>> at_position_;
   int best_count_ = 0;
+  bool complete_ = false;
   Fit best_fit_;
   std::vector<int> best_image_of_;
   std::vector<IdentifiedLine> best_lines_;

@@ -1,5 +1,6 @@
 #include "planar_pose.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -63,14 +64,15 @@ Refined refine(const calibration::CameraModel& camera, Eigen::Isometry3d pose,
   double lambda = 1e-3;
   Eigen::MatrixXd jacobian(current.values.size(), 6);
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    // Forward differences while iterating (half the projections); the covariance below
+    // uses central ones.
     for (int k = 0; k < 6; ++k) {
-      double h = k < 3 ? 1e-6 * std::max(1.0, pose.translation().norm()) : 1e-6;
+      double h = k < 3 ? 1e-7 * std::max(1.0, pose.translation().norm()) : 1e-7;
       Vector6d step = Vector6d::Zero();
       step(k) = h;
       Residuals plus = residuals(camera, perturbed(pose, step), object, pixels);
-      Residuals minus = residuals(camera, perturbed(pose, -step), object, pixels);
-      if (!plus.valid || !minus.valid) return out;
-      jacobian.col(k) = (plus.values - minus.values) / (2 * h);
+      if (!plus.valid) return out;
+      jacobian.col(k) = (plus.values - current.values) / h;
     }
     Matrix6d jtj = jacobian.transpose() * jacobian;
     Vector6d jtr = jacobian.transpose() * current.values;
@@ -167,7 +169,9 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
     result.rejection = fmt::format("IPPE failed: {}", e.what());
     return result;
   }
-  Refined best;
+  // IPPE's two poses, best first by their pixel error; the second is refined too only when
+  // it is nearly as good (a distant or fronto-parallel plane), since refinement may swap them.
+  std::vector<std::pair<double, Eigen::Isometry3d>> starts;
   for (size_t s = 0; s < rotations.size(); ++s) {
     cv::Mat r;
     cv::Rodrigues(rotations[s], r);
@@ -176,8 +180,16 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
       for (int j = 0; j < 3; ++j) camera_from_plane.linear()(i, j) = r.at<double>(i, j);
       camera_from_plane.translation()(i) = translations[s].at<double>(i);
     }
-    Refined refined = refine(camera, camera_from_plane * plane_from_object, object, image,
-                             options.max_iterations);
+    Eigen::Isometry3d start = camera_from_plane * plane_from_object;
+    Residuals r0 = residuals(camera, start, object, image);
+    if (r0.valid) starts.emplace_back(r0.values.norm(), start);
+  }
+  std::sort(starts.begin(), starts.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  Refined best;
+  for (size_t s = 0; s < starts.size(); ++s) {
+    if (s > 0 && starts[s].first > 3 * starts[0].first + 1.0) break;
+    Refined refined = refine(camera, starts[s].second, object, image, options.max_iterations);
     if (refined.valid && (!best.valid || refined.rms < best.rms)) best = refined;
   }
   if (!best.valid) {

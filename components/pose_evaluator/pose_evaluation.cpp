@@ -1,0 +1,117 @@
+#include "pose_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mocap::evaluation {
+namespace {
+
+double angle_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  Eigen::Quaterniond qa(a.linear()), qb(b.linear());
+  double dot = std::clamp(std::abs(qa.normalized().dot(qb.normalized())), 0.0, 1.0);
+  return 2 * std::acos(dot) * 180 / M_PI;  // seed eq. 10
+}
+
+void merge(EvaluationSummary& into, const EvaluationSummary& from) {
+  into.frames += from.frames;
+  into.frames_lost += from.frames_lost;
+  into.expected += from.expected;
+  into.tracked += from.tracked;
+  into.false_identifications += from.false_identifications;
+  into.position_errors_m.insert(into.position_errors_m.end(), from.position_errors_m.begin(),
+                                from.position_errors_m.end());
+  into.orientation_errors_deg.insert(into.orientation_errors_deg.end(),
+                                     from.orientation_errors_deg.begin(),
+                                     from.orientation_errors_deg.end());
+}
+
+}  // namespace
+
+double EvaluationSummary::tracked_percent() const {
+  return expected == 0 ? std::numeric_limits<double>::quiet_NaN() : 100.0 * tracked / expected;
+}
+
+double EvaluationSummary::quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  size_t index = std::min(values.size() - 1, static_cast<size_t>(q * values.size()));
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(index), values.end());
+  return values[index];
+}
+
+void PoseEvaluator::add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects) {
+  if (auto estimate = pending_estimates_.find(stamp_ns); estimate != pending_estimates_.end()) {
+    evaluate(objects, estimate->second);
+    pending_estimates_.erase(estimate);
+    return;
+  }
+  pending_truth_[stamp_ns] = std::move(objects);
+  expire();
+}
+
+void PoseEvaluator::add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects) {
+  if (auto truth = pending_truth_.find(stamp_ns); truth != pending_truth_.end()) {
+    evaluate(truth->second, objects);
+    pending_truth_.erase(truth);
+    return;
+  }
+  pending_estimates_[stamp_ns] = std::move(objects);
+  expire();
+}
+
+void PoseEvaluator::evaluate(const std::vector<ObjectPose>& truth,
+                             const std::vector<ObjectPose>& estimates) {
+  EvaluationSummary frame;
+  frame.frames = 1;
+  for (const ObjectPose& t : truth) {
+    if (t.visible_markers >= options_.min_visible_markers) ++frame.expected;
+  }
+  for (const ObjectPose& e : estimates) {
+    auto t = std::find_if(truth.begin(), truth.end(),
+                          [&](const ObjectPose& o) { return o.name == e.name; });
+    if (t == truth.end()) {
+      ++frame.false_identifications;
+      continue;
+    }
+    double position = (e.pose.translation() - t->pose.translation()).norm();
+    double orientation = angle_deg(e.pose, t->pose);
+    if (position > options_.false_position_error_m ||
+        orientation > options_.false_orientation_error_deg) {
+      ++frame.false_identifications;
+      continue;
+    }
+    // Found with fewer visible markers than expected is a bonus, not a trackable object.
+    if (t->visible_markers >= options_.min_visible_markers) ++frame.tracked;
+    frame.position_errors_m.push_back(position);
+    frame.orientation_errors_deg.push_back(orientation);
+  }
+  merge(total_, frame);
+  merge(window_, frame);
+}
+
+void PoseEvaluator::expire() {
+  // Truth without estimates: the pipeline dropped the frame. Estimates without truth: the
+  // truth was lost (it is reliable, so only at start-up); they are not judged.
+  while (pending_truth_.size() > options_.max_pending_frames) {
+    EvaluationSummary lost;
+    lost.frames = 1;
+    lost.frames_lost = 1;
+    for (const ObjectPose& t : pending_truth_.begin()->second) {
+      if (t.visible_markers >= options_.min_visible_markers) ++lost.expected;
+    }
+    merge(total_, lost);
+    merge(window_, lost);
+    pending_truth_.erase(pending_truth_.begin());
+  }
+  while (pending_estimates_.size() > options_.max_pending_frames) {
+    pending_estimates_.erase(pending_estimates_.begin());
+  }
+}
+
+EvaluationSummary PoseEvaluator::take_window() {
+  EvaluationSummary window = std::move(window_);
+  window_ = {};
+  return window;
+}
+
+}  // namespace mocap::evaluation

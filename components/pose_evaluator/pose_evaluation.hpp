@@ -1,0 +1,70 @@
+// Compares estimated poses with the synthetic camera's ground truth, frame by frame: the
+// accuracy figures of the tracking pipeline (DESIGN.md §8).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace mocap::evaluation {
+
+struct EvaluationOptions {
+  // A ground-truth object counts as trackable when at least this many of its markers are
+  // visible (three sides of a 12-marker board).
+  int min_visible_markers = 10;
+  // An estimate further than this from the truth, or of an object not in view, is a false
+  // identification rather than an inaccurate pose.
+  double false_position_error_m = 0.05;
+  double false_orientation_error_deg = 5.0;
+  // Frames whose estimate has not arrived after this many newer truth frames count as lost.
+  size_t max_pending_frames = 200;
+};
+
+struct ObjectPose {
+  std::string name;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  int visible_markers = 0;  // truth only
+};
+
+// Totals over a run or a window of it.
+struct EvaluationSummary {
+  uint64_t frames = 0;       // truth frames evaluated
+  uint64_t frames_lost = 0;  // truth frames no estimate array arrived for
+  uint64_t expected = 0;     // trackable objects in those frames
+  uint64_t tracked = 0;      // of them, estimated within the false-identification bounds
+  uint64_t false_identifications = 0;
+  std::vector<double> position_errors_m;       // one per tracked object
+  std::vector<double> orientation_errors_deg;  // one per tracked object
+
+  double tracked_percent() const;
+  // Quantile q in [0, 1] of a list (NaN when empty).
+  static double quantile(std::vector<double> values, double q);
+};
+
+// Pairs truth and estimates by their stamp (both carry the image's), in any arrival order.
+class PoseEvaluator {
+ public:
+  explicit PoseEvaluator(EvaluationOptions options = {}) : options_(options) {}
+
+  void add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects);
+  void add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects);
+
+  const EvaluationSummary& total() const { return total_; }
+  // What was evaluated since the last call.
+  EvaluationSummary take_window();
+
+ private:
+  void evaluate(const std::vector<ObjectPose>& truth, const std::vector<ObjectPose>& estimates);
+  void expire();
+
+  EvaluationOptions options_;
+  std::map<int64_t, std::vector<ObjectPose>> pending_truth_;
+  std::map<int64_t, std::vector<ObjectPose>> pending_estimates_;
+  EvaluationSummary total_;
+  EvaluationSummary window_;
+};
+
+}  // namespace mocap::evaluation

@@ -1,0 +1,157 @@
+// pose_evaluator: compares /mocap/poses with the synthetic camera's ground truth and prints
+// a live summary line and a final table (pose_evaluation.hpp).
+#include <chrono>
+#include <fstream>
+
+#include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+
+#include "pose_evaluation.hpp"
+
+namespace mocap::evaluation {
+namespace {
+
+constexpr const char* kTruth = "/camera/ir/ground_truth";
+constexpr const char* kPoses = "/mocap/poses";
+
+int64_t stamp_ns(const std_msgs::msg::Header& header) {
+  return static_cast<int64_t>(header.stamp().sec()) * 1'000'000'000 + header.stamp().nanosec();
+}
+
+std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array) {
+  std::vector<ObjectPose> out;
+  for (const auto& pose : array.poses()) {
+    const auto& p = pose.pose().pose();
+    ObjectPose object;
+    object.name = pose.name();
+    object.pose.translation() =
+        Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
+    object.pose.linear() = Eigen::Quaterniond(p.orientation().w(), p.orientation().x(),
+                                              p.orientation().y(), p.orientation().z())
+                               .normalized()
+                               .toRotationMatrix();
+    object.visible_markers = static_cast<int>(pose.points_used());
+    out.push_back(std::move(object));
+  }
+  return out;
+}
+
+class PoseEvaluatorComponent final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Compares estimated poses with the synthetic ground truth: a live summary line (input "
+        "rate, latency, tracked %, errors) and a final table.");
+    spec.parameter("report_period_s", 1.0, "seconds between summary lines").range(0.1, 3600);
+    spec.parameter("min_visible_markers", 10,
+                   "a truth object with fewer visible markers is not expected to be tracked")
+        .range(0, 10000);
+    spec.parameter("stop_after_frames", 0,
+                   "stop the process after evaluating this many frames (0: never)")
+        .range(0, 1e9);
+    spec.parameter("summary_file", std::string(), "where the final figures go (YAML), optional")
+        .path();
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kTruth, Qos::reliable(),
+                                                             "ground truth, one array per image");
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoses, Qos::reliable(),
+                                                             "estimated poses");
+  }
+
+  explicit PoseEvaluatorComponent(Context& context) : Component(context) {
+    EvaluationOptions options;
+    options.min_visible_markers = param<int>("min_visible_markers");
+    evaluator_ = PoseEvaluator(options);
+    stop_after_ = static_cast<uint64_t>(param<int>("stop_after_frames"));
+    summary_file_ = param<std::string>("summary_file");
+    period_s_ = param<double>("report_period_s");
+    create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
+        kTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
+          ++truth_arrays_;
+          evaluator_.add_truth(stamp_ns(truth.header()), objects(truth));
+          check_done();
+        });
+    create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
+        kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
+          latencies_s_.push_back(
+              std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());
+          evaluator_.add_estimate(stamp_ns(poses.header()), objects(poses));
+          check_done();
+        });
+    create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                     std::chrono::duration<double>(period_s_)),
+                 [this] { report(); });
+  }
+
+  ~PoseEvaluatorComponent() override { finish(); }
+
+ private:
+  void report() {
+    EvaluationSummary window = evaluator_.take_window();
+    window_latencies_s_.swap(latencies_s_);
+    all_latencies_s_.insert(all_latencies_s_.end(), window_latencies_s_.begin(),
+                            window_latencies_s_.end());
+    latencies_s_.clear();
+    if (window.frames == 0) {
+      log().info("no frames evaluated in the last {} s ({} truth arrays so far)", period_s_,
+                 truth_arrays_);
+      return;
+    }
+    log().info(
+        "{:.1f} frames/s, latency {:.2f} ms, tracked {:.1f} %, position error {:.2f} mm, "
+        "orientation error {:.3f} deg, false identifications {}",
+        window.frames / period_s_, EvaluationSummary::quantile(window_latencies_s_, 0.5) * 1e3,
+        window.tracked_percent(), EvaluationSummary::quantile(window.position_errors_m, 0.5) * 1e3,
+        EvaluationSummary::quantile(window.orientation_errors_deg, 0.5),
+        window.false_identifications);
+  }
+
+  void check_done() {
+    if (stop_after_ > 0 && !stopping_ && evaluator_.total().frames >= stop_after_) {
+      stopping_ = true;
+      log().info("{} frames evaluated, stopping", evaluator_.total().frames);
+      request_shutdown(0);
+    }
+  }
+
+  void finish() {
+    all_latencies_s_.insert(all_latencies_s_.end(), latencies_s_.begin(), latencies_s_.end());
+    const EvaluationSummary& total = evaluator_.total();
+    auto q = [](const std::vector<double>& v, double p) {
+      return EvaluationSummary::quantile(v, p);
+    };
+    log().info(
+        "| frames | lost | tracked | position mm (median, p95) | orientation deg "
+        "(median, p95) | false ids | latency ms (median, p99) |");
+    log().info("| {} | {} | {:.2f} % | {:.2f}, {:.2f} | {:.3f}, {:.3f} | {} | {:.2f}, {:.2f} |",
+               total.frames, total.frames_lost, total.tracked_percent(),
+               q(total.position_errors_m, 0.5) * 1e3, q(total.position_errors_m, 0.95) * 1e3,
+               q(total.orientation_errors_deg, 0.5), q(total.orientation_errors_deg, 0.95),
+               total.false_identifications, q(all_latencies_s_, 0.5) * 1e3,
+               q(all_latencies_s_, 0.99) * 1e3);
+    if (summary_file_.empty()) return;
+    std::ofstream out(summary_file_);
+    out << "frames: " << total.frames << "\nframes_lost: " << total.frames_lost
+        << "\nexpected: " << total.expected << "\ntracked: " << total.tracked
+        << "\nfalse_identifications: " << total.false_identifications
+        << "\nposition_error_median_m: " << q(total.position_errors_m, 0.5)
+        << "\nposition_error_p95_m: " << q(total.position_errors_m, 0.95)
+        << "\norientation_error_median_deg: " << q(total.orientation_errors_deg, 0.5)
+        << "\norientation_error_p95_deg: " << q(total.orientation_errors_deg, 0.95)
+        << "\nlatency_median_s: " << q(all_latencies_s_, 0.5) << "\n";
+    if (!out) log().error("cannot write {}", summary_file_);
+  }
+
+  PoseEvaluator evaluator_;
+  uint64_t stop_after_ = 0;
+  bool stopping_ = false;
+  std::string summary_file_;
+  double period_s_ = 1;
+  uint64_t truth_arrays_ = 0;
+  std::vector<double> latencies_s_, window_latencies_s_, all_latencies_s_;
+};
+
+}  // namespace
+}  // namespace mocap::evaluation
+
+MOCAP_REGISTER_COMPONENT(mocap::evaluation::PoseEvaluatorComponent, "pose_evaluator")
