@@ -1,0 +1,111 @@
+// Renders a scene as an infrared camera sees it: retro-reflective markers as bright ellipses
+// on a dark background, distractor lights, occluders and sensor noise; with the ground truth
+// of every frame.
+//
+// Each marker is a flat disc of RenderOptions::marker_diameter_m in its board's plane, drawn
+// exactly under the camera model: every pixel near the disc's image is covered by casting
+// supersampling x supersampling rays through it (interpolated from RayTable), intersecting
+// them with the board's plane and counting those that land inside the disc. Pixels whose
+// corners all land inside (or whose footprint on the plane is far from the disc) skip the
+// rays. A disc seen from behind (its board facing away) is not drawn. The coverage is blurred
+// (Gaussian, on the marker's own patch), scaled by the exposure and added to the background;
+// motion blur averages the coverage of several poses spread over the exposure time. Boards
+// themselves are transparent: one board does not hide another's markers.
+//
+// The random parts of a frame (the noise window, moving hot points) are a function of the
+// scene's seed and the frame number only, so a frame renders the same every time.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+
+#include <mocap/calibration/camera_model.hpp>
+
+#include "ray_table.hpp"
+#include "scene.hpp"
+#include "sensor_noise.hpp"
+
+namespace mocap::synthetic {
+
+struct MarkerTruth {
+  // The projected centre of the marker (pixels), also when it faces away; NaN when the
+  // camera cannot image it (behind the camera).
+  Eigen::Vector2d pixel = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  // Facing the camera, its centre inside the image and not behind an occluder. A marker cut
+  // by the image border or an occluder's edge counts as visible when its centre is.
+  bool visible = false;
+};
+
+struct ObjectTruth {
+  std::string constellation;
+  // Constellation frame in the camera frame at mid-exposure (see trajectory.hpp).
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  bool in_front = false;             // its origin has z > 0
+  bool facing_camera = false;        // the marker side of the board faces the camera
+  std::vector<MarkerTruth> markers;  // in the order of the constellation's points
+
+  int visible_markers() const;
+};
+
+struct RenderedFrame {
+  cv::Mat image;                     // CV_8UC1, camera width x height
+  double time_s = 0;                 // scene time at mid-exposure
+  std::vector<ObjectTruth> objects;  // in the scene's order
+};
+
+// Not thread-safe: a renderer keeps its working buffers between frames.
+class IrRenderer {
+ public:
+  // Precomputes what does not change between frames: the noise pool and the static layer
+  // (background, blobs, lamp, fixed occluders and hot points); the camera's rays follow as
+  // frames need them (ray_table.hpp). Throws std::invalid_argument for a null camera or render
+  // options out of range (load_scene checks those of a file).
+  IrRenderer(Scene scene, std::shared_ptr<const calibration::CameraModel> camera);
+
+  // The frame whose exposure is centred on scene time `time_s`. `frame_number` selects the
+  // frame's random draws.
+  RenderedFrame render(double time_s, uint64_t frame_number = 0);
+
+  const Scene& scene() const { return scene_; }
+  const calibration::CameraModel& camera() const { return *camera_; }
+
+ private:
+  struct DiscView;  // one marker at one instant, as seen from the camera
+  struct Rect {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // inclusive pixel bounds
+    bool empty() const { return x1 < x0 || y1 < y0; }
+  };
+
+  std::vector<double> exposure_times(const SceneObject& object, double time_s) const;
+  bool view_disc(const Eigen::Isometry3d& pose, const Eigen::Vector3d& marker,
+                 DiscView& view) const;
+  void add_coverage(const DiscView& view, const Rect& patch_rect, double weight,
+                    cv::Mat& patch) const;
+  void draw_marker(const std::vector<Eigen::Isometry3d>& poses, const Eigen::Vector3d& marker,
+                   cv::Mat& image);
+  void draw_static_layer();
+  void occlude(const Rect& rect, double level_dn, const cv::Mat& noise, cv::Mat& image) const;
+  Rect object_occlusion(const SceneObject& object, const ObjectTruth& truth) const;
+  Rect clip(double x0, double y0, double x1, double y1) const;
+
+  Scene scene_;
+  std::shared_ptr<const calibration::CameraModel> camera_;
+  RayTable rays_;
+  SensorNoise noise_;
+  double marker_radius_m_;
+  double peak_dn_;        // a fully covered pixel, above the background
+  cv::Mat static_layer_;  // CV_32F: everything that does not move
+  std::vector<Rect> fixed_occluders_;
+  std::vector<cv::Point> fixed_hot_points_;
+  cv::Mat work_;   // CV_32F: the frame being drawn
+  cv::Mat patch_;  // CV_32F: one marker's coverage
+};
+
+}  // namespace mocap::synthetic

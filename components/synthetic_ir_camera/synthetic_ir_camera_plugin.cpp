@@ -1,0 +1,156 @@
+// synthetic_ir_camera: renders a scene (ir_renderer.hpp) into mono8 images and publishes them
+// with the ground truth of each frame, the embedded default camera when there is no hardware.
+//
+// Frame k shows the scene at time k * time_step_s (by default 1 / rate_hz): scene time follows
+// the frame count, not the wall clock, so a run renders the same frames whatever the load of
+// the machine. Headers carry the wall-clock time of publication; an image and its ground truth
+// share header stamp and frame id, so consumers pair them by stamp.
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "constellation_database.hpp"
+#include "image_message.hpp"
+#include "ir_renderer.hpp"
+#include "scene.hpp"
+
+namespace mocap::synthetic {
+namespace {
+
+constexpr const char* kImageTopic = "/camera/ir/image_raw";
+constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
+// With rate_hz 0 frames follow each other as fast as they render: the timer only has to fire
+// again before a frame is done, and a faster timer would only wake its thread for nothing.
+constexpr std::chrono::microseconds kBackToBackPeriod{200};
+constexpr double kDefaultTimeStep_s = 1.0 / 30;
+
+std::string config_file(const char* relative) { return std::string(MOCAP_CONFIG_DIR) + relative; }
+
+class SyntheticIrCamera final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Renders constellations moving through a scene, distractor lights and sensor noise "
+        "into mono8 infrared images, and publishes each frame's ground truth. Frame k shows "
+        "scene time k * time_step_s, whatever the wall clock does, so runs are reproducible.");
+    spec.parameter("scene", config_file("/scenes/demo.yaml"),
+                   "scene file: objects, trajectories, rendering, distractors "
+                   "(config/scenes/README.md)")
+        .path();
+    spec.parameter("camera", config_file("/cameras/synthetic_ir_1280x720.yaml"),
+                   "camera file (ROS camera_info YAML): image size and lens")
+        .path();
+    spec.parameter("database", config_file("/constellations.yaml"),
+                   "constellation database: YAML or the seed's constellation CSV")
+        .path();
+    spec.parameter("sub_constellations", std::string(),
+                   "the seed's sub-constellation CSV for a CSV database; empty = none")
+        .path();
+    spec.parameter("rate_hz", 30.0, "frames per second; 0 = as fast as they render")
+        .range(0, 10000);
+    spec.parameter("time_step_s", 0.0,
+                   "scene time between frames, seconds; 0 = 1 / rate_hz (1/30 when rate_hz is 0)")
+        .range(0, 3600);
+    spec.parameter("frame_id", std::string(), "frame id of the headers; empty = the camera file's");
+    spec.parameter("max_frames", 0, "frames to publish before stopping; 0 = no limit").min(0);
+    spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
+                                            "rendered frames, mono8");
+    spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
+        kTruthTopic, Qos::reliable(),
+        "per frame, the true pose of every constellation in front of the camera (camera frame, "
+        "mid-exposure); points_used = its visible markers; same header as the image");
+  }
+
+  explicit SyntheticIrCamera(Context& context) : Component(context) {
+    // Load errors propagate: the runtime reports them with this component's name.
+    calibration::CameraFile camera = calibration::load_camera_file(param<std::string>("camera"));
+    constellations::ConstellationDatabase database = constellations::load_database(
+        param<std::string>("database"), param<std::string>("sub_constellations"));
+    Scene scene = load_scene(param<std::string>("scene"), database);
+    size_t object_count = scene.objects.size();
+    renderer_ = std::make_unique<IrRenderer>(std::move(scene), camera.model);
+
+    frame_id_ = param<std::string>("frame_id");
+    if (frame_id_.empty()) frame_id_ = camera.frame_id;
+    max_frames_ = param<int64_t>("max_frames");
+    double rate_hz = param<double>("rate_hz");
+    time_step_s_ = param<double>("time_step_s");
+    if (time_step_s_ == 0) time_step_s_ = rate_hz > 0 ? 1 / rate_hz : kDefaultTimeStep_s;
+
+    images_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
+    truths_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kTruthTopic);
+    std::chrono::nanoseconds period = rate_hz > 0
+                                          ? std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                                std::chrono::duration<double>(1 / rate_hz))
+                                          : std::chrono::nanoseconds(kBackToBackPeriod);
+    create_timer(period, [this] { tick(); });
+    log().info("{}x{} frames of {} ({} objects) at {} on {}, scene time step {:.6g} s",
+               camera.model->width(), camera.model->height(), param<std::string>("scene"),
+               object_count, rate_hz > 0 ? fmt::format("{} Hz", rate_hz) : "full speed",
+               images_.topic(), time_step_s_);
+  }
+
+ private:
+  void tick() {
+    if (max_frames_ > 0 && frames_ >= static_cast<uint64_t>(max_frames_)) {
+      if (!reported_end_) {
+        log().info("published {} frames (max_frames); no more", frames_);
+        reported_end_ = true;
+      }
+      return;
+    }
+    RenderedFrame frame = renderer_->render(static_cast<double>(frames_) * time_step_s_, frames_);
+    ++frames_;
+
+    std_msgs::msg::Header header;
+    header.stamp(to_time_msg(now()));
+    header.frame_id(frame_id_);
+
+    auto image = std::make_shared<sensor_msgs::msg::Image>();
+    image->header(header);
+    fill_image_message(frame.image, *image);
+
+    auto truth = std::make_shared<mocap_msgs::msg::ConstellationPoseArray>();
+    truth->header(header);
+    for (const ObjectTruth& object : frame.objects) {
+      if (!object.in_front) continue;
+      mocap_msgs::msg::ConstellationPose pose;
+      pose.name(object.constellation);
+      pose.pose().header(header);
+      const Eigen::Vector3d& position = object.pose.translation();
+      pose.pose().pose().position().x(position.x());
+      pose.pose().pose().position().y(position.y());
+      pose.pose().pose().position().z(position.z());
+      Eigen::Quaterniond orientation(object.pose.linear());
+      pose.pose().pose().orientation().x(orientation.x());
+      pose.pose().pose().orientation().y(orientation.y());
+      pose.pose().pose().orientation().z(orientation.z());
+      pose.pose().pose().orientation().w(orientation.w());
+      pose.reprojection_rms_px(0);
+      pose.points_used(static_cast<uint32_t>(object.visible_markers()));
+      truth->poses().push_back(std::move(pose));
+    }
+    images_.publish(std::move(image));
+    truths_.publish(std::move(truth));
+  }
+
+  std::unique_ptr<IrRenderer> renderer_;
+  std::string frame_id_;
+  int64_t max_frames_ = 0;
+  double time_step_s_ = 0;
+  uint64_t frames_ = 0;
+  bool reported_end_ = false;
+  Publisher<sensor_msgs::msg::Image> images_;
+  Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
+};
+
+}  // namespace
+}  // namespace mocap::synthetic
+
+MOCAP_REGISTER_COMPONENT(mocap::synthetic::SyntheticIrCamera, "synthetic_ir_camera")
