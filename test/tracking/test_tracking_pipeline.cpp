@@ -1,0 +1,136 @@
+// The whole tracking pipeline through the runtime: synthetic camera -> tracker ->
+// identifier -> pose estimator -> evaluator, in one process and across two over DDS; and the
+// components' handling of bad input.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fmt/format.h>
+
+#include "test_support.hpp"
+
+namespace mocap {
+namespace {
+
+std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
+
+std::string config(const std::string& file) {
+  return (test::source_dir() / "config" / file).string();
+}
+
+// One board walking across the view at 1.5-2.5 m, a lamp, hot pixels; `frames` frames.
+std::string pipeline_launch_file(const std::filesystem::path& summary, int frames,
+                                 bool two_processes, int domain) {
+  std::string camera = fmt::format(R"(
+      - plugin: synthetic_ir_camera
+        name: camera
+        parameters:
+          scene: {}
+          rate_hz: 60.0
+          max_frames: {}
+        qos:
+          /camera/ir/image_raw: {{profile: reliable, depth: 1000}})",
+                                   config("scenes/demo.yaml"), frames);
+  std::string tracking =
+      fmt::format(R"(
+      - plugin: fiducial_tracker
+        name: tracker
+        qos:
+          /camera/ir/image_raw: {{profile: reliable, depth: 1000}}
+      - plugin: constellation_identifier
+        name: identifier
+        parameters:
+          camera: {0}
+      - plugin: pose_estimator
+        name: pose
+      - plugin: pose_evaluator
+        name: evaluator
+        parameters:
+          stop_after_frames: {1}
+          summary_file: {2})",
+                  config("cameras/synthetic_ir_1280x720.yaml"), frames, summary.string());
+  std::string dds = fmt::format("dds:\n  enabled: {}\n  domain_id: {}\n",
+                                two_processes ? "true" : "false", domain);
+  if (two_processes) {
+    return dds + "groups:\n  - name: camera\n    components:" + camera +
+           "\n  - name: tracking\n    components:" + tracking + "\n";
+  }
+  return dds + "groups:\n  - name: mocap\n    components:" + camera + tracking + "\n";
+}
+
+void expect_accurate(const std::filesystem::path& summary_file, int frames) {
+  YAML::Node summary = YAML::LoadFile(summary_file.string());
+  EXPECT_EQ(summary["frames"].as<int>(), frames);
+  EXPECT_EQ(summary["frames_lost"].as<int>(), 0);
+  // demo.yaml keeps both boards in view: two per frame.
+  EXPECT_EQ(summary["expected"].as<int>(), 2 * frames);
+  EXPECT_GE(summary["tracked"].as<double>(), 0.98 * 2 * frames);
+  EXPECT_EQ(summary["false_identifications"].as<int>(), 0);
+  EXPECT_LT(summary["position_error_median_m"].as<double>(), 0.002);
+  EXPECT_LT(summary["orientation_error_median_deg"].as<double>(), 0.2);
+}
+
+TEST(TrackingPipeline, InOneProcess) {
+  test::TempDir dir;
+  constexpr int kFrames = 60;
+  test::write_file(dir / "pipeline.yaml",
+                   pipeline_launch_file(dir / "summary.yaml", kFrames, false, 0));
+  auto [code, output] = test::run_command({launcher(), (dir / "pipeline.yaml").string()}, {},
+                                          std::chrono::seconds(120));
+  ASSERT_EQ(code, 0) << output;
+  expect_accurate(dir / "summary.yaml", kFrames);
+  // The evaluator's final table.
+  EXPECT_NE(output.find("| frames | lost | tracked |"), std::string::npos) << output;
+}
+
+TEST(TrackingPipeline, CameraAndTrackingInTwoProcesses) {
+  test::TempDir dir;
+  constexpr int kFrames = 60;
+  test::write_file(dir / "pipeline.yaml", pipeline_launch_file(dir / "summary.yaml", kFrames, true,
+                                                               test::test_domain(20)));
+  auto [code, output] = test::run_command({launcher(), (dir / "pipeline.yaml").string()}, {},
+                                          std::chrono::seconds(120));
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("[camera] "), std::string::npos) << output;
+  EXPECT_NE(output.find("[tracking] "), std::string::npos) << output;
+  expect_accurate(dir / "summary.yaml", kFrames);
+}
+
+TEST(TrackingPipeline, ShippedLaunchFilesAreValid) {
+  for (const char* file :
+       {"mobile_mocap_demo.yaml", "mobile_mocap_two_process.yaml", "mobile_mocap_camera.yaml"}) {
+    auto [code, output] = test::run_command(
+        {launcher(), (test::source_dir() / "launch_yaml" / file).string(), "--check"});
+    EXPECT_EQ(code, 0) << file << ": " << output;
+  }
+}
+
+TEST(TrackingPipeline, BadConfigurationFilesAreOneLineErrors) {
+  test::TempDir dir;
+  test::write_file(dir / "camera.yaml", "image_width: 640\nimage_height: 480\n");
+  test::write_file(dir / "db.csv", "Const_ID,1\nPts,L\nName,X_coord,Y_coord,Z_coord\nL,0,0,0\n");
+  struct Case {
+    std::string component, parameter, value, expected;
+  };
+  std::vector<Case> cases = {
+      {"pose_estimator", "camera", (dir / "camera.yaml").string(),
+       "camera.yaml:1: missing field 'camera_matrix'"},
+      {"constellation_identifier", "database", (dir / "db.csv").string(),
+       "db.csv: line 'L' needs 4 point rows ',x,y,z', found 0"},
+      {"pose_estimator", "database", (dir / "missing.yaml").string(),
+       "missing.yaml: cannot read the constellation database"},
+  };
+  for (const Case& c : cases) {
+    std::string file = fmt::format(
+        "dds: {{enabled: false}}\ngroups:\n  - name: g\n    components:\n      - plugin: {}\n"
+        "        name: under_test\n        parameters:\n          {}: {}\n",
+        c.component, c.parameter, c.value);
+    test::write_file(dir / "launch.yaml", file);
+    auto [code, output] = test::run_command({launcher(), (dir / "launch.yaml").string()}, {},
+                                            std::chrono::seconds(30));
+    EXPECT_EQ(code, 1) << output;
+    EXPECT_NE(output.find(c.expected), std::string::npos) << output;
+  }
+}
+
+}  // namespace
+}  // namespace mocap
