@@ -28,7 +28,7 @@ Runs the components of a launch file (launch_yaml/README.md describes the format
                    a single-group file runs in this process
   --group NAME     run only this group, in this process (one host's share of a deployment)
   --set C.P=V      set parameter P of component C to V (YAML: 3, 0.5, true, [1, 2], text)
-  --duration S     stop after S seconds (default: run until Ctrl-C)
+  --duration S     stop after S seconds (default, or 0: run until Ctrl-C)
   --check          validate the file and exit: 0 when valid
   --describe NAME  print a plugin's description, parameters and topics
   --plugins        list the plugins on the search path (MOCAP_PLUGIN_PATH, then build/lib)
@@ -109,10 +109,11 @@ int main(int argc, char** argv) {
       const std::string& text = value(arg);
       double seconds = 0;
       auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), seconds);
-      if (error != std::errc() || end != text.data() + text.size() || !(seconds > 0)) {
-        usage_error(fmt::format("--duration {}: expected a positive number of seconds", text));
+      if (error != std::errc() || end != text.data() + text.size() || !(seconds >= 0)) {
+        usage_error(fmt::format("--duration {}: expected a number of seconds >= 0", text));
       }
-      duration = seconds;
+      // The last one given counts, so a wrapper's default can be overridden; 0 means none.
+      duration = seconds > 0 ? std::optional<double>(seconds) : std::nullopt;
     } else if (arg == "--check") {
       check = true;
     } else if (arg == "--describe") {

@@ -1,0 +1,91 @@
+// The evaluator's bookkeeping and the overlay's drawing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <mocap/calibration/pinhole_camera.hpp>
+
+#include "overlay_drawing.hpp"
+#include "pose_evaluation.hpp"
+
+namespace mocap {
+namespace {
+
+using evaluation::EvaluationSummary;
+using evaluation::ObjectPose;
+using evaluation::PoseEvaluator;
+
+ObjectPose at(const std::string& name, double x, double z, int visible = 12) {
+  ObjectPose pose;
+  pose.name = name;
+  pose.pose.translation() = Eigen::Vector3d(x, 0, z);
+  pose.visible_markers = visible;
+  return pose;
+}
+
+TEST(PoseEvaluator, PairsByStampInAnyOrder) {
+  PoseEvaluator evaluator;
+  evaluator.add_truth(1, {at("a", 0, 2), at("b", 1, 2)});
+  evaluator.add_estimate(2, {at("a", 0.003, 2)});  // before its truth
+  evaluator.add_estimate(1, {at("a", 0.001, 2), at("b", 1, 2.002)});
+  evaluator.add_truth(2, {at("a", 0, 2)});
+  const EvaluationSummary& total = evaluator.total();
+  EXPECT_EQ(total.frames, 2u);
+  EXPECT_EQ(total.expected, 3u);
+  EXPECT_EQ(total.tracked, 3u);
+  EXPECT_EQ(total.false_identifications, 0u);
+  ASSERT_EQ(total.position_errors_m.size(), 3u);
+  EXPECT_NEAR(EvaluationSummary::quantile(total.position_errors_m, 0.5), 0.002, 1e-12);
+  EXPECT_DOUBLE_EQ(total.tracked_percent(), 100.0);
+}
+
+TEST(PoseEvaluator, CountsMissesFalseIdentificationsAndLostFrames) {
+  evaluation::EvaluationOptions options;
+  options.max_pending_frames = 2;
+  PoseEvaluator evaluator(options);
+  // A board in view but not found; one with too few visible markers is not expected.
+  evaluator.add_truth(1, {at("a", 0, 2), at("b", 1, 2, 4)});
+  evaluator.add_estimate(1, {at("c", 0, 2), at("a", 0.2, 2)});  // c not in view, a far off
+  EXPECT_EQ(evaluator.total().expected, 1u);
+  EXPECT_EQ(evaluator.total().tracked, 0u);
+  EXPECT_EQ(evaluator.total().false_identifications, 2u);
+  // Truth frames whose estimates never come are lost once newer ones pile up.
+  for (int stamp = 2; stamp <= 5; ++stamp) evaluator.add_truth(stamp, {at("a", 0, 2)});
+  EXPECT_EQ(evaluator.total().frames_lost, 2u);
+  EXPECT_EQ(evaluator.total().expected, 3u);
+  EXPECT_NEAR(evaluator.total().tracked_percent(), 0.0, 1e-12);
+  EvaluationSummary window = evaluator.take_window();
+  EXPECT_EQ(window.frames, 3u);
+  EXPECT_EQ(evaluator.take_window().frames, 0u);
+}
+
+TEST(Overlay, DrawsFiducialsLinesAndAxes) {
+  calibration::PinholeIntrinsics k;
+  k.fx = k.fy = 500;
+  k.cx = 319.5;
+  k.cy = 239.5;
+  calibration::PinholeCamera camera(640, 480, k);
+  cv::Mat image(480, 640, CV_8UC1, cv::Scalar(10));
+  overlay::OverlayFrame frame;
+  frame.fiducials = {{100, 100}, {std::nan(""), 5}};
+  frame.constellations = {{"board", {{"T1", {{{200, 300}, {250, 300}, {300, 300}, {400, 300}}}}}}};
+  overlay::OverlayPose pose;
+  pose.name = "board";
+  pose.camera_from_object.translation() = Eigen::Vector3d(0, 0, 1);
+  frame.poses = {pose};
+  cv::Mat picture = overlay::draw_overlay(image, frame, &camera, 0.1);
+  ASSERT_EQ(picture.type(), CV_8UC3);
+  auto pixel = [&](int x, int y) { return picture.at<cv::Vec3b>(y, x); };
+  EXPECT_GT(pixel(106, 100)[2], 150);  // yellow circle of radius 6: red and green high
+  EXPECT_EQ(pixel(100, 100), cv::Vec3b(10, 10, 10));  // its centre untouched
+  EXPECT_GT(pixel(350, 300)[1], 150);                 // green line
+  // The x axis of the pose runs from the principal point 50 px to the right, in red.
+  EXPECT_GT(pixel(345, 240)[2], 150);
+  EXPECT_LT(pixel(345, 240)[0], 100);
+  // No camera: no axes, the rest still drawn.
+  cv::Mat without = overlay::draw_overlay(image, frame, nullptr);
+  EXPECT_EQ(without.at<cv::Vec3b>(240, 345), cv::Vec3b(10, 10, 10));
+}
+
+}  // namespace
+}  // namespace mocap
