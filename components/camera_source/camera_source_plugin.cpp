@@ -1,0 +1,170 @@
+// camera_source: publishes mono8 images from a V4L2 camera, a video file or a directory of
+// images (frame_source.hpp).
+//
+// Frames are read on a thread of the component's own, so a device's blocking grab never holds
+// the executor. Recorded input is paced at rate_hz and, by default, waits for its first
+// subscriber, so that a short recording is not played to nobody while the graph starts.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "frame_source.hpp"
+#include "image_message.hpp"
+
+namespace mocap::capture {
+namespace {
+
+constexpr const char* kImageTopic = "/camera/ir/image_raw";
+
+class CameraSource final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Publishes mono8 images from a V4L2 camera, a video file or a directory of images "
+        "(colour and 16-bit frames are converted). Set exactly one of device, file and "
+        "directory.");
+    spec.parameter("device", std::string(),
+                   "V4L2 camera: a path (/dev/video0) or an index (0); frames come at the "
+                   "device's rate");
+    spec.parameter("file", std::string(), "video file (whatever OpenCV decodes)").path();
+    spec.parameter("directory", std::string(),
+                   "directory of png/jpg/bmp/tif/pgm images, read in name order")
+        .path();
+    spec.parameter("rate_hz", 30.0,
+                   "file and directory: frames published per second; 0 = as fast as possible")
+        .range(0, 1e6);
+    spec.parameter("loop", false, "file and directory: start over at the end");
+    spec.parameter("wait_for_subscriber", true,
+                   "file and directory: hold the first frame until a subscriber has matched");
+    spec.parameter("frame_id", std::string("camera_ir_optical"), "frame id of the images");
+    spec.parameter("width", 0, "device: requested frame width; 0 = the device's").min(0);
+    spec.parameter("height", 0, "device: requested frame height; 0 = the device's").min(0);
+    spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
+                                            "mono8 images, stamped when captured");
+  }
+
+  explicit CameraSource(Context& context) : Component(context) {
+    source_ = open_source();
+    frame_id_ = param<std::string>("frame_id");
+    rate_hz_ = param<double>("rate_hz");
+    wait_for_subscriber_ = param<bool>("wait_for_subscriber") && !source_->is_live();
+    publisher_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
+    if (source_->is_live()) {
+      log().info("publishing {} on {} at the device's rate", source_->description(),
+                 publisher_.topic());
+    } else if (rate_hz_ > 0) {
+      log().info("publishing {} on {} at {} Hz", source_->description(), publisher_.topic(),
+                 rate_hz_);
+    } else {
+      log().info("publishing {} on {} as fast as possible", source_->description(),
+                 publisher_.topic());
+    }
+    capture_thread_ = std::thread([this] { capture(); });
+  }
+
+  ~CameraSource() override {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    // A device's grab returns within a frame period.
+    capture_thread_.join();
+    log().info("published {} frames", published_.load());
+  }
+
+ private:
+  std::unique_ptr<FrameSource> open_source() {
+    const std::string device = param<std::string>("device");
+    const std::string file = param<std::string>("file");
+    const std::string directory = param<std::string>("directory");
+    std::vector<std::string> given;
+    if (!device.empty()) given.push_back("device");
+    if (!file.empty()) given.push_back("file");
+    if (!directory.empty()) given.push_back("directory");
+    if (given.size() != 1) {
+      std::string list = given.empty() ? "none" : given[0];
+      for (size_t i = 1; i < given.size(); ++i) list += " and " + given[i];
+      throw std::invalid_argument("set exactly one of device, file and directory (got " + list +
+                                  ")");
+    }
+    const bool loop = param<bool>("loop");
+    if (!device.empty()) {
+      return std::make_unique<VideoDeviceSource>(
+          device, VideoDeviceOptions{.width = param<int>("width"), .height = param<int>("height")});
+    }
+    if (!file.empty()) return std::make_unique<VideoFileSource>(file, loop);
+    return std::make_unique<ImageDirectorySource>(
+        directory, loop, [this](const std::string& warning) { log().warn("{}", warning); });
+  }
+
+  // Waits until `deadline` or until the component stops; true when it stops.
+  bool wait_until(std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock lock(mutex_);
+    return wake_.wait_until(lock, deadline, [this] { return stopping_; });
+  }
+  bool stopping() {
+    std::lock_guard lock(mutex_);
+    return stopping_;
+  }
+
+  void capture() {
+    using Steady = std::chrono::steady_clock;
+    try {
+      while (wait_for_subscriber_ && publisher_.matched_subscribers() == 0) {
+        if (wait_until(Steady::now() + std::chrono::milliseconds(10))) return;
+      }
+      const auto period = rate_hz_ > 0 ? std::chrono::duration_cast<Steady::duration>(
+                                             std::chrono::duration<double>(1.0 / rate_hz_))
+                                       : Steady::duration::zero();
+      Steady::time_point next = Steady::now();
+      cv::Mat frame;
+      while (!stopping()) {
+        if (!source_->read(frame)) {
+          log().info("end of input after {} frames", source_->frames_read());
+          return;
+        }
+        auto message = std::make_shared<sensor_msgs::msg::Image>();
+        message->header().stamp(to_time_msg(now()));
+        message->header().frame_id(frame_id_);
+        fill_image_message(frame, *message);
+        publisher_.publish(std::move(message));
+        published_.fetch_add(1);
+        if (source_->is_live() || period == Steady::duration::zero()) continue;
+        // Keep to the rate's grid; after a stall, start a new grid rather than catch up in
+        // a burst.
+        next += period;
+        if (next < Steady::now()) next = Steady::now();
+        if (wait_until(next)) return;
+      }
+    } catch (const std::exception& e) {
+      log().error("{}: {}; no more frames", source_->description(), e.what());
+    }
+  }
+
+  std::unique_ptr<FrameSource> source_;
+  std::string frame_id_;
+  double rate_hz_ = 0;
+  bool wait_for_subscriber_ = true;
+  Publisher<sensor_msgs::msg::Image> publisher_;
+  std::atomic<uint64_t> published_{0};
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  std::thread capture_thread_;  // last: starts once everything it uses exists
+};
+
+}  // namespace
+}  // namespace mocap::capture
+
+MOCAP_REGISTER_COMPONENT(mocap::capture::CameraSource, "camera_source")
