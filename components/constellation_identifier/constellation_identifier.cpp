@@ -70,6 +70,7 @@ class ConstellationSearch {
         points_(points),
         options_(options),
         min_lines_(std::min<int>(options.min_lines, static_cast<int>(model.lines.size()))),
+        search_min_lines_(options.min_extra_markers > 0 ? std::min(min_lines_, 2) : min_lines_),
         image_of_(model.points.size(), -1),
         chosen_(model.lines.size()),
         choices_(model.lines.size()),
@@ -124,6 +125,8 @@ class ConstellationSearch {
       }
     }
     if (best_count_ == 0) return std::nullopt;
+    int extra = complete_with_markers();
+    if (best_count_ < min_lines_ && extra < options_.min_extra_markers) return std::nullopt;
     IdentifiedConstellation found;
     found.model = &model_;
     found.image_point_of = best_image_of_;
@@ -139,6 +142,39 @@ class ConstellationSearch {
     bool reversed = false;
     int image_point(int k) const { return candidate->points[reversed ? 3 - k : k]; }
   };
+
+  // Adds the unseen markers that an image point lies on, where the plane of the best
+  // assignment puts them (the nearest within a third of max_fit_error_px: the prediction from
+  // whole lines is good to a fraction of a pixel, and a tight radius keeps stray points from
+  // confirming a chance pair of lines); returns how many.
+  int complete_with_markers() {
+    auto h = plane_homography(model_, best_image_of_, points_);
+    if (!h) return 0;
+    int added = 0;
+    for (size_t m = 0; m < best_image_of_.size(); ++m) {
+      if (best_image_of_[m] >= 0) continue;
+      Eigen::Vector2d predicted = apply_homography(*h, model_.plane_points[m]);
+      int nearest = -1;
+      double nearest_distance = options_.max_fit_error_px / 3;
+      for (size_t i = 0; i < points_.size(); ++i) {
+        double distance = (points_[i] - predicted).norm();
+        if (distance <= nearest_distance &&
+            std::find(best_image_of_.begin(), best_image_of_.end(), static_cast<int>(i)) ==
+                best_image_of_.end()) {
+          nearest = static_cast<int>(i);
+          nearest_distance = distance;
+        }
+      }
+      if (nearest >= 0) {
+        best_image_of_[m] = nearest;
+        ++added;
+      }
+    }
+    if (added > 0) {
+      if (auto fit = plane_fit(model_, best_image_of_, points_)) best_fit_ = *fit;
+    }
+    return added;
+  }
 
   // The choices for `line` whose image point at position k is `point`, from a sorted index,
   // so that linked lines are found in logarithmic time rather than by a scan.
@@ -245,7 +281,7 @@ class ConstellationSearch {
   void evaluate() {
     int count = static_cast<int>(
         std::count_if(chosen_.begin(), chosen_.end(), [](const Choice& c) { return c.candidate; }));
-    if (count < min_lines_ || count < best_count_) return;
+    if (count < search_min_lines_ || count < best_count_) return;
     auto fit = plane_fit(model_, image_of_, points_);
     if (!fit || fit->max > options_.max_fit_error_px) {
       ++stats_->rejected_by_fit;
@@ -274,6 +310,7 @@ class ConstellationSearch {
   const std::vector<Eigen::Vector2d>& points_;
   const IdentifierOptions& options_;
   const int min_lines_;
+  const int search_min_lines_;  // fewer whole lines may do when extra markers confirm them
   IdentificationStats* stats_ = nullptr;
   std::vector<int> image_of_;
   std::vector<Choice> chosen_;
@@ -365,10 +402,13 @@ std::vector<IdentifiedConstellation> ConstellationIdentifier::identify(
     ConstellationSearch search(models[m], line_type_of_[m], by_type, points, options_);
     if (auto result = search.search(s)) found.push_back(std::move(*result));
   }
-  // Most lines first, then the best fit; a constellation whose points a better one took is
-  // a misreading of that one.
+  // Most lines first, then most markers, then the best fit; a constellation whose points a
+  // better one took is a misreading of that one.
   std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
     if (a.lines.size() != b.lines.size()) return a.lines.size() > b.lines.size();
+    if (a.points_identified() != b.points_identified()) {
+      return a.points_identified() > b.points_identified();
+    }
     return a.fit_rms_px < b.fit_rms_px;
   });
   std::vector<bool> taken(points.size(), false);

@@ -29,6 +29,10 @@ struct IdentifierOptions {
   // Fewest lines of a constellation that identify it; capped at its number of lines. With the
   // shipped database three lines name a board uniquely.
   int min_lines = 3;
+  // A constellation with fewer whole lines than min_lines, but at least two that share a
+  // marker, is identified when this many of its other markers lie where its plane puts them
+  // (a board with a corner hidden keeps only two whole sides). 0 disables it.
+  int min_extra_markers = 2;
   // Largest distance, pixels, of an identified point from where the plane-to-image
   // homography of all identified points puts it.
   double max_fit_error_px = 3.0;
@@ -45,9 +49,11 @@ struct IdentifiedLine {
 
 struct IdentifiedConstellation {
   const ConstellationModel* model = nullptr;
-  std::vector<IdentifiedLine> lines;  // in the model's line order
-  std::vector<int> image_point_of;    // per model point: image point index, or -1 if unseen
-  double fit_rms_px = 0;              // of the plane-to-image homography over all points
+  std::vector<IdentifiedLine> lines;  // whole lines found by cross-ratio, in the model's order
+  // Per model point: image point index, or -1 if unseen. Besides the whole lines' points it
+  // holds the markers of broken lines found where the plane of the whole lines puts them.
+  std::vector<int> image_point_of;
+  double fit_rms_px = 0;  // of the plane-to-image homography over all points
   double fit_max_px = 0;
   int points_identified() const;
 };

@@ -1,5 +1,6 @@
 // constellation_identifier: FiducialArray -> ConstellationArray (constellation_identifier.hpp).
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -92,22 +93,42 @@ class ConstellationIdentifierComponent final : public Component {
       constellation.name(model.name);
       constellation.point_names(model.line_names());
       constellation.xyz_tol(static_cast<float>(found.fit_rms_px));
-      for (const IdentifiedLine& line : found.lines) {
-        const ConstellationLine& model_line = model.lines[line.model_line];
+      // Every line with a marker seen, its fiducials in database order; a marker not seen
+      // (hidden, out of view) is a fiducial with NaN coordinates.
+      for (size_t l = 0; l < model.lines.size(); ++l) {
+        const ConstellationLine& model_line = model.lines[l];
         mocap_msgs::msg::SubConstellation sub;
         sub.name(model_line.name);
         sub.fiducial_array().header(array.header());
         float cx = 0, cy = 0;
-        for (int index : line.image_points) {
+        int seen = 0;
+        for (int marker : model_line.points) {
+          int index = found.image_point_of[marker];
+          if (index < 0) {
+            mocap_msgs::msg::Fiducial unseen;
+            unseen.x(std::numeric_limits<float>::quiet_NaN());
+            unseen.y(std::numeric_limits<float>::quiet_NaN());
+            sub.fiducial_array().fiducials().push_back(unseen);
+            continue;
+          }
           sub.fiducial_array().fiducials().push_back(fiducials[index]);
-          cx += fiducials[index].x() / 4;
-          cy += fiducials[index].y() / 4;
+          cx += fiducials[index].x();
+          cy += fiducials[index].y();
+          ++seen;
         }
-        sub.Cx(cx);
-        sub.Cy(cy);
+        if (seen == 0) continue;
+        sub.Cx(cx / seen);
+        sub.Cy(cy / seen);
         sub.Cz(0);
-        sub.uncertainty(
-            static_cast<float>(relative_difference(line.cross_ratio, model_line.cross_ratio)));
+        // How far the measured cross-ratio is from the database's; NaN for a broken line.
+        float difference = std::numeric_limits<float>::quiet_NaN();
+        for (const IdentifiedLine& line : found.lines) {
+          if (line.model_line == static_cast<int>(l)) {
+            difference =
+                static_cast<float>(relative_difference(line.cross_ratio, model_line.cross_ratio));
+          }
+        }
+        sub.uncertainty(difference);
         constellation.sub_constellations().push_back(std::move(sub));
       }
       message->constellations().push_back(std::move(constellation));

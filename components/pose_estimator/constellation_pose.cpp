@@ -17,6 +17,7 @@ Correspondences match_to_model(const constellations::ConstellationModel& model,
       continue;
     }
     for (int k = 0; k < 4; ++k) {
+      if (!line.pixels[k].allFinite()) continue;  // a marker not seen
       sum[model_line->points[k]] += line.pixels[k];
       ++seen[model_line->points[k]];
     }

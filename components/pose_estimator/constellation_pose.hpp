@@ -11,7 +11,8 @@
 
 namespace mocap::pose {
 
-// One identified line: its name in the model and its four pixels in the model's order A..D.
+// One identified line: its name in the model and its four pixels in the model's order A..D;
+// a non-finite pixel is a marker not seen.
 struct ObservedLine {
   std::string name;
   std::array<Eigen::Vector2d, 4> pixels;

@@ -196,6 +196,35 @@ TEST(Identifier, SeveralBoardsDistractorsAndAnOccludedSide) {
   }
 }
 
+TEST(Identifier, ABoardWithAHiddenCornerKeepsTwoSidesAndItsOtherMarkers) {
+  ConstellationDatabase database = shipped_database();
+  ConstellationIdentifier identifier(database);
+  PinholeCamera camera = test_camera();
+  std::mt19937 random(13);
+  const ConstellationModel& model = database.constellations()[3];
+  Projected p = project(camera, model, board_pose({0, 0, 1.8}, 70, 20, 10), 0.05, random);
+  // The corner shared by lines 0 and 1 hides: two whole sides remain, and the other three
+  // markers of the broken ones.
+  int corner = model.lines[0].points[0];
+  for (int q : model.lines[1].points) {
+    for (int r : model.lines[0].points) {
+      if (q == r) corner = q;
+    }
+  }
+  p.pixels[p.truth[corner]] = {NAN, NAN};
+  auto found = identifier.identify(ideal(camera, p.pixels));
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].lines.size(), 2u);
+  EXPECT_EQ(found[0].points_identified(), 11);
+  std::vector<int> expected = p.truth;
+  expected[corner] = -1;
+  EXPECT_EQ(found[0].image_point_of, expected);
+  // Without the extra markers' help two sides are not enough.
+  IdentifierOptions strict;
+  strict.min_extra_markers = 0;
+  EXPECT_TRUE(ConstellationIdentifier(database, strict).identify(ideal(camera, p.pixels)).empty());
+}
+
 TEST(Identifier, RandomPointsAreNotABoard) {
   ConstellationDatabase database = shipped_database();
   ConstellationIdentifier identifier(database);
@@ -204,7 +233,7 @@ TEST(Identifier, RandomPointsAreNotABoard) {
   int false_identifications = 0;
   IdentificationStats stats;
   size_t matched_lines = 0;
-  for (int frame = 0; frame < 200; ++frame) {
+  for (int frame = 0; frame < 1000; ++frame) {
     std::vector<Eigen::Vector2d> points;
     for (int i = 0; i < 40; ++i) points.emplace_back(x(random), y(random));
     // Distractor lines: many collinear points at random spacings.

@@ -405,7 +405,9 @@ TEST(FiducialDetector, CircularityIsThatOfTheSubPixelOutlineAtTheThreshold) {
   auto block_circularity = [](int width, int height) {
     cv::Mat image(40, 40, CV_8U, cv::Scalar(0));
     image(cv::Rect(10, 10, width, height)).setTo(200);
-    auto found = detect_fiducials(image, accept_everything(8));
+    FiducialDetectorOptions options = accept_everything(8);
+    options.threshold_ratio = 0.75;
+    auto found = detect_fiducials(image, options);
     EXPECT_EQ(found.size(), 1u);
     return found.empty() ? 0.0 : found[0].circularity;
   };

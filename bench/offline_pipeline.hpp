@@ -1,0 +1,93 @@
+// The tracking pipeline as plain function calls (tracker -> identifier -> pose), without the
+// runtime: what the benchmarks time and score. The plugins call the same libraries.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <mocap/calibration/camera_model.hpp>
+
+#include "constellation_identifier.hpp"
+#include "fiducial_detector.hpp"
+#include "planar_pose.hpp"
+
+namespace mocap::bench {
+
+struct PipelineTimes {
+  double tracker_s = 0, identifier_s = 0, pose_s = 0;
+};
+
+// What became of a frame on its way, for the benchmarks' failure reports.
+struct PipelineTrace {
+  size_t fiducials = 0;
+  std::vector<std::string> identified;
+  std::vector<std::string> rejections;  // "name: why" of poses rejected
+};
+
+struct PipelinePose {
+  std::string name;
+  pose::PlanarPose pose;
+};
+
+class OfflinePipeline {
+ public:
+  OfflinePipeline(const constellations::ConstellationDatabase& database,
+                  std::shared_ptr<const calibration::CameraModel> camera)
+      : camera_(std::move(camera)), identifier_(database) {}
+
+  // Accepted poses of one image; `fiducials` and `times` report what happened on the way.
+  std::vector<PipelinePose> run(const cv::Mat& mono8, PipelineTimes* times = nullptr,
+                                PipelineTrace* trace = nullptr) {
+    using Clock = std::chrono::steady_clock;
+    auto t0 = Clock::now();
+    const auto& detected = detector_.detect(mono8);
+    auto t1 = Clock::now();
+    pixels_.clear();
+    ideal_.clear();
+    for (const auto& f : detected) {
+      Eigen::Vector2d pixel(f.x, f.y);
+      pixels_.push_back(pixel);
+      auto ray = camera_->unproject(pixel);
+      ideal_.push_back(ray ? Eigen::Vector2d(camera_->focal_length_px() * ray->head<2>())
+                           : Eigen::Vector2d::Constant(NAN));
+    }
+    auto found = identifier_.identify(ideal_);
+    auto t2 = Clock::now();
+    std::vector<PipelinePose> poses;
+    for (const auto& constellation : found) {
+      std::vector<Eigen::Vector3d> object;
+      std::vector<Eigen::Vector2d> image;
+      for (size_t m = 0; m < constellation.image_point_of.size(); ++m) {
+        int i = constellation.image_point_of[m];
+        if (i < 0) continue;
+        object.push_back(constellation.model->points[m]);
+        image.push_back(pixels_[i]);
+      }
+      pose::PlanarPose pose = pose::estimate_planar_pose(*camera_, object, image);
+      if (pose.valid) poses.push_back({constellation.model->name, pose});
+      if (trace) {
+        trace->identified.push_back(constellation.model->name);
+        if (!pose.valid)
+          trace->rejections.push_back(constellation.model->name + ": " + pose.rejection);
+      }
+    }
+    auto t3 = Clock::now();
+    if (times) {
+      times->tracker_s += std::chrono::duration<double>(t1 - t0).count();
+      times->identifier_s += std::chrono::duration<double>(t2 - t1).count();
+      times->pose_s += std::chrono::duration<double>(t3 - t2).count();
+    }
+    if (trace) trace->fiducials = detected.size();
+    return poses;
+  }
+
+ private:
+  std::shared_ptr<const calibration::CameraModel> camera_;
+  tracking::FiducialDetector detector_;
+  constellations::ConstellationIdentifier identifier_;
+  std::vector<Eigen::Vector2d> pixels_, ideal_;
+};
+
+}  // namespace mocap::bench
