@@ -7,13 +7,38 @@
 #include <string>
 #include <vector>
 
+#include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/camera_model.hpp>
 
 #include "constellation_identifier.hpp"
 #include "fiducial_detector.hpp"
 #include "planar_pose.hpp"
+#include "scene.hpp"
 
 namespace mocap::bench {
+
+// The shipped database and camera (config/), which the benchmarks measure with.
+struct ShippedConfiguration {
+  constellations::ConstellationDatabase database =
+      constellations::load_database(MOCAP_CONFIG_DIR "/constellations.yaml");
+  calibration::CameraFile camera =
+      calibration::load_camera_file(MOCAP_CONFIG_DIR "/cameras/synthetic_ir_1280x720.yaml");
+};
+
+// A board standing still at `position` (camera frame, metres), turned by `rpy_deg` from
+// facing the camera (synthetic/trajectory.hpp).
+inline synthetic::SceneObject static_board(const constellations::ConstellationModel& model,
+                                           const Eigen::Vector3d& position,
+                                           const Eigen::Vector3d& rpy_deg) {
+  synthetic::SceneObject object;
+  object.constellation = model.name;
+  object.markers = model.points;
+  synthetic::StaticTrajectory pose;
+  pose.position = position;
+  pose.rpy_deg = rpy_deg;
+  object.trajectory = pose;
+  return object;
+}
 
 struct PipelineTimes {
   double tracker_s = 0, identifier_s = 0, pose_s = 0;

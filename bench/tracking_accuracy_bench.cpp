@@ -11,8 +11,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <mocap/calibration/camera_file.hpp>
-
 #include "ir_renderer.hpp"
 #include "offline_pipeline.hpp"
 #include "pose_evaluation.hpp"
@@ -89,25 +87,13 @@ void score(const synthetic::RenderedFrame& frame, const std::vector<bench::Pipel
   }
 }
 
-synthetic::SceneObject board(const constellations::ConstellationModel& model,
-                             Eigen::Vector3d position, Eigen::Vector3d rpy_deg) {
-  synthetic::SceneObject object;
-  object.constellation = model.name;
-  object.markers = model.points;
-  synthetic::StaticTrajectory pose;
-  pose.position = position;
-  pose.rpy_deg = rpy_deg;
-  object.trajectory = pose;
-  return object;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
-  const std::string config = MOCAP_CONFIG_DIR;
-  auto database = constellations::load_database(config + "/constellations.yaml");
-  auto camera = calibration::load_camera_file(config + "/cameras/synthetic_ir_1280x720.yaml");
+  bench::ShippedConfiguration shipped;
+  const auto& database = shipped.database;
+  const auto& camera = shipped.camera;
   bench::OfflinePipeline pipeline(database, camera.model);
   const int frames_per_cell = quick ? 4 : 20;
   const std::vector<double> distances = {0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5};
@@ -138,7 +124,7 @@ int main(int argc, char** argv) {
           scene.seed = ++frame_number;
           scene.render.noise_sigma_dn = noise.noise_sigma_dn;
           scene.render.blur_sigma_px = noise.blur_sigma_px;
-          scene.objects.push_back(board(model, position, rpy));
+          scene.objects.push_back(bench::static_board(model, position, rpy));
           synthetic::IrRenderer renderer(scene, camera.model);
           synthetic::RenderedFrame frame = renderer.render(0.0, frame_number);
           bench::PipelineTrace trace;
@@ -210,9 +196,9 @@ int main(int argc, char** argv) {
     if (i % 2 == 0) {
       Eigen::Vector3d position((unit(random) - 0.5) * 1.0, (unit(random) - 0.5) * 0.5,
                                1.0 + unit(random) * 2);
-      scene.objects.push_back(
-          board(database.constellations()[i % 8], position,
-                {unit(random) * 360, unit(random) * 40 - 20, unit(random) * 40 - 20}));
+      scene.objects.push_back(bench::static_board(
+          database.constellations()[i % 8], position,
+          {unit(random) * 360, unit(random) * 40 - 20, unit(random) * 40 - 20}));
       if (i % 4 == 0) scene.objects.back().occlusion = synthetic::ObjectOcclusion{0.2};
     }
     synthetic::IrRenderer renderer(scene, camera.model);
@@ -246,9 +232,9 @@ int main(int argc, char** argv) {
     for (int b = 0; b < 8; ++b) {
       Eigen::Vector3d position(-1.05 + 0.7 * (b % 4) + (unit(random) - 0.5) * 0.1,
                                (b < 4 ? -0.3 : 0.3) + (unit(random) - 0.5) * 0.1, 2.5);
-      scene.objects.push_back(
-          board(database.constellations()[b], position,
-                {unit(random) * 360, unit(random) * 30 - 15, unit(random) * 30 - 15}));
+      scene.objects.push_back(bench::static_board(
+          database.constellations()[b], position,
+          {unit(random) * 360, unit(random) * 30 - 15, unit(random) * 30 - 15}));
     }
     synthetic::IrRenderer renderer(scene, camera.model);
     synthetic::RenderedFrame frame = renderer.render(0.0, frame_number);

@@ -8,8 +8,6 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include <mocap/calibration/camera_file.hpp>
-
 #include "ir_renderer.hpp"
 #include "offline_pipeline.hpp"
 
@@ -32,16 +30,10 @@ synthetic::Scene scene_with(const constellations::ConstellationDatabase& databas
   synthetic::Scene scene;
   scene.source = "bench";
   for (int b = 0; b < boards; ++b) {
-    const auto& model = database.constellations()[b];
-    synthetic::SceneObject object;
-    object.constellation = model.name;
-    object.markers = model.points;
-    synthetic::StaticTrajectory pose;
-    pose.position = Eigen::Vector3d(-0.9 + 0.6 * (b % 4), b < 4 ? -0.2 : 0.25, 2.0);
-    if (boards <= 2) pose.position.x() = -0.35 + 0.7 * b;
-    pose.rpy_deg = Eigen::Vector3d(10 + 25 * b, 15, -20);
-    object.trajectory = pose;
-    scene.objects.push_back(object);
+    Eigen::Vector3d position(-0.9 + 0.6 * (b % 4), b < 4 ? -0.2 : 0.25, 2.0);
+    if (boards <= 2) position.x() = -0.35 + 0.7 * b;
+    scene.objects.push_back(bench::static_board(database.constellations()[b], position,
+                                                Eigen::Vector3d(10 + 25 * b, 15, -20)));
   }
   return scene;
 }
@@ -72,9 +64,9 @@ void add_loose_markers(cv::Mat& image, int count, std::mt19937& random) {
 
 int main(int argc, char** argv) {
   bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
-  const std::string config = MOCAP_CONFIG_DIR;
-  auto database = constellations::load_database(config + "/constellations.yaml");
-  auto camera = calibration::load_camera_file(config + "/cameras/synthetic_ir_1280x720.yaml");
+  bench::ShippedConfiguration shipped;
+  const auto& database = shipped.database;
+  const auto& camera = shipped.camera;
   bench::OfflinePipeline pipeline(database, camera.model);
   const double seconds_per_row = quick ? 0.5 : 3.0;
 

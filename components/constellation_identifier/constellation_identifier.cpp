@@ -17,11 +17,12 @@ struct Candidate {
 };
 
 struct Fit {
+  Eigen::Matrix3d homography = Eigen::Matrix3d::Identity();  // plane to image
   double rms = 0;
   double max = 0;
 };
 
-// How well one plane-to-image homography explains the assigned points.
+// The plane-to-image homography of the assigned points and how well it explains them.
 std::optional<Fit> plane_fit(const ConstellationModel& model, const std::vector<int>& image_of,
                              const std::vector<Eigen::Vector2d>& points) {
   std::vector<Eigen::Vector2d> from, to;
@@ -33,6 +34,7 @@ std::optional<Fit> plane_fit(const ConstellationModel& model, const std::vector<
   auto h = fit_homography(from, to);
   if (!h) return std::nullopt;
   Fit fit;
+  fit.homography = *h;
   for (size_t i = 0; i < from.size(); ++i) {
     double e = (apply_homography(*h, from[i]) - to[i]).norm();
     fit.rms += e * e;
@@ -40,18 +42,6 @@ std::optional<Fit> plane_fit(const ConstellationModel& model, const std::vector<
   }
   fit.rms = std::sqrt(fit.rms / static_cast<double>(from.size()));
   return fit;
-}
-
-std::optional<Eigen::Matrix3d> plane_homography(const ConstellationModel& model,
-                                                const std::vector<int>& image_of,
-                                                const std::vector<Eigen::Vector2d>& points) {
-  std::vector<Eigen::Vector2d> from, to;
-  for (size_t m = 0; m < image_of.size(); ++m) {
-    if (image_of[m] < 0) continue;
-    from.push_back(model.plane_points[m]);
-    to.push_back(points[image_of[m]]);
-  }
-  return fit_homography(from, to);
 }
 
 // Finds one constellation among the candidates: hypothesise from two lines that share a
@@ -148,12 +138,12 @@ class ConstellationSearch {
   // whole lines is good to a fraction of a pixel, and a tight radius keeps stray points from
   // confirming a chance pair of lines); returns how many.
   int complete_with_markers() {
-    auto h = plane_homography(model_, best_image_of_, points_);
-    if (!h) return 0;
+    auto fit = plane_fit(model_, best_image_of_, points_);
+    if (!fit) return 0;
     int added = 0;
     for (size_t m = 0; m < best_image_of_.size(); ++m) {
       if (best_image_of_[m] >= 0) continue;
-      Eigen::Vector2d predicted = apply_homography(*h, model_.plane_points[m]);
+      Eigen::Vector2d predicted = apply_homography(fit->homography, model_.plane_points[m]);
       int nearest = -1;
       double nearest_distance = options_.max_fit_error_px / 3;
       for (size_t i = 0; i < points_.size(); ++i) {
@@ -171,7 +161,7 @@ class ConstellationSearch {
       }
     }
     if (added > 0) {
-      if (auto fit = plane_fit(model_, best_image_of_, points_)) best_fit_ = *fit;
+      if (auto refit = plane_fit(model_, best_image_of_, points_)) best_fit_ = *refit;
     }
     return added;
   }
@@ -232,7 +222,7 @@ class ConstellationSearch {
   // puts it, then scores the whole.
   void extend_and_evaluate() {
     std::vector<size_t> added;
-    std::optional<Eigen::Matrix3d> h;
+    std::optional<Fit> fit;
     bool stale = true;
     for (size_t line = 0; line < model_.lines.size(); ++line) {
       if (chosen_[line].candidate != nullptr) continue;
@@ -247,13 +237,13 @@ class ConstellationSearch {
       }
       if (range.first == range.second) continue;
       if (stale) {
-        h = plane_homography(model_, image_of_, points_);
+        fit = plane_fit(model_, image_of_, points_);
         stale = false;
       }
-      if (!h) break;
+      if (!fit) break;
       std::array<Eigen::Vector2d, 4> predicted;
       for (int k = 0; k < 4; ++k) {
-        predicted[k] = apply_homography(*h, model_.plane_points[model_line.points[k]]);
+        predicted[k] = apply_homography(fit->homography, model_.plane_points[model_line.points[k]]);
       }
       // The candidate whose points lie closest to where the plane puts this line.
       double best_error = options_.max_fit_error_px;

@@ -8,6 +8,7 @@
 
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/constellation_array.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
@@ -26,10 +27,6 @@ constexpr const char* kPoses = "/mocap/poses";
 constexpr const char* kOverlay = "/mocap/overlay";
 // Frames waiting for their poses; older ones are dropped.
 constexpr size_t kPendingFrames = 30;
-
-int64_t stamp_ns(const std_msgs::msg::Header& header) {
-  return static_cast<int64_t>(header.stamp().sec()) * 1'000'000'000 + header.stamp().nanosec();
-}
 
 class OverlayComponent final : public Component {
  public:
@@ -61,16 +58,16 @@ class OverlayComponent final : public Component {
     publisher_ = create_publisher<sensor_msgs::msg::Image>(kOverlay);
     create_subscription<sensor_msgs::msg::Image>(
         kImage, [this](const std::shared_ptr<const sensor_msgs::msg::Image>& image) {
-          keep(frames_[stamp_ns(image->header())]).image = image;
+          keep(frames_[to_nanoseconds(image->header().stamp())]).image = image;
         });
     create_subscription<mocap_msgs::msg::FiducialArray>(
         kFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
-          auto& fiducials = keep(frames_[stamp_ns(array.header())]).content.fiducials;
+          auto& fiducials = keep(frames_[to_nanoseconds(array.header().stamp())]).content.fiducials;
           for (const auto& f : array.fiducials()) fiducials.emplace_back(f.x(), f.y());
         });
     create_subscription<mocap_msgs::msg::ConstellationArray>(
         kConstellations, [this](const mocap_msgs::msg::ConstellationArray& array) {
-          auto& frame = keep(frames_[stamp_ns(array.header())]).content;
+          auto& frame = keep(frames_[to_nanoseconds(array.header().stamp())]).content;
           for (const auto& c : array.constellations()) {
             OverlayConstellation constellation{c.name(), {}};
             for (const auto& sub : c.sub_constellations()) {
@@ -99,7 +96,7 @@ class OverlayComponent final : public Component {
   }
 
   void draw(const mocap_msgs::msg::ConstellationPoseArray& poses) {
-    auto found = frames_.find(stamp_ns(poses.header()));
+    auto found = frames_.find(to_nanoseconds(poses.header().stamp()));
     if (found == frames_.end() || !found->second.image) return;
     Pending pending = std::move(found->second);
     frames_.erase(frames_.begin(), std::next(found));

@@ -15,10 +15,6 @@ namespace {
 constexpr const char* kTruth = "/camera/ir/ground_truth";
 constexpr const char* kPoses = "/mocap/poses";
 
-int64_t stamp_ns(const std_msgs::msg::Header& header) {
-  return static_cast<int64_t>(header.stamp().sec()) * 1'000'000'000 + header.stamp().nanosec();
-}
-
 std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array) {
   std::vector<ObjectPose> out;
   for (const auto& pose : array.poses()) {
@@ -68,14 +64,14 @@ class PoseEvaluatorComponent final : public Component {
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
           ++truth_arrays_;
-          evaluator_.add_truth(stamp_ns(truth.header()), objects(truth));
+          evaluator_.add_truth(to_nanoseconds(truth.header().stamp()), objects(truth));
           check_done();
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
           latencies_s_.push_back(
               std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());
-          evaluator_.add_estimate(stamp_ns(poses.header()), objects(poses));
+          evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses));
           check_done();
         });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 
 #include <builtin_interfaces/msg/time.hpp>
 
@@ -27,6 +28,11 @@ typename Clock::time_point from_time_msg(const builtin_interfaces::msg::Time& ms
   auto since_epoch = std::chrono::seconds(msg.sec()) + std::chrono::nanoseconds(msg.nanosec());
   return
       typename Clock::time_point(std::chrono::duration_cast<typename Clock::duration>(since_epoch));
+}
+
+// A stamp as one integer, to pair messages of the same frame (an image and its results).
+inline int64_t to_nanoseconds(const builtin_interfaces::msg::Time& msg) {
+  return static_cast<int64_t>(msg.sec()) * 1000000000 + msg.nanosec();
 }
 
 }  // namespace mocap
