@@ -251,12 +251,6 @@ TEST(VideoDeviceSource, MissingDevicesAreErrorsNamingTheDevice) {
 
 class CameraSourcePlugin : public testing::Test {
  protected:
-  void SetUp() override {
-    if (!fs::exists(test::bin_dir().parent_path() / "lib" / "libmocap_plugin_camera_source.so")) {
-      GTEST_SKIP() << "build mocap_plugin_camera_source first";
-    }
-  }
-
   // Runs a one-group graph holding camera_source with `parameters` (YAML flow map body).
   std::pair<int, std::string> run(const std::string& parameters, double seconds = 2) {
     test::write_file(dir_ / "graph.yaml", fmt::format(R"(dds: {{enabled: false}}
