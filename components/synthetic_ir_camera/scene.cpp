@@ -15,27 +15,12 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <mocap/spelling.hpp>
 
 namespace mocap::synthetic {
 namespace {
 
 using Keys = std::initializer_list<std::string_view>;
-
-// Edits between two short words: finds the key a typo meant.
-size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
 
 // Reads one scene document; every error names the source and the line of the node at fault.
 class SceneReader {
@@ -83,18 +68,8 @@ class SceneReader {
       std::string name = key.IsScalar() ? key.Scalar() : std::string("(not a word)");
       if (!seen.insert(name).second) fail(key, fmt::format("'{}' appears twice in {}", name, what));
       if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-      std::string_view nearest;
-      size_t nearest_distance = 3;  // suggest only near misses
-      for (std::string_view candidate : allowed) {
-        size_t distance = edit_distance(name, candidate);
-        if (distance < nearest_distance) {
-          nearest_distance = distance;
-          nearest = candidate;
-        }
-      }
-      std::string hint = nearest.empty() ? "" : fmt::format(" (did you mean '{}'?)", nearest);
-      fail(key, fmt::format("unknown key '{}' in {}{}; expected one of: {}", name, what, hint,
-                            fmt::join(allowed, ", ")));
+      fail(key, fmt::format("unknown key '{}' in {}{}", name, what,
+                            did_you_mean(name, {allowed.begin(), allowed.end()}, "keys")));
     }
   }
 

@@ -335,9 +335,12 @@ TEST(SceneFile, ErrorsNameTheFileTheLineAndTheProblem) {
       "    trajectory: {type: static, position: [0, 0, 1]}\n";
   // An unknown key, with the key it probably meant.
   EXPECT_EQ(scene_error(std::string(kObject) + "render:\n  exposre: 2\n"),
-            "bad.yaml:5: unknown key 'exposre' in 'render' (did you mean 'exposure'?); expected "
-            "one of: marker_diameter_m, exposure, background_dn, noise_sigma_dn, blur_sigma_px, "
-            "motion_blur_s, motion_blur_steps, supersampling");
+            "bad.yaml:5: unknown key 'exposre' in 'render' (did you mean 'exposure'?)");
+  // Far from every key: the keys it may be.
+  EXPECT_EQ(scene_error(std::string(kObject) + "render:\n  brightness: 2\n"),
+            "bad.yaml:5: unknown key 'brightness' in 'render' (keys: marker_diameter_m, exposure, "
+            "background_dn, noise_sigma_dn, blur_sigma_px, motion_blur_s, motion_blur_steps, "
+            "supersampling)");
   EXPECT_EQ(scene_error("objects:\n"
                         "  - constellation: board_z\n"
                         "    trajectory: {type: static, position: [0, 0, 1]}\n"),
