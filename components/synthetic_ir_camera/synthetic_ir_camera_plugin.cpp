@@ -59,6 +59,9 @@ class SyntheticIrCamera final : public Component {
         .range(0, 3600);
     spec.parameter("frame_id", std::string(), "frame id of the headers; empty = the camera file's");
     spec.parameter("max_frames", 0, "frames to publish before stopping; 0 = no limit").min(0);
+    spec.parameter("wait_for_subscriber", true,
+                   "hold the first frame until the image topic has a subscriber, so a run "
+                   "across processes starts with frame 0 however long discovery takes");
     spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
                                             "rendered frames, mono8");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
@@ -79,6 +82,7 @@ class SyntheticIrCamera final : public Component {
     frame_id_ = param<std::string>("frame_id");
     if (frame_id_.empty()) frame_id_ = camera.frame_id;
     max_frames_ = param<int64_t>("max_frames");
+    wait_for_subscriber_ = param<bool>("wait_for_subscriber");
     double rate_hz = param<double>("rate_hz");
     time_step_s_ = param<double>("time_step_s");
     if (time_step_s_ == 0) time_step_s_ = rate_hz > 0 ? 1 / rate_hz : kDefaultTimeStep_s;
@@ -98,6 +102,14 @@ class SyntheticIrCamera final : public Component {
 
  private:
   void tick() {
+    if (wait_for_subscriber_) {
+      if (images_.matched_subscribers() == 0) {
+        if (!reported_waiting_) log().info("waiting for a subscriber on {}", images_.topic());
+        reported_waiting_ = true;
+        return;
+      }
+      wait_for_subscriber_ = false;
+    }
     if (max_frames_ > 0 && frames_ >= static_cast<uint64_t>(max_frames_)) {
       if (!reported_end_) {
         log().info("published {} frames (max_frames); no more", frames_);
@@ -143,6 +155,8 @@ class SyntheticIrCamera final : public Component {
   std::unique_ptr<IrRenderer> renderer_;
   std::string frame_id_;
   int64_t max_frames_ = 0;
+  bool wait_for_subscriber_ = true;
+  bool reported_waiting_ = false;
   double time_step_s_ = 0;
   uint64_t frames_ = 0;
   bool reported_end_ = false;
