@@ -5,6 +5,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fmt/format.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "test_support.hpp"
 
@@ -73,14 +75,31 @@ void expect_accurate(const std::filesystem::path& summary_file, int frames) {
 TEST(TrackingPipeline, InOneProcess) {
   test::TempDir dir;
   constexpr int kFrames = 60;
+  // With the overlay saving a snapshot every frame.
+  std::string overlay = fmt::format(R"(
+      - plugin: overlay
+        name: overlay
+        parameters:
+          snapshot_directory: {}
+          snapshot_period_s: 0.01
+)",
+                                    (dir / "snapshots").string());
   test::write_file(dir / "pipeline.yaml",
-                   pipeline_launch_file(dir / "summary.yaml", kFrames, false, 0));
+                   pipeline_launch_file(dir / "summary.yaml", kFrames, false, 0) + overlay);
   auto [code, output] = test::run_command({launcher(), (dir / "pipeline.yaml").string()}, {},
                                           std::chrono::seconds(120));
   ASSERT_EQ(code, 0) << output;
   expect_accurate(dir / "summary.yaml", kFrames);
   // The evaluator's final table.
   EXPECT_NE(output.find("| frames | lost | tracked |"), std::string::npos) << output;
+  // The overlay's pictures: colour frames of the camera's size with the boards drawn on them.
+  cv::Mat picture = cv::imread((dir / "snapshots" / "overlay_00000.png").string());
+  ASSERT_FALSE(picture.empty()) << output;
+  EXPECT_EQ(picture.cols, 1280);
+  EXPECT_EQ(picture.rows, 720);
+  cv::Mat green;
+  cv::inRange(picture, cv::Scalar(0, 150, 0), cv::Scalar(60, 255, 60), green);
+  EXPECT_GT(cv::countNonZero(green), 200);  // identified lines and their names
 }
 
 TEST(TrackingPipeline, CameraAndTrackingInTwoProcesses) {
