@@ -39,13 +39,19 @@ class ConstellationIdentifierComponent final : public Component {
     spec.parameter("line_tolerance_px", 1.5, "largest distance of a point from its line, pixels")
         .range(0.01, 100);
     spec.parameter("min_lines", 3, "fewest lines that identify a constellation").range(1, 64);
+    spec.parameter("min_extra_markers", 2,
+                   "with two whole lines only, markers that must lie where their plane puts "
+                   "them (a board with a hidden corner); 0 = never identify from two lines")
+        .range(0, 1000);
     spec.parameter("max_fit_error_px", 3.0,
                    "largest distance of a point from the constellation's plane fit, pixels")
         .range(0.01, 1000);
     spec.subscribes<mocap_msgs::msg::FiducialArray>(kInput, Qos::reliable(),
                                                     "fiducials of one image, pixels");
     spec.publishes<mocap_msgs::msg::ConstellationArray>(
-        kOutput, Qos::reliable(), "constellations identified in each fiducial array");
+        kOutput, Qos::reliable(),
+        "constellations identified in each fiducial array: each line's fiducials in database "
+        "order, NaN for a marker not seen");
   }
 
   explicit ConstellationIdentifierComponent(Context& context) : Component(context) {
@@ -58,6 +64,7 @@ class ConstellationIdentifierComponent final : public Component {
     options.cross_ratio_tolerance = param<double>("cross_ratio_tolerance");
     options.line_search.tolerance_px = param<double>("line_tolerance_px");
     options.min_lines = param<int>("min_lines");
+    options.min_extra_markers = param<int>("min_extra_markers");
     options.max_fit_error_px = param<double>("max_fit_error_px");
     identifier_.emplace(database_, options);
     for (const std::string& problem : database_.ambiguities(options.cross_ratio_tolerance)) {
