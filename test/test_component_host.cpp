@@ -16,6 +16,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 #include "fastdds_transport.hpp"
+#include "names.hpp"
 
 namespace mocap {
 namespace {
@@ -103,6 +104,83 @@ TEST_F(ComponentHostTest, RemapsConnectTopics) {
   host.add(kSink, {.name = "sink", .remaps = {{"/numbers", "/renamed"}}});
   EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
   EXPECT_EQ(record.received.size(), 50u);  // all from "sink"
+}
+
+// Publishes on one topic of the family /cameras/{camera}/numbers, chosen by a parameter.
+class FamilySource final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.parameter("camera", std::string("left"), "which topic of the family");
+    spec.publishes<Array>("/cameras/{camera}/numbers", Qos::reliable(), "");
+  }
+  explicit FamilySource(Context& context) : Component(context) {
+    publisher_ = create_publisher<Array>("/cameras/" + param<std::string>("camera") + "/numbers");
+    create_timer(std::chrono::milliseconds(1), [this] {
+      if (publisher_.matched_subscribers() == 0 || sent_ == 50) return;
+      auto message = std::make_shared<Array>();
+      message->header().frame_id(publisher_.topic());
+      ++sent_;
+      publisher_.publish(std::move(message));
+    });
+  }
+
+ private:
+  Publisher<Array> publisher_;
+  int sent_ = 0;
+};
+
+TEST_F(ComponentHostTest, TopicFamiliesAreInstantiatedAndRemappedByTheirPlaceholders) {
+  ComponentHost host(in_process());
+  // The family remapped with its placeholder: the source's /cameras/right/numbers becomes
+  // /right/numbers, where the sink reads.
+  host.add(make_component_factory<FamilySource>("family_source"),
+           {.name = "right",
+            .parameters = {{"camera", std::string("right")}},
+            .remaps = {{"/cameras/{camera}/numbers", "/{camera}/numbers"}}});
+  host.add(kSink, {.name = "sink", .remaps = {{"/numbers", "/right/numbers"}}});
+  EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
+  EXPECT_EQ(record.received.size(), 50u);
+}
+
+TEST(TopicFamilies, NamesMatchSegmentBySegment) {
+  EXPECT_EQ(match_topic_family("/pixart/{camera}/fiducials", "/pixart/cam_0/fiducials"),
+            std::vector<std::string>{"cam_0"});
+  EXPECT_FALSE(match_topic_family("/pixart/{camera}/fiducials", "/pixart/a/b/fiducials"));
+  EXPECT_FALSE(match_topic_family("/pixart/{camera}/fiducials", "/pixart/cam0/raw"));
+  EXPECT_EQ(instantiate_topic_family("/{a}/x/{b}", {"1", "2"}), "/1/x/2");
+  EXPECT_TRUE(topics_overlap("/pixart/{camera}/fiducials", "/pixart/cam0/fiducials"));
+  EXPECT_TRUE(topics_overlap("/pixart/{camera}/fiducials", "/pixart/{c}/fiducials"));
+  EXPECT_FALSE(topics_overlap("/pixart/{camera}/fiducials", "/mocap/fiducials"));
+  EXPECT_FALSE(topics_overlap("/a/b", "/a/c"));
+  EXPECT_TRUE(valid_topic_family("/a/{b}/c"));
+  EXPECT_FALSE(valid_topic_family("/a/{b}x/c"));
+}
+
+TEST(TopicFamilies, TopicsOfAFamilyMustMatchItAndRemapsKeepItsPlaceholders) {
+  ComponentSpec spec;
+  FamilySource::declare(spec);
+  EXPECT_TRUE(
+      check_component_config(
+          spec, {.name = "s", .remaps = {{"/cameras/{camera}/numbers", "/{camera}/numbers"}}})
+          .empty());
+  auto problems = check_component_config(
+      spec, {.name = "s", .remaps = {{"/cameras/{camera}/numbers", "/all/numbers"}}});
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("must be a topic family with 1 placeholder(s)"), std::string::npos)
+      << problems[0];
+  ComponentSpec bad;
+  EXPECT_THROW(bad.publishes<Array>("/cameras/x{camera}/numbers", Qos::reliable(), ""),
+               std::logic_error);
+  // A topic outside the family is refused when the component asks for it.
+  class Stray final : public Component {
+   public:
+    static void declare(ComponentSpec& s) { FamilySource::declare(s); }
+    explicit Stray(Context& context) : Component(context) {
+      create_publisher<Array>("/cameras/left/other");
+    }
+  };
+  ComponentHost host(in_process());
+  EXPECT_THROW(host.add(make_component_factory<Stray>("stray"), {.name = "stray"}), ComponentError);
 }
 
 TEST_F(ComponentHostTest, QosOverrideThatCannotMatchDeliversNothing) {

@@ -103,7 +103,15 @@ std::vector<std::string> check_component_config(const ComponentSpec& spec,
       problems.push_back(fmt::format("remap of unknown topic '{}'{}", from,
                                      did_you_mean(from, topic_names, "topics")));
     }
-    if (!valid_topic_name(to)) {
+    if (is_topic_family(from)) {
+      // A family maps to a family with the same placeholders, in the same order.
+      auto count = [](std::string_view t) { return std::count(t.begin(), t.end(), '{'); };
+      if (!valid_topic_family(to) || count(to) != count(from)) {
+        problems.push_back(
+            fmt::format("remap target '{}' must be a topic family with {} placeholder(s) like '{}'",
+                        to, count(from), from));
+      }
+    } else if (!valid_topic_name(to)) {
       problems.push_back(fmt::format("remap target '{}' is not a topic name (like /a/b_c)", to));
     }
   }
@@ -222,6 +230,12 @@ class ComponentHost::Impl::ComponentContext final : public Context {
  private:
   Endpoint resolve(std::string_view topic, const MessageType& type, TopicDirection direction) {
     const TopicSpec* declared = spec_.find_topic(topic);
+    // A topic of a declared family: its placeholders' values carry over to a remap.
+    std::optional<std::vector<std::string>> family_values;
+    for (const TopicSpec& t : spec_.topics()) {
+      if (declared != nullptr || !is_topic_family(t.topic)) continue;
+      if ((family_values = match_topic_family(t.topic, topic))) declared = &t;
+    }
     std::string_view verb = direction == TopicDirection::Publish ? "publishes" : "subscribes";
     if (declared == nullptr) {
       throw std::logic_error(
@@ -235,9 +249,10 @@ class ComponentHost::Impl::ComponentContext final : public Context {
                       verb, topic, type.name(), declared->type->name(),
                       declared->direction == TopicDirection::Publish ? "published" : "subscribed"));
     }
-    Endpoint endpoint{declared->topic, &type, declared->qos, config_.name};
+    Endpoint endpoint{std::string(topic), &type, declared->qos, config_.name};
     if (auto it = config_.remaps.find(declared->topic); it != config_.remaps.end()) {
-      endpoint.topic = it->second;
+      endpoint.topic =
+          family_values ? instantiate_topic_family(it->second, *family_values) : it->second;
     }
     if (auto it = config_.qos.find(declared->topic); it != config_.qos.end()) {
       endpoint.qos = it->second;

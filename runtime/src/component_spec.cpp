@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "names.hpp"
+
 namespace mocap {
 
 ParameterSpec& ComponentSpec::ParameterDeclaration::parameter() {
@@ -65,6 +67,10 @@ void ComponentSpec::add_topic(TopicSpec topic) {
   }
   if (!topic.topic.starts_with('/')) {
     throw std::logic_error(fmt::format("topic '{}' must start with '/'", topic.topic));
+  }
+  if (is_topic_family(topic.topic) && !valid_topic_family(topic.topic)) {
+    throw std::logic_error(fmt::format(
+        "topic family '{}': placeholders are whole segments like /a/{{name}}/b", topic.topic));
   }
   if (topic.qos.depth < 1) {
     throw std::logic_error(fmt::format("topic '{}' has QoS depth {}; it must be at least 1",

@@ -135,13 +135,34 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
   return qos;
 }
 
+struct TopicUse {
+  const TopicSpec* spec;
+  Qos qos;
+  const LaunchComponent* component;
+};
+
+// Subscribers in `subscribers` that no publisher in `publishers` can serve.
+void check_qos(const std::string& topic, const std::vector<TopicUse>& subscribers,
+               const std::vector<TopicUse>& publishers, Problems& problems) {
+  for (const TopicUse& subscriber : subscribers) {
+    if (subscriber.spec->direction != TopicDirection::Subscribe) continue;
+    for (const TopicUse& publisher : publishers) {
+      if (publisher.spec->direction != TopicDirection::Publish) continue;
+      if (auto why = qos_mismatch(publisher.qos, subscriber.qos)) {
+        problems.add(subscriber.component->line,
+                     fmt::format("topic '{}': component '{}' ({}) would receive nothing from "
+                                 "component '{}' (line {}, {}): {}",
+                                 topic, subscriber.component->config.name,
+                                 subscriber.qos.to_string(), publisher.component->config.name,
+                                 publisher.component->line, publisher.qos.to_string(), *why));
+      }
+    }
+  }
+}
+
 // Checks across the whole file (every group): one type per topic, and QoS that can match.
 void check_topics(const std::vector<const LaunchComponent*>& components, Problems& problems) {
-  struct Use {
-    const TopicSpec* spec;
-    Qos qos;
-    const LaunchComponent* component;
-  };
+  using Use = TopicUse;
   std::map<std::string, std::vector<Use>> uses;
   for (const LaunchComponent* component : components) {
     const ComponentConfig& config = component->config;
@@ -152,32 +173,26 @@ void check_topics(const std::vector<const LaunchComponent*>& components, Problem
           {&topic, qos == config.qos.end() ? topic.qos : qos->second, component});
     }
   }
-  for (const auto& [topic, list] : uses) {
-    const Use& first = list.front();
-    for (const Use& use : list) {
-      if (use.spec->type != first.spec->type) {
-        problems.add(use.component->line,
-                     fmt::format("topic '{}' is {} for component '{}' but {} for component '{}' "
-                                 "(line {})",
-                                 topic, use.spec->type->name(), use.component->config.name,
-                                 first.spec->type->name(), first.component->config.name,
-                                 first.component->line));
-        break;
-      }
-    }
-    for (const Use& subscriber : list) {
-      if (subscriber.spec->direction != TopicDirection::Subscribe) continue;
-      for (const Use& publisher : list) {
-        if (publisher.spec->direction != TopicDirection::Publish) continue;
-        if (auto why = qos_mismatch(publisher.qos, subscriber.qos)) {
-          problems.add(subscriber.component->line,
-                       fmt::format("topic '{}': component '{}' ({}) would receive nothing from "
-                                   "component '{}' (line {}, {}): {}",
-                                   topic, subscriber.component->config.name,
-                                   subscriber.qos.to_string(), publisher.component->config.name,
-                                   publisher.component->line, publisher.qos.to_string(), *why));
+  // A family ("/pixart/{camera}/fiducials") shares its type and QoS rules with every topic
+  // it can produce, so uses are compared across overlapping names, not only equal ones.
+  for (auto a = uses.begin(); a != uses.end(); ++a) {
+    for (auto b = a; b != uses.end(); ++b) {
+      if (!topics_overlap(a->first, b->first)) continue;
+      const std::string& topic = a->first == b->first ? a->first : b->first;
+      const Use& first = a->second.front();
+      for (const Use& use : b->second) {
+        if (use.spec->type != first.spec->type) {
+          problems.add(use.component->line,
+                       fmt::format("topic '{}' is {} for component '{}' but {} for component "
+                                   "'{}' (line {})",
+                                   topic, use.spec->type->name(), use.component->config.name,
+                                   first.spec->type->name(), first.component->config.name,
+                                   first.component->line));
+          break;
         }
       }
+      check_qos(topic, a->second, b->second, problems);
+      if (a != b) check_qos(topic, b->second, a->second, problems);
     }
   }
 }

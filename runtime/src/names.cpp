@@ -33,6 +33,80 @@ bool valid_topic_name(std::string_view topic) {
   });
 }
 
+namespace {
+
+std::vector<std::string_view> segments(std::string_view topic) {
+  std::vector<std::string_view> out;
+  size_t start = 1;  // after the leading '/'
+  while (start <= topic.size()) {
+    size_t end = topic.find('/', start);
+    if (end == std::string_view::npos) end = topic.size();
+    out.push_back(topic.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+bool is_placeholder(std::string_view segment) {
+  return segment.size() > 2 && segment.front() == '{' && segment.back() == '}';
+}
+
+}  // namespace
+
+bool is_topic_family(std::string_view topic) { return topic.find('{') != std::string_view::npos; }
+
+bool valid_topic_family(std::string_view family) {
+  if (family.size() < 2 || family.front() != '/') return false;
+  for (std::string_view segment : segments(family)) {
+    if (segment.empty()) return false;
+    std::string_view word =
+        is_placeholder(segment) ? segment.substr(1, segment.size() - 2) : segment;
+    bool plain = std::all_of(word.begin(), word.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    });
+    if (!plain) return false;
+  }
+  return true;
+}
+
+std::optional<std::vector<std::string>> match_topic_family(std::string_view family,
+                                                           std::string_view topic) {
+  if (!valid_topic_name(topic)) return std::nullopt;
+  std::vector<std::string_view> pattern = segments(family), parts = segments(topic);
+  if (pattern.size() != parts.size()) return std::nullopt;
+  std::vector<std::string> values;
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    if (is_placeholder(pattern[i])) {
+      values.emplace_back(parts[i]);
+    } else if (pattern[i] != parts[i]) {
+      return std::nullopt;
+    }
+  }
+  return values;
+}
+
+std::string instantiate_topic_family(std::string_view family,
+                                     const std::vector<std::string>& values) {
+  std::string topic;
+  size_t next = 0;
+  for (std::string_view segment : segments(family)) {
+    topic += '/';
+    topic += is_placeholder(segment) && next < values.size() ? std::string_view(values[next++])
+                                                             : segment;
+  }
+  return topic;
+}
+
+bool topics_overlap(std::string_view a, std::string_view b) {
+  if (a == b) return true;
+  std::vector<std::string_view> x = segments(a), y = segments(b);
+  if (x.size() != y.size()) return false;
+  for (size_t i = 0; i < x.size(); ++i) {
+    if (x[i] != y[i] && !is_placeholder(x[i]) && !is_placeholder(y[i])) return false;
+  }
+  return is_topic_family(a) || is_topic_family(b);
+}
+
 bool valid_component_name(std::string_view name) {
   return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
