@@ -1,0 +1,187 @@
+// pixart_bridge: PixArt points from a CAN bus (can_source.hpp, pixart_decoder.hpp), published
+// raw and as one FiducialArray per camera sample, so that downstream components treat each
+// PixArt sensor like any camera.
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <thread>
+
+#include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+#include <mocap_msgs/msg/pixart_raw_point_array.hpp>
+
+#include "camera_samples.hpp"
+#include "can_source.hpp"
+#include "pixart_decoder.hpp"
+
+namespace mocap::pixart {
+namespace {
+
+constexpr const char* kRawTopic = "/pixart/raw";
+constexpr const char* kFiducialFamily = "/pixart/{camera}/fiducials";
+// Uncertainty of a PixArt coordinate: the sensor reports whole pixels (1/sqrt(12) px).
+constexpr float kQuantisationPx = 0.29f;
+
+class PixartBridge final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Reads PixArt IR sensors' points from a CAN bus (SLCAN adaptor, SocketCAN or a candump "
+        "log), publishes them raw and as one fiducial array per camera sample.");
+    spec.parameter("source", std::string("slcan"), "slcan, socketcan or candump");
+    spec.parameter("device", std::string("/dev/ttyACM0"), "slcan: the adaptor's serial device")
+        .path();
+    spec.parameter("bitrate", 1000000, "slcan: CAN bitrate, bit/s").range(10000, 1000000);
+    spec.parameter("baud", 115200, "slcan: serial baud rate (USB adaptors ignore it)")
+        .range(9600, 3000000);
+    spec.parameter("interface", std::string("can0"), "socketcan: the CAN interface");
+    spec.parameter("file", std::string(), "candump: a `candump -L` log").path();
+    spec.parameter("recorded_timing", true,
+                   "candump: replay at the recorded pace (false: as fast as possible)");
+    spec.parameter("base_id", 0x100, "CAN ID of box 0, camera 0, points 0-1").range(0, 0x7FF);
+    spec.parameter("boxes", 8, "camera boxes on the bus (4 cameras each)").range(1, 64);
+    spec.parameter("camera_names", std::vector<std::string>{},
+                   "name of camera 0, 1, ...: topic and frame id; others are camera<N>");
+    spec.publishes<mocap_msgs::msg::PixartRawPointArray>(
+        kRawTopic, Qos::reliable(), "the points decoded from each batch of frames read");
+    spec.publishes<mocap_msgs::msg::FiducialArray>(
+        kFiducialFamily, Qos::reliable(),
+        "one array per camera sample (up to 4 points, pixels), frame id = camera name");
+  }
+
+  explicit PixartBridge(Context& context)
+      : Component(context),
+        decoder_(PixartDecoderOptions{static_cast<uint32_t>(param<int>("base_id")),
+                                      param<int>("boxes")}) {
+    source_kind_ = param<std::string>("source");
+    if (source_kind_ != "slcan" && source_kind_ != "socketcan" && source_kind_ != "candump") {
+      throw std::invalid_argument("parameter 'source' is '" + source_kind_ +
+                                  "'; expected slcan, socketcan or candump");
+    }
+    camera_names_ = param<std::vector<std::string>>("camera_names");
+    raw_ = create_publisher<mocap_msgs::msg::PixartRawPointArray>(kRawTopic);
+    for (int camera = 0; camera < 4 * param<int>("boxes"); ++camera) {
+      fiducials_.push_back(create_publisher<mocap_msgs::msg::FiducialArray>(
+          "/pixart/" + camera_name(camera) + "/fiducials"));
+    }
+    // A log must exist now: a typo is an error at start, not a retry loop.
+    if (source_kind_ == "candump") source_ = open();
+    reader_ = std::thread([this] { read_loop(); });
+  }
+
+  ~PixartBridge() override {
+    stop_ = true;
+    if (reader_.joinable()) reader_.join();
+    const PixartDecodeStats& s = decoder_.stats();
+    log().info(
+        "{} frames, {} points; {} frames of the wrong length, {} of unknown IDs, {} invalid "
+        "points, {} incomplete samples, {} read errors",
+        s.frames, s.points, s.wrong_length, s.unknown_id, s.invalid_points,
+        assembler_.incomplete_samples(), read_errors_);
+  }
+
+ private:
+  std::string camera_name(int camera) const {
+    if (camera < static_cast<int>(camera_names_.size())) return camera_names_[camera];
+    return "camera" + std::to_string(camera);
+  }
+
+  std::unique_ptr<can::CanSource> open() {
+    if (source_kind_ == "slcan") {
+      return can::open_slcan(
+          {param<std::string>("device"), param<int>("bitrate"), param<int>("baud")});
+    }
+    if (source_kind_ == "socketcan") return can::open_socketcan(param<std::string>("interface"));
+    return can::open_candump({param<std::string>("file"), param<bool>("recorded_timing")});
+  }
+
+  // Reads until stopped; a device that fails is reopened with back-off (0.1 s doubling to
+  // 2 s), so unplugging the adaptor costs the frames of the gap and nothing else.
+  void read_loop() {
+    std::chrono::milliseconds backoff(100);
+    bool reported_end = false;
+    while (!stop_) {
+      try {
+        if (!source_) {
+          source_ = open();
+          log().info("reading {}", source_->description());
+          backoff = std::chrono::milliseconds(100);
+        }
+        handle(source_->read(std::chrono::milliseconds(100)));
+        if (source_->finished() && !reported_end) {
+          for (const CameraSample& sample : assembler_.flush()) publish(sample);
+          log().info("end of {}", source_->description());
+          reported_end = true;
+        }
+      } catch (const std::exception& e) {
+        if (source_) read_errors_ += source_->read_errors();
+        source_.reset();
+        log().warn("{}; retrying in {} ms", e.what(), backoff.count());
+        for (auto waited = std::chrono::milliseconds(0); waited < backoff && !stop_;
+             waited += std::chrono::milliseconds(20)) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
+      }
+    }
+    if (source_) read_errors_ += source_->read_errors();
+  }
+
+  void handle(const std::vector<can::CanFrame>& frames) {
+    if (frames.empty()) return;
+    auto raw = std::make_shared<mocap_msgs::msg::PixartRawPointArray>();
+    raw->header().stamp(to_time_msg(now()));
+    raw->header().frame_id("pixart");
+    std::vector<PixartPoint> points;
+    for (const can::CanFrame& frame : frames) {
+      points.clear();
+      auto camera = decoder_.decode(frame, points);
+      if (!camera) continue;
+      for (const PixartPoint& p : points) {
+        mocap_msgs::msg::PixartRawPoint point;
+        point.x(p.x);
+        point.y(p.y);
+        point.camera_id(p.camera_id);
+        point.point_id(p.point_id);
+        point.stamp(to_time_msg(Clock::time_point(std::chrono::nanoseconds(p.stamp_ns))));
+        raw->points().push_back(point);
+      }
+      int half = static_cast<int>((frame.id - decoder_.options().base_id) & 1u);
+      if (auto sample = assembler_.add(*camera, half, frame.stamp_ns, points)) publish(*sample);
+    }
+    if (!raw->points().empty()) raw_.publish(std::move(raw));
+  }
+
+  void publish(const CameraSample& sample) {
+    if (sample.camera_id >= fiducials_.size()) return;
+    auto array = std::make_shared<mocap_msgs::msg::FiducialArray>();
+    array->header().stamp(
+        to_time_msg(Clock::time_point(std::chrono::nanoseconds(sample.stamp_ns))));
+    array->header().frame_id(camera_name(sample.camera_id));
+    for (const PixartPoint& p : sample.points) {
+      mocap_msgs::msg::Fiducial fiducial;
+      fiducial.x(p.x);
+      fiducial.y(p.y);
+      fiducial.uncertainty(kQuantisationPx);
+      array->fiducials().push_back(fiducial);
+    }
+    fiducials_[sample.camera_id].publish(std::move(array));
+  }
+
+  PixartDecoder decoder_;
+  CameraSampleAssembler assembler_;
+  std::string source_kind_;
+  std::vector<std::string> camera_names_;
+  std::unique_ptr<can::CanSource> source_;
+  Publisher<mocap_msgs::msg::PixartRawPointArray> raw_;
+  std::vector<Publisher<mocap_msgs::msg::FiducialArray>> fiducials_;
+  uint64_t read_errors_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread reader_;
+};
+
+}  // namespace
+}  // namespace mocap::pixart
+
+MOCAP_REGISTER_COMPONENT(mocap::pixart::PixartBridge, "pixart_bridge")
