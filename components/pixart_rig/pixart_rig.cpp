@@ -1,0 +1,218 @@
+#include "pixart_rig.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/calibration/pinhole_camera.hpp>
+
+namespace mocap::pixart {
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
+    if (node && node.Mark().line >= 0) {
+      throw RigError(fmt::format("{}:{}: {}", source_, node.Mark().line + 1, what));
+    }
+    throw RigError(fmt::format("{}: {}", source_, what));
+  }
+
+  void keys(const YAML::Node& map, std::initializer_list<const char*> allowed,
+            const char* what) const {
+    if (!map.IsMap()) fail(map, fmt::format("{} must be a map", what));
+    for (const auto& entry : map) {
+      std::string key = entry.first.Scalar();
+      bool known = false;
+      for (const char* k : allowed) known = known || key == k;
+      if (!known) {
+        fail(entry.first,
+             fmt::format("unknown key '{}' in {} (keys: {})", key, what, fmt::join(allowed, ", ")));
+      }
+    }
+  }
+
+  double number(const YAML::Node& node, const char* what, double min, double max) const {
+    double value = 0;
+    if (!node || !node.IsScalar() || !YAML::convert<double>::decode(node, value) ||
+        !std::isfinite(value)) {
+      fail(node, fmt::format("'{}' must be a number", what));
+    }
+    if (value < min || value > max) {
+      fail(node, fmt::format("'{}' is {}, outside [{}, {}]", what, value, min, max));
+    }
+    return value;
+  }
+
+  template <int N>
+  Eigen::Matrix<double, N, 1> vector(const YAML::Node& node, const char* what) const {
+    if (!node || !node.IsSequence() || node.size() != N) {
+      fail(node, fmt::format("'{}' must be a list of {} numbers", what, N));
+    }
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) v[i] = number(node[i], what, -1e6, 1e6);
+    return v;
+  }
+
+  std::string text(const YAML::Node& node, const char* what) const {
+    if (!node || !node.IsScalar() || node.Scalar().empty()) {
+      fail(node, fmt::format("'{}' must be a non-empty string", what));
+    }
+    return node.Scalar();
+  }
+
+ private:
+  std::string source_;
+};
+
+}  // namespace
+
+bool Led::is_on(double time_s) const {
+  if (off_s <= 0) return true;
+  double period = on_s + off_s;
+  double t = std::fmod(time_s + phase_s, period);
+  if (t < 0) t += period;
+  return t < on_s;
+}
+
+const RigCamera* Rig::find_camera(int camera_id) const {
+  for (const RigCamera& camera : cameras) {
+    if (camera.camera_id == camera_id) return &camera;
+  }
+  return nullptr;
+}
+
+std::shared_ptr<const calibration::CameraModel> nominal_pixart_camera(double horizontal_fov_deg) {
+  calibration::PinholeIntrinsics k;
+  k.fx = k.fy = 512.0 / std::tan(horizontal_fov_deg * M_PI / 360.0);
+  k.cx = 511.5;
+  k.cy = 383.5;
+  return std::make_shared<calibration::PinholeCamera>(1024, 768, k);
+}
+
+Eigen::Isometry3d downward_camera_pose(const Eigen::Vector3d& position, double yaw_deg) {
+  // Looking down: camera z = world −z; camera x = world x turned by yaw; camera y = z × x.
+  double yaw = yaw_deg * M_PI / 180.0;
+  Eigen::Vector3d x(std::cos(yaw), std::sin(yaw), 0), z(0, 0, -1);
+  Eigen::Matrix3d rotation;
+  rotation.col(0) = x;
+  rotation.col(1) = z.cross(x);
+  rotation.col(2) = z;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation;
+  pose.translation() = position;
+  return pose;
+}
+
+std::optional<Eigen::Vector2d> pixel_to_plane(const RigCamera& camera, const Eigen::Vector2d& pixel,
+                                              double height) {
+  auto ray = camera.model->unproject(pixel);
+  if (!ray) return std::nullopt;
+  Eigen::Vector3d origin = camera.world_from_camera.translation();
+  Eigen::Vector3d direction = camera.world_from_camera.linear() * *ray;
+  if (std::abs(direction.z()) < 1e-12) return std::nullopt;
+  double t = (height - origin.z()) / direction.z();
+  if (!(t > 0)) return std::nullopt;
+  return (origin + t * direction).head<2>();
+}
+
+Rig parse_rig(const std::string& text, const std::string& source,
+              const std::string& base_directory) {
+  Reader reader(source);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw RigError(fmt::format("{}:{}: {}", source, e.mark.line + 1, e.msg));
+  }
+  reader.keys(root, {"led_plane_height_m", "cameras", "robots"}, "the rig");
+  Rig rig;
+  rig.source = source;
+  if (root["led_plane_height_m"]) {
+    rig.led_plane_height_m =
+        reader.number(root["led_plane_height_m"], "led_plane_height_m", 0, 100);
+  }
+  YAML::Node cameras = root["cameras"];
+  if (!cameras || !cameras.IsSequence() || cameras.size() == 0) {
+    reader.fail(cameras ? cameras : root, "'cameras' must be a non-empty list");
+  }
+  std::set<int> ids;
+  std::set<std::string> names;
+  for (const YAML::Node& node : cameras) {
+    reader.keys(node,
+                {"name", "camera_id", "position", "yaw_deg", "camera_file", "horizontal_fov_deg"},
+                "a camera");
+    RigCamera camera;
+    camera.name = reader.text(node["name"], "name");
+    camera.camera_id = static_cast<int>(reader.number(node["camera_id"], "camera_id", 0, 1023));
+    if (!ids.insert(camera.camera_id).second || !names.insert(camera.name).second) {
+      reader.fail(node, fmt::format("camera '{}' (id {}) repeats a name or id", camera.name,
+                                    camera.camera_id));
+    }
+    double yaw = node["yaw_deg"] ? reader.number(node["yaw_deg"], "yaw_deg", -360, 360) : 0.0;
+    camera.world_from_camera =
+        downward_camera_pose(reader.vector<3>(node["position"], "position"), yaw);
+    if (node["camera_file"]) {
+      std::filesystem::path file = reader.text(node["camera_file"], "camera_file");
+      if (file.is_relative()) file = std::filesystem::path(base_directory) / file;
+      try {
+        camera.model = calibration::load_camera_file(file.string()).model;
+      } catch (const calibration::CameraFileError& e) {
+        reader.fail(node["camera_file"], e.what());
+      }
+    } else {
+      double fov = node["horizontal_fov_deg"]
+                       ? reader.number(node["horizontal_fov_deg"], "horizontal_fov_deg", 1, 179)
+                       : 41.0;
+      camera.model = nominal_pixart_camera(fov);
+    }
+    rig.cameras.push_back(std::move(camera));
+  }
+  std::set<std::string> robot_names;
+  for (const YAML::Node& node :
+       root["robots"] ? root["robots"] : YAML::Node(YAML::NodeType::Sequence)) {
+    reader.keys(node, {"name", "leds"}, "a robot");
+    RobotModel robot;
+    robot.name = reader.text(node["name"], "name");
+    if (!robot_names.insert(robot.name).second) {
+      reader.fail(node, fmt::format("robot '{}' appears twice", robot.name));
+    }
+    YAML::Node leds = node["leds"];
+    if (!leds || !leds.IsSequence() || leds.size() == 0) {
+      reader.fail(node, fmt::format("robot '{}' needs 'leds'", robot.name));
+    }
+    for (const YAML::Node& led_node : leds) {
+      reader.keys(led_node, {"position", "on_s", "off_s", "phase_s"}, "an LED");
+      Led led;
+      led.position = reader.vector<2>(led_node["position"], "position");
+      if (led_node["on_s"]) led.on_s = reader.number(led_node["on_s"], "on_s", 1e-3, 1e6);
+      if (led_node["off_s"]) led.off_s = reader.number(led_node["off_s"], "off_s", 0, 1e6);
+      if (led_node["phase_s"])
+        led.phase_s = reader.number(led_node["phase_s"], "phase_s", -1e6, 1e6);
+      robot.leds.push_back(led);
+    }
+    rig.robots.push_back(std::move(robot));
+  }
+  return rig;
+}
+
+Rig load_rig(const std::string& path) {
+  std::ifstream stream(path);
+  if (!stream)
+    throw RigError(fmt::format("{}: cannot read the rig: {}", path, std::strerror(errno)));
+  std::stringstream text;
+  text << stream.rdbuf();
+  return parse_rig(text.str(), path, std::filesystem::path(path).parent_path().string());
+}
+
+}  // namespace mocap::pixart
