@@ -67,7 +67,11 @@ class PixartBridge final : public Component {
     }
     // A log must exist now: a typo is an error at start, not a retry loop.
     if (source_kind_ == "candump") source_ = open();
-    reader_ = std::thread([this] { read_loop(); });
+    // Reading starts with the graph (timers run once the host has started every component),
+    // so no frame is published before the subscribers exist.
+    create_timer(std::chrono::milliseconds(1), [this] {
+      if (!reader_.joinable()) reader_ = std::thread([this] { read_loop(); });
+    });
   }
 
   ~PixartBridge() override {
@@ -82,6 +86,14 @@ class PixartBridge final : public Component {
   }
 
  private:
+  bool subscribed() const {
+    if (raw_.matched_subscribers() > 0) return true;
+    for (const auto& publisher : fiducials_) {
+      if (publisher.matched_subscribers() > 0) return true;
+    }
+    return false;
+  }
+
   std::string camera_name(int camera) const {
     if (camera < static_cast<int>(camera_names_.size())) return camera_names_[camera];
     return "camera" + std::to_string(camera);
@@ -99,6 +111,11 @@ class PixartBridge final : public Component {
   // Reads until stopped; a device that fails is reopened with back-off (0.1 s doubling to
   // 2 s), so unplugging the adaptor costs the frames of the gap and nothing else.
   void read_loop() {
+    // A log replayed as fast as possible would be over before subscribers in other processes
+    // are discovered: it waits for one.
+    while (source_kind_ == "candump" && !stop_ && !subscribed()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     std::chrono::milliseconds backoff(100);
     bool reported_end = false;
     while (!stop_) {
