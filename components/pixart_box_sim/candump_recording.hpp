@@ -1,0 +1,31 @@
+// A `candump -L` log of the simulated box (candump_log.hpp), written as fast as the simulator
+// runs: what a real box on the bus would have produced over `duration_s` of scene time, for
+// the bridge to replay (source: candump) or for can-utils' canplayer.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <stop_token>
+#include <string>
+
+#include "pixart_box_simulator.hpp"
+#include "sample_schedule.hpp"
+
+namespace mocap::pixart {
+
+struct CandumpRecordingOptions {
+  double duration_s = 10;  // scene time covered: the samples before it
+  double rate_hz = 270;    // samples per second (each: two frames per camera)
+  int64_t start_ns = 0;    // receive time of sample 0, nanoseconds since the Unix epoch
+  std::string interface = "can0";
+};
+
+// Writes the frames of every sample before options.duration_s, one line each. A sample's
+// frames follow each other on the bus: frame i of sample k is stamped start + k/rate plus
+// i · 130 µs (a classic 8-byte frame with stuffing at 1 Mbit/s), squeezed when the sample
+// period is too short for that. Stops early, between samples, when `stop` is requested.
+// Returns the number of frames written. Throws std::runtime_error when the stream fails.
+uint64_t write_candump_recording(PixartBoxSimulator& simulator, std::ostream& out,
+                                 const CandumpRecordingOptions& options, std::stop_token stop = {});
+
+}  // namespace mocap::pixart

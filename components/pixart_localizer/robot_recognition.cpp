@@ -1,0 +1,272 @@
+#include "robot_recognition.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+namespace mocap::pixart::localization {
+namespace {
+
+const std::tuple<size_t, size_t, size_t> kPermutations[] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                                            {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+
+std::optional<std::string> layout_problem(const RobotModel& robot, double tolerance) {
+  if (robot.leds.size() != 3) {
+    return fmt::format("has {} LEDs; the recognizer needs the seed's 3", robot.leds.size());
+  }
+  int steady = 0;
+  for (const Led& led : robot.leds) steady += led.off_s <= 0 ? 1 : 0;
+  if (steady != 1) {
+    return fmt::format("has {} always-on LEDs; the recognizer needs exactly 1", steady);
+  }
+  double d01 = (robot.leds[0].position - robot.leds[1].position).norm();
+  double d02 = (robot.leds[0].position - robot.leds[2].position).norm();
+  double d12 = (robot.leds[1].position - robot.leds[2].position).norm();
+  double closest = std::min({std::abs(d01 - d02), std::abs(d01 - d12), std::abs(d02 - d12)});
+  if (closest <= 2 * tolerance) {
+    return fmt::format(
+        "has LED distances {:.3f}, {:.3f}, {:.3f} m, two of them within twice the pattern "
+        "tolerance ({} m) of each other: its LEDs could not be told apart",
+        d01, d02, d12, tolerance);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+const char* to_string(PoseEvidence evidence) {
+  switch (evidence) {
+    case PoseEvidence::AllLeds:
+      return "3 LEDs";
+    case PoseEvidence::TwoLeds:
+      return "2 LEDs";
+    case PoseEvidence::SteadyLed:
+      return "the steady LED";
+  }
+  return "?";
+}
+
+RobotRecognizer::RobotRecognizer(const std::vector<RobotModel>& robots, RecognitionOptions options)
+    : options_(options) {
+  for (const RobotModel& robot : robots) {
+    if (auto problem = layout_problem(robot, options_.pattern_tolerance_m)) {
+      unsupported_.push_back(fmt::format("robot '{}': {}", robot.name, *problem));
+      patterns_.emplace_back();
+      continue;
+    }
+    Pattern pattern;
+    for (size_t i = 0; i < 3; ++i) {
+      pattern.leds[i] = robot.leds[i].position;
+      if (robot.leds[i].off_s <= 0) pattern.steady = i;
+    }
+    for (size_t a = 0; a < 3; ++a) {
+      for (size_t b = 0; b < 3; ++b) {
+        pattern.distance[a][b] = (pattern.leds[a] - pattern.leds[b]).norm();
+      }
+    }
+    patterns_.push_back(pattern);
+  }
+  // A steady-to-end spacing identifies its robot when no other LED distance of any robot
+  // (its own included) is within twice the tolerance: a measured distance within the
+  // tolerance of it then fits nothing else.
+  for (size_t r = 0; r < patterns_.size(); ++r) {
+    if (!patterns_[r]) continue;
+    Pattern& pattern = *patterns_[r];
+    for (size_t end = 0; end < 3; ++end) {
+      if (end == pattern.steady) continue;
+      double spacing = pattern.distance[pattern.steady][end];
+      bool unique = true;
+      for (size_t q = 0; q < patterns_.size(); ++q) {
+        if (!patterns_[q]) continue;
+        for (size_t a = 0; a < 3; ++a) {
+          for (size_t b = a + 1; b < 3; ++b) {
+            bool itself =
+                q == r && ((a == pattern.steady && b == end) || (b == pattern.steady && a == end));
+            if (!itself && std::abs(patterns_[q]->distance[a][b] - spacing) <=
+                               2 * options_.pattern_tolerance_m) {
+              unique = false;
+            }
+          }
+        }
+      }
+      pattern.identifying_spacing[end] = unique;
+    }
+  }
+}
+
+double RobotRecognizer::smallest_led_distance_m() const {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const auto& pattern : patterns_) {
+    if (!pattern) continue;
+    smallest = std::min(
+        {smallest, pattern->distance[0][1], pattern->distance[0][2], pattern->distance[1][2]});
+  }
+  return std::isfinite(smallest) ? smallest : 0.0;
+}
+
+RecognitionResult RobotRecognizer::recognize(
+    const std::vector<Eigen::Vector2d>& points,
+    const std::vector<std::optional<PlanarPose>>& tracked) const {
+  RecognitionResult result;
+  std::vector<bool> used(points.size(), false);
+  std::vector<bool> found(patterns_.size(), false);
+  // Untracked robots, whatever the caller's vector holds.
+  std::vector<std::optional<PlanarPose>> priors(patterns_.size());
+  for (size_t r = 0; r < priors.size() && r < tracked.size(); ++r) priors[r] = tracked[r];
+
+  find_triples(points, used, found, result);
+  find_pairs(points, priors, used, found, result);
+  find_steady_leds(points, priors, used, found, result);
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!used[i]) result.unexplained_points.push_back(i);
+  }
+  return result;
+}
+
+void RobotRecognizer::find_triples(const std::vector<Eigen::Vector2d>& points,
+                                   std::vector<bool>& used, std::vector<bool>& found,
+                                   RecognitionResult& result) const {
+  const double tolerance = options_.pattern_tolerance_m;
+  std::vector<Recognition> candidates;
+  const size_t n = points.size();
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      double dij = (points[i] - points[j]).norm();
+      for (size_t k = j + 1; k < n; ++k) {
+        double dik = (points[i] - points[k]).norm(), djk = (points[j] - points[k]).norm();
+        for (size_t r = 0; r < patterns_.size(); ++r) {
+          if (!patterns_[r]) continue;
+          const Pattern& pattern = *patterns_[r];
+          // Point i shows LED a, j shows b, k shows c.
+          for (const auto& [a, b, c] : kPermutations) {
+            if (std::abs(dij - pattern.distance[a][b]) > tolerance ||
+                std::abs(dik - pattern.distance[a][c]) > tolerance ||
+                std::abs(djk - pattern.distance[b][c]) > tolerance) {
+              continue;
+            }
+            PlanarFit fit = fit_planar_pose({pattern.leds[a], pattern.leds[b], pattern.leds[c]},
+                                            {points[i], points[j], points[k]});
+            if (fit.max_residual_m > tolerance) continue;  // the mirror image of the layout
+            candidates.push_back(
+                {r, fit.pose, PoseEvidence::AllLeds, {i, j, k}, fit.rms_residual_m});
+          }
+        }
+      }
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Recognition& l, const Recognition& r) {
+    return l.rms_residual_m < r.rms_residual_m;
+  });
+  for (Recognition& candidate : candidates) {
+    if (found[candidate.robot]) continue;
+    if (std::any_of(candidate.points.begin(), candidate.points.end(),
+                    [&](size_t p) { return used[p]; })) {
+      continue;
+    }
+    found[candidate.robot] = true;
+    for (size_t p : candidate.points) used[p] = true;
+    result.robots.push_back(std::move(candidate));
+  }
+}
+
+void RobotRecognizer::find_pairs(const std::vector<Eigen::Vector2d>& points,
+                                 const std::vector<std::optional<PlanarPose>>& tracked,
+                                 std::vector<bool>& used, std::vector<bool>& found,
+                                 RecognitionResult& result) const {
+  const double tolerance = options_.pattern_tolerance_m;
+  struct Candidate {
+    Recognition recognition;
+    double distance_to_track;  // of the steady LED: the nearest are taken first
+  };
+  std::vector<Candidate> candidates;
+  const size_t n = points.size();
+  for (size_t i = 0; i < n; ++i) {
+    if (used[i]) continue;
+    for (size_t j = i + 1; j < n; ++j) {
+      if (used[j]) continue;
+      double d = (points[i] - points[j]).norm();
+      bool fits_any = false;
+      std::optional<std::pair<size_t, size_t>> identified;  // robot, end LED
+      for (size_t r = 0; r < patterns_.size(); ++r) {
+        if (!patterns_[r]) continue;
+        const Pattern& pattern = *patterns_[r];
+        for (size_t a = 0; a < 3; ++a) {
+          for (size_t b = a + 1; b < 3; ++b) {
+            if (std::abs(d - pattern.distance[a][b]) > tolerance) continue;
+            fits_any = true;
+            size_t end = a == pattern.steady ? b : b == pattern.steady ? a : 3;
+            if (end < 3 && pattern.identifying_spacing[end]) identified = {{r, end}};
+          }
+        }
+      }
+      if (!identified) {
+        if (fits_any) ++result.ambiguous_pairs;
+        continue;
+      }
+      auto [r, end] = *identified;
+      if (found[r] || !tracked[r]) continue;
+      const Pattern& pattern = *patterns_[r];
+      Eigen::Vector2d expected_steady = tracked[r]->to_world(pattern.leds[pattern.steady]);
+      double di = (points[i] - expected_steady).norm();
+      double dj = (points[j] - expected_steady).norm();
+      size_t steady_point = di <= dj ? i : j, end_point = di <= dj ? j : i;
+      double distance_to_track = std::min(di, dj);
+      if (distance_to_track > options_.tracking_gate_m) continue;
+      PlanarFit fit = fit_planar_pose({pattern.leds[pattern.steady], pattern.leds[end]},
+                                      {points[steady_point], points[end_point]});
+      candidates.push_back(
+          {{r, fit.pose, PoseEvidence::TwoLeds, {steady_point, end_point}, fit.rms_residual_m},
+           distance_to_track});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& l, const Candidate& r) {
+    return l.distance_to_track < r.distance_to_track;
+  });
+  for (Candidate& candidate : candidates) {
+    Recognition& recognition = candidate.recognition;
+    if (found[recognition.robot] || used[recognition.points[0]] || used[recognition.points[1]]) {
+      continue;
+    }
+    found[recognition.robot] = true;
+    for (size_t p : recognition.points) used[p] = true;
+    result.robots.push_back(std::move(recognition));
+  }
+}
+
+void RobotRecognizer::find_steady_leds(const std::vector<Eigen::Vector2d>& points,
+                                       const std::vector<std::optional<PlanarPose>>& tracked,
+                                       std::vector<bool>& used, std::vector<bool>& found,
+                                       RecognitionResult& result) const {
+  struct Candidate {
+    double distance;
+    size_t point, robot;
+  };
+  std::vector<Candidate> candidates;
+  for (size_t r = 0; r < patterns_.size(); ++r) {
+    if (!patterns_[r] || found[r] || !tracked[r]) continue;
+    Eigen::Vector2d expected = tracked[r]->to_world(patterns_[r]->leds[patterns_[r]->steady]);
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (used[i]) continue;
+      double distance = (points[i] - expected).norm();
+      if (distance <= options_.tracking_gate_m) candidates.push_back({distance, i, r});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& l, const Candidate& r) { return l.distance < r.distance; });
+  for (const Candidate& candidate : candidates) {
+    if (found[candidate.robot] || used[candidate.point]) continue;
+    found[candidate.robot] = true;
+    used[candidate.point] = true;
+    // The steady LED lands on the point; the heading stays.
+    PlanarPose pose = *tracked[candidate.robot];
+    const Pattern& pattern = *patterns_[candidate.robot];
+    Eigen::Vector2d offset = PlanarPose{0, 0, pose.theta}.to_world(pattern.leds[pattern.steady]);
+    pose.x = points[candidate.point].x() - offset.x();
+    pose.y = points[candidate.point].y() - offset.y();
+    result.robots.push_back({candidate.robot, pose, PoseEvidence::SteadyLed, {candidate.point}, 0});
+  }
+}
+
+}  // namespace mocap::pixart::localization
