@@ -89,9 +89,9 @@ class PixartLocalizer final : public Component {
     const LocalizerStats& s = localizer_.stats();
     log().info(
         "{} samples used, {} pose arrays published; readings: {} from 3 LEDs, {} from 2 LEDs, "
-        "{} from the steady LED, {} ambiguous LED pairs; ignored: {} arrays from cameras not "
+        "{} from one LED, {} ambiguous LED pairs; ignored: {} arrays from cameras not "
         "in the rig, {} non-finite points, {} points off the LED plane, {} out-of-order samples",
-        s.samples, published_, s.readings_all_leds, s.readings_two_leds, s.readings_steady_led,
+        s.samples, published_, s.readings_all_leds, s.readings_two_leds, s.readings_one_led,
         s.ambiguous_pairs, s.unknown_camera_samples, s.non_finite_pixels, s.unprojectable_pixels,
         s.out_of_order_samples);
   }

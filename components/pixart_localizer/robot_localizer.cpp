@@ -94,8 +94,8 @@ RobotLocalizer::SampleStatus RobotLocalizer::add_sample(
       case PoseEvidence::TwoLeds:
         ++stats_.readings_two_leds;
         break;
-      case PoseEvidence::SteadyLed:
-        ++stats_.readings_steady_led;
+      case PoseEvidence::OneLed:
+        ++stats_.readings_one_led;
         break;
     }
   }

@@ -50,7 +50,7 @@ struct LocalizerStats {
   uint64_t unprojectable_pixels = 0;    // the ray misses the LED plane: ignored
   uint64_t readings_all_leds = 0;       // robot readings by evidence (robot_recognition.hpp)
   uint64_t readings_two_leds = 0;
-  uint64_t readings_steady_led = 0;
+  uint64_t readings_one_led = 0;
   uint64_t ambiguous_pairs = 0;
 };
 

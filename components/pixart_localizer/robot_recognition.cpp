@@ -42,8 +42,8 @@ const char* to_string(PoseEvidence evidence) {
       return "3 LEDs";
     case PoseEvidence::TwoLeds:
       return "2 LEDs";
-    case PoseEvidence::SteadyLed:
-      return "the steady LED";
+    case PoseEvidence::OneLed:
+      return "one LED";
   }
   return "?";
 }
@@ -118,7 +118,7 @@ RecognitionResult RobotRecognizer::recognize(
 
   find_triples(points, used, found, result);
   find_pairs(points, priors, used, found, result);
-  find_steady_leds(points, priors, used, found, result);
+  find_single_leds(points, priors, used, found, result);
   for (size_t i = 0; i < points.size(); ++i) {
     if (!used[i]) result.unexplained_points.push_back(i);
   }
@@ -235,22 +235,24 @@ void RobotRecognizer::find_pairs(const std::vector<Eigen::Vector2d>& points,
   }
 }
 
-void RobotRecognizer::find_steady_leds(const std::vector<Eigen::Vector2d>& points,
+void RobotRecognizer::find_single_leds(const std::vector<Eigen::Vector2d>& points,
                                        const std::vector<std::optional<PlanarPose>>& tracked,
                                        std::vector<bool>& used, std::vector<bool>& found,
                                        RecognitionResult& result) const {
   struct Candidate {
     double distance;
-    size_t point, robot;
+    size_t point, robot, led;
   };
   std::vector<Candidate> candidates;
   for (size_t r = 0; r < patterns_.size(); ++r) {
     if (!patterns_[r] || found[r] || !tracked[r]) continue;
-    Eigen::Vector2d expected = tracked[r]->to_world(patterns_[r]->leds[patterns_[r]->steady]);
-    for (size_t i = 0; i < points.size(); ++i) {
-      if (used[i]) continue;
-      double distance = (points[i] - expected).norm();
-      if (distance <= options_.tracking_gate_m) candidates.push_back({distance, i, r});
+    for (size_t led = 0; led < patterns_[r]->leds.size(); ++led) {
+      Eigen::Vector2d expected = tracked[r]->to_world(patterns_[r]->leds[led]);
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (used[i]) continue;
+        double distance = (points[i] - expected).norm();
+        if (distance <= options_.tracking_gate_m) candidates.push_back({distance, i, r, led});
+      }
     }
   }
   std::sort(candidates.begin(), candidates.end(),
@@ -259,13 +261,13 @@ void RobotRecognizer::find_steady_leds(const std::vector<Eigen::Vector2d>& point
     if (found[candidate.robot] || used[candidate.point]) continue;
     found[candidate.robot] = true;
     used[candidate.point] = true;
-    // The steady LED lands on the point; the heading stays.
+    // That LED lands on the point; the heading stays.
     PlanarPose pose = *tracked[candidate.robot];
     const Pattern& pattern = *patterns_[candidate.robot];
-    Eigen::Vector2d offset = PlanarPose{0, 0, pose.theta}.to_world(pattern.leds[pattern.steady]);
+    Eigen::Vector2d offset = PlanarPose{0, 0, pose.theta}.to_world(pattern.leds[candidate.led]);
     pose.x = points[candidate.point].x() - offset.x();
     pose.y = points[candidate.point].y() - offset.y();
-    result.robots.push_back({candidate.robot, pose, PoseEvidence::SteadyLed, {candidate.point}, 0});
+    result.robots.push_back({candidate.robot, pose, PoseEvidence::OneLed, {candidate.point}, 0});
   }
 }
 

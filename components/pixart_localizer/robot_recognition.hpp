@@ -20,9 +20,11 @@
 //      LED the pair cannot say; the robot's tracked pose can: the point nearer the tracked
 //      position of the steady LED, within `tracking_gate_m`. An untracked robot is not
 //      initialised from two LEDs.
-//   3. One LED: a point left over from 1 and 2 that lies within `tracking_gate_m` of where a
-//      tracked robot (not yet found) had its steady LED moves that robot's position there,
-//      keeping its heading; the nearest point–robot pairs are taken first.
+//   3. One LED: a point left over from 1 and 2 that lies within `tracking_gate_m` of where one
+//      of a tracked robot's LEDs (not yet found) should be moves that robot so that LED lands
+//      on it, keeping its heading; the nearest point–LED pairs are taken first. Usually it is
+//      the steady LED, but a sensor reports only 4 points, and with more LEDs in its view the
+//      steady one may be among those dropped while a blinking end is reported.
 //
 // Robots the recognizer cannot tell apart or orient are set aside when it is built, each
 // with the reason (unsupported()): it needs exactly three LEDs, one of them steady (off_s 0)
@@ -51,11 +53,11 @@ struct RecognitionOptions {
 
 // How a pose was measured.
 enum class PoseEvidence {
-  AllLeds,    // step 1: position and heading
-  TwoLeds,    // step 2: position and heading, the steady LED told apart by tracking
-  SteadyLed,  // step 3: position; heading kept from before
+  AllLeds,  // step 1: position and heading
+  TwoLeds,  // step 2: position and heading, the steady LED told apart by tracking
+  OneLed,   // step 3: position; heading kept from before
 };
-const char* to_string(PoseEvidence evidence);  // "3 LEDs", "2 LEDs", "the steady LED"
+const char* to_string(PoseEvidence evidence);  // "3 LEDs", "2 LEDs", "one LED"
 
 struct Recognition {
   size_t robot = 0;  // index into the rig's robots
@@ -104,7 +106,7 @@ class RobotRecognizer {
   void find_pairs(const std::vector<Eigen::Vector2d>& points,
                   const std::vector<std::optional<PlanarPose>>& tracked, std::vector<bool>& used,
                   std::vector<bool>& found, RecognitionResult& result) const;
-  void find_steady_leds(const std::vector<Eigen::Vector2d>& points,
+  void find_single_leds(const std::vector<Eigen::Vector2d>& points,
                         const std::vector<std::optional<PlanarPose>>& tracked,
                         std::vector<bool>& used, std::vector<bool>& found,
                         RecognitionResult& result) const;
