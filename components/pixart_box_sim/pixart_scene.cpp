@@ -17,10 +17,12 @@
 #include <fmt/ranges.h>
 #include <mocap/spelling.hpp>
 
+#include "yaml_reader.hpp"
+
 namespace mocap::pixart {
 namespace {
 
-using Keys = std::initializer_list<std::string_view>;
+using Keys = YamlKeys;
 
 constexpr double kPi = 3.14159265358979323846;
 // Far beyond any room, but finite: catches a misplaced exponent.
@@ -28,9 +30,9 @@ constexpr double kMaxCoordinate_m = 1000;
 constexpr double kMaxTime_s = 1e6;
 
 // Reads one scene document; every error names the source and the line of the node at fault.
-class SceneReader {
+class SceneReader : YamlReader<PixartSceneError> {
  public:
-  SceneReader(std::string source, const Rig& rig) : source_(std::move(source)), rig_(rig) {}
+  SceneReader(std::string source, const Rig& rig) : YamlReader(std::move(source)), rig_(rig) {}
 
   PixartScene read(const YAML::Node& root) {
     if (!root.IsMap()) fail(root, "a scene is a map with 'robots' and/or 'calibration_boards'");
@@ -39,20 +41,12 @@ class SceneReader {
       fail(root, "a scene needs 'robots' or 'calibration_boards' (either may be an empty list)");
     }
     PixartScene scene;
-    scene.source = source_;
+    scene.source = source();
     for (const YAML::Node& node : list(root, "robots")) scene.objects.push_back(robot(node));
     for (const YAML::Node& node : list(root, "calibration_boards")) {
       scene.objects.push_back(board(node));
     }
     return scene;
-  }
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    std::string where = source_;
-    if (node.IsDefined() && node.Mark().line >= 0) {
-      where += ":" + std::to_string(node.Mark().line + 1);
-    }
-    throw PixartSceneError(where + ": " + what);
   }
 
  private:
@@ -142,68 +136,6 @@ class SceneReader {
     if (!names_.insert(name).second) fail(node, fmt::format("'{}' appears twice", name));
   }
 
-  // The list under `key`, or an empty one when the key is absent.
-  YAML::Node list(const YAML::Node& map, const char* key) const {
-    YAML::Node node = map[key];
-    if (!node) return YAML::Node(YAML::NodeType::Sequence);
-    if (!node.IsSequence())
-      fail(node, fmt::format("'{}' must be a list, not {}", key, describe(node)));
-    return node;
-  }
-
-  // Rejects keys outside `allowed` and repeated keys, suggesting the nearest allowed key.
-  void check_keys(const YAML::Node& map, Keys allowed, std::string_view what) const {
-    if (!map.IsMap()) fail(map, fmt::format("{} must be a map, not {}", what, describe(map)));
-    std::set<std::string> seen;
-    for (const auto& entry : map) {
-      const YAML::Node& key = entry.first;
-      std::string name = key.IsScalar() ? key.Scalar() : std::string("(not a word)");
-      if (!seen.insert(name).second) fail(key, fmt::format("'{}' appears twice in {}", name, what));
-      if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-      fail(key, fmt::format("unknown key '{}' in {}{}", name, what,
-                            did_you_mean(name, {allowed.begin(), allowed.end()}, "keys")));
-    }
-  }
-
-  YAML::Node required(const YAML::Node& map, const char* key, std::string_view what) const {
-    YAML::Node node = map[key];
-    if (!node) fail(map, fmt::format("{} needs '{}'", what, key));
-    return node;
-  }
-
-  std::string text(const YAML::Node& node, const char* key) const {
-    if (!node.IsScalar() || node.Scalar().empty()) {
-      fail(node, fmt::format("'{}' must be a non-empty name, not {}", key, describe(node)));
-    }
-    return node.Scalar();
-  }
-
-  double to_number(const YAML::Node& node, const char* key, double min, double max) const {
-    double value = 0;
-    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
-      fail(node, fmt::format("'{}' must be a number, not {}", key, describe(node)));
-    }
-    if (value < min || value > max) {
-      fail(node, fmt::format("'{}' is {}, must be in [{}, {}]", key, value, min, max));
-    }
-    return value;
-  }
-
-  double number(const YAML::Node& map, const char* key, double fallback, double min,
-                double max) const {
-    YAML::Node node = map[key];
-    return node ? to_number(node, key, min, max) : fallback;
-  }
-
-  // A number above 0 and up to `max` (periods, speeds, sizes).
-  double positive(const YAML::Node& map, const char* key, double fallback, double max) const {
-    YAML::Node node = map[key];
-    if (!node) return fallback;
-    double value = to_number(node, key, -max, max);
-    if (!(value > 0)) fail(node, fmt::format("'{}' is {}, must be positive", key, value));
-    return value;
-  }
-
   double coordinate(const YAML::Node& node, const char* key) const {
     return to_number(node, key, -kMaxCoordinate_m, kMaxCoordinate_m);
   }
@@ -215,24 +147,6 @@ class SceneReader {
     return {coordinate(node[0], key), coordinate(node[1], key)};
   }
 
-  bool boolean(const YAML::Node& map, const char* key, bool fallback) const {
-    YAML::Node node = map[key];
-    if (!node) return fallback;
-    bool value = false;
-    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) {
-      fail(node, fmt::format("'{}' must be true or false, not {}", key, describe(node)));
-    }
-    return value;
-  }
-
-  static std::string describe(const YAML::Node& node) {
-    if (node.IsScalar()) return "'" + node.Scalar() + "'";
-    if (node.IsSequence()) return fmt::format("a list of {}", node.size());
-    if (node.IsMap()) return "a map";
-    return "nothing";
-  }
-
-  std::string source_;
   const Rig& rig_;
   std::set<std::string> names_;
 };

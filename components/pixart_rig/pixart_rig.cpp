@@ -14,66 +14,12 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
+#include "yaml_reader.hpp"
+
 namespace mocap::pixart {
 namespace {
 
-class Reader {
- public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    if (node && node.Mark().line >= 0) {
-      throw RigError(fmt::format("{}:{}: {}", source_, node.Mark().line + 1, what));
-    }
-    throw RigError(fmt::format("{}: {}", source_, what));
-  }
-
-  void keys(const YAML::Node& map, std::initializer_list<const char*> allowed,
-            const char* what) const {
-    if (!map.IsMap()) fail(map, fmt::format("{} must be a map", what));
-    for (const auto& entry : map) {
-      std::string key = entry.first.Scalar();
-      bool known = false;
-      for (const char* k : allowed) known = known || key == k;
-      if (!known) {
-        fail(entry.first,
-             fmt::format("unknown key '{}' in {} (keys: {})", key, what, fmt::join(allowed, ", ")));
-      }
-    }
-  }
-
-  double number(const YAML::Node& node, const char* what, double min, double max) const {
-    double value = 0;
-    if (!node || !node.IsScalar() || !YAML::convert<double>::decode(node, value) ||
-        !std::isfinite(value)) {
-      fail(node, fmt::format("'{}' must be a number", what));
-    }
-    if (value < min || value > max) {
-      fail(node, fmt::format("'{}' is {}, outside [{}, {}]", what, value, min, max));
-    }
-    return value;
-  }
-
-  template <int N>
-  Eigen::Matrix<double, N, 1> vector(const YAML::Node& node, const char* what) const {
-    if (!node || !node.IsSequence() || node.size() != N) {
-      fail(node, fmt::format("'{}' must be a list of {} numbers", what, N));
-    }
-    Eigen::Matrix<double, N, 1> v;
-    for (int i = 0; i < N; ++i) v[i] = number(node[i], what, -1e6, 1e6);
-    return v;
-  }
-
-  std::string text(const YAML::Node& node, const char* what) const {
-    if (!node || !node.IsScalar() || node.Scalar().empty()) {
-      fail(node, fmt::format("'{}' must be a non-empty string", what));
-    }
-    return node.Scalar();
-  }
-
- private:
-  std::string source_;
-};
+using Reader = YamlReader<RigError>;
 
 }  // namespace
 
@@ -135,33 +81,29 @@ Rig parse_rig(const std::string& text, const std::string& source,
   } catch (const YAML::Exception& e) {
     throw RigError(fmt::format("{}:{}: {}", source, e.mark.line + 1, e.msg));
   }
-  reader.keys(root, {"led_plane_height_m", "cameras", "robots"}, "the rig");
+  reader.check_keys(root, {"led_plane_height_m", "cameras", "robots"}, "the rig");
   Rig rig;
   rig.source = source;
-  if (root["led_plane_height_m"]) {
-    rig.led_plane_height_m =
-        reader.number(root["led_plane_height_m"], "led_plane_height_m", 0, 100);
-  }
-  YAML::Node cameras = root["cameras"];
-  if (!cameras || !cameras.IsSequence() || cameras.size() == 0) {
-    reader.fail(cameras ? cameras : root, "'cameras' must be a non-empty list");
-  }
+  rig.led_plane_height_m = reader.number(root, "led_plane_height_m", 0.45, 0, 100);
+  YAML::Node cameras = reader.list(root, "cameras");
+  if (cameras.size() == 0) reader.fail(root, "'cameras' must be a non-empty list");
   std::set<int> ids;
   std::set<std::string> names;
   for (const YAML::Node& node : cameras) {
-    reader.keys(node,
-                {"name", "camera_id", "position", "yaw_deg", "camera_file", "horizontal_fov_deg"},
-                "a camera");
+    reader.check_keys(
+        node, {"name", "camera_id", "position", "yaw_deg", "camera_file", "horizontal_fov_deg"},
+        "a camera");
     RigCamera camera;
-    camera.name = reader.text(node["name"], "name");
-    camera.camera_id = static_cast<int>(reader.number(node["camera_id"], "camera_id", 0, 1023));
+    camera.name = reader.text(reader.required(node, "name", "a camera"), "name");
+    camera.camera_id = static_cast<int>(
+        reader.to_number(reader.required(node, "camera_id", "a camera"), "camera_id", 0, 1023));
     if (!ids.insert(camera.camera_id).second || !names.insert(camera.name).second) {
       reader.fail(node, fmt::format("camera '{}' (id {}) repeats a name or id", camera.name,
                                     camera.camera_id));
     }
-    double yaw = node["yaw_deg"] ? reader.number(node["yaw_deg"], "yaw_deg", -360, 360) : 0.0;
-    camera.world_from_camera =
-        downward_camera_pose(reader.vector<3>(node["position"], "position"), yaw);
+    camera.world_from_camera = downward_camera_pose(
+        reader.vector<3>(reader.required(node, "position", "a camera"), "position", -1e6, 1e6),
+        reader.number(node, "yaw_deg", 0, -360, 360));
     if (node["camera_file"]) {
       std::filesystem::path file = reader.text(node["camera_file"], "camera_file");
       if (file.is_relative()) file = std::filesystem::path(base_directory) / file;
@@ -171,34 +113,28 @@ Rig parse_rig(const std::string& text, const std::string& source,
         reader.fail(node["camera_file"], e.what());
       }
     } else {
-      double fov = node["horizontal_fov_deg"]
-                       ? reader.number(node["horizontal_fov_deg"], "horizontal_fov_deg", 1, 179)
-                       : 41.0;
-      camera.model = nominal_pixart_camera(fov);
+      camera.model = nominal_pixart_camera(reader.number(node, "horizontal_fov_deg", 41, 1, 179));
     }
     rig.cameras.push_back(std::move(camera));
   }
   std::set<std::string> robot_names;
-  for (const YAML::Node& node :
-       root["robots"] ? root["robots"] : YAML::Node(YAML::NodeType::Sequence)) {
-    reader.keys(node, {"name", "leds"}, "a robot");
+  for (const YAML::Node& node : reader.list(root, "robots")) {
+    reader.check_keys(node, {"name", "leds"}, "a robot");
     RobotModel robot;
-    robot.name = reader.text(node["name"], "name");
+    robot.name = reader.text(reader.required(node, "name", "a robot"), "name");
     if (!robot_names.insert(robot.name).second) {
       reader.fail(node, fmt::format("robot '{}' appears twice", robot.name));
     }
-    YAML::Node leds = node["leds"];
-    if (!leds || !leds.IsSequence() || leds.size() == 0) {
-      reader.fail(node, fmt::format("robot '{}' needs 'leds'", robot.name));
-    }
+    YAML::Node leds = reader.list(node, "leds");
+    if (leds.size() == 0) reader.fail(node, fmt::format("robot '{}' needs 'leds'", robot.name));
     for (const YAML::Node& led_node : leds) {
-      reader.keys(led_node, {"position", "on_s", "off_s", "phase_s"}, "an LED");
+      reader.check_keys(led_node, {"position", "on_s", "off_s", "phase_s"}, "an LED");
       Led led;
-      led.position = reader.vector<2>(led_node["position"], "position");
-      if (led_node["on_s"]) led.on_s = reader.number(led_node["on_s"], "on_s", 1e-3, 1e6);
-      if (led_node["off_s"]) led.off_s = reader.number(led_node["off_s"], "off_s", 0, 1e6);
-      if (led_node["phase_s"])
-        led.phase_s = reader.number(led_node["phase_s"], "phase_s", -1e6, 1e6);
+      led.position =
+          reader.vector<2>(reader.required(led_node, "position", "an LED"), "position", -1e6, 1e6);
+      led.on_s = reader.number(led_node, "on_s", led.on_s, 1e-3, 1e6);
+      led.off_s = reader.number(led_node, "off_s", led.off_s, 0, 1e6);
+      led.phase_s = reader.number(led_node, "phase_s", led.phase_s, -1e6, 1e6);
       robot.leds.push_back(led);
     }
     rig.robots.push_back(std::move(robot));
