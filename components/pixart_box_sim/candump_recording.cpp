@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "candump_log.hpp"
 
 namespace mocap::pixart {
@@ -12,6 +14,15 @@ namespace {
 // A standard frame with 8 data bytes is 111 bits plus up to 24 stuff bits: about 130 µs at
 // 1 Mbit/s, the box's bus.
 constexpr int64_t kFrameOnBus_ns = 130000;
+
+void write_truth(const PixartBoxSimulator& simulator, double time_s, int64_t stamp_ns,
+                 std::ostream& out) {
+  for (const RobotTruth& truth : simulator.ground_truth(time_s)) {
+    out << fmt::format("{},{},{:.6f},{:.6f},{:.6f}\n", stamp_ns, truth.name, truth.pose.x,
+                       truth.pose.y, truth.pose.theta);
+  }
+  if (!out) throw std::runtime_error("cannot write the ground truth");
+}
 
 }  // namespace
 
@@ -27,11 +38,20 @@ uint64_t write_candump_recording(PixartBoxSimulator& simulator, std::ostream& ou
           : std::min(kFrameOnBus_ns, period_ns / static_cast<int64_t>(frames_per_sample));
   can::CandumpRecord record;
   record.interface = options.interface;
+  const bool with_truth = options.truth != nullptr && options.truth_rate_hz > 0;
+  if (with_truth) *options.truth << kTruthCsvHeader << '\n';
+  const SampleSchedule truth_schedule(with_truth ? options.truth_rate_hz : 1);
+  uint64_t next_truth = 0;
   uint64_t written = 0;
   std::string line;
   for (uint64_t k = 0; k < samples && !stop.stop_requested(); ++k) {
     const double time_s = schedule.time_of(k);
     const int64_t sample_ns = options.start_ns + std::llround(time_s * 1e9);
+    for (; with_truth && truth_schedule.time_of(next_truth) <= time_s; ++next_truth) {
+      const double truth_s = truth_schedule.time_of(next_truth);
+      write_truth(simulator, truth_s, options.start_ns + std::llround(truth_s * 1e9),
+                  *options.truth);
+    }
     int64_t frame_ns = sample_ns;
     for (can::CanFrame& frame : simulator.frames_at(time_s)) {
       frame.stamp_ns = frame_ns;
@@ -47,6 +67,9 @@ uint64_t write_candump_recording(PixartBoxSimulator& simulator, std::ostream& ou
   }
   out.flush();
   if (!out) throw std::runtime_error("cannot write the candump log");
+  if (with_truth && !options.truth->flush()) {
+    throw std::runtime_error("cannot write the ground truth");
+  }
   return written;
 }
 

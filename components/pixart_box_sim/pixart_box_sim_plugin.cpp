@@ -9,9 +9,11 @@
 //     can (to FILE.partial, renamed to FILE when complete), for the bridge's candump source.
 //
 // Scene time starts when the component is created and follows the steady clock: sample k is
-// sent at start + k / rate_hz. Ground truth (pty output only) goes out on /pixart/ground_truth
-// at truth_rate_hz, stamped with the wall-clock time now() at which it was computed, so a
-// consumer pairs it with the bridge's fiducials (stamped when read) by stamp.
+// sent at start + k / rate_hz. Ground truth, truth_rate_hz times per second of scene time:
+//   - pty: on /pixart/ground_truth, stamped with the wall-clock time now() at which it was
+//     computed, so a consumer pairs it with the bridge's fiducials (stamped when read) by stamp;
+//   - candump: in FILE.truth.csv (candump_recording.hpp), stamped on the log's time scale, so
+//     the poses localized from a replay of FILE pair with it by stamp.
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -120,7 +122,9 @@ class PixartBoxSim final : public Component {
                    "Gaussian noise on each coordinate before rounding, pixels (sigma); 0 = none")
         .range(0, 100);
     spec.parameter("seed", 1, "seed of the noise").range(0, 2147483647);
-    spec.parameter("truth_rate_hz", 50.0, "pty: ground truth messages per second; 0 = none")
+    spec.parameter("truth_rate_hz", 50.0,
+                   "ground truth per second of scene time (pty: /pixart/ground_truth messages; "
+                   "candump: rows of FILE.truth.csv); 0 = none")
         .range(0, 1000);
     spec.publishes<mocap_msgs::msg::RobotPoseArray>(
         kTruthTopic, Qos::reliable(),
@@ -199,26 +203,32 @@ class PixartBoxSim final : public Component {
       throw std::invalid_argument("parameter 'file' is empty; output candump needs it");
     }
     const std::string partial = file + ".partial";
-    log_stream_.open(partial, std::ios::out | std::ios::trunc);
-    if (!log_stream_) {
-      throw std::runtime_error("cannot write " + partial + ": " + std::strerror(errno));
-    }
+    open_for_writing(log_stream_, partial);
+    const double truth_rate = param<double>("truth_rate_hz");
+    const std::string truth_file = truth_rate > 0 ? file + ".truth.csv" : std::string();
+    if (!truth_file.empty()) open_for_writing(truth_stream_, truth_file + ".partial");
     const double start_s = param<double>("start_stamp_s");
     CandumpRecordingOptions options{
         .duration_s = param<double>("duration_s"),
         .rate_hz = rate_hz_,
         .start_ns =
-            start_s > 0 ? static_cast<int64_t>(std::llround(start_s * 1e9)) : wall_clock_ns()};
-    log().info("writing {} s of {} cameras, {} objects at {} Hz to {}", options.duration_s, cameras,
-               objects, rate_hz_, file);
-    worker_ = std::jthread([this, options, file, partial](std::stop_token stop) {
+            start_s > 0 ? static_cast<int64_t>(std::llround(start_s * 1e9)) : wall_clock_ns(),
+        .truth = truth_file.empty() ? nullptr : &truth_stream_,
+        .truth_rate_hz = truth_rate};
+    log().info("writing {} s of {} cameras, {} objects at {} Hz to {}{}", options.duration_s,
+               cameras, objects, rate_hz_, file,
+               truth_file.empty() ? "" : ", ground truth to " + truth_file);
+    worker_ = std::jthread([this, options, file, partial, truth_file](std::stop_token stop) {
       try {
         const uint64_t frames = write_candump_recording(*simulator_, log_stream_, options, stop);
         log_stream_.close();
+        truth_stream_.close();
         if (stop.stop_requested()) {
           log().warn("stopped after {} frames; the incomplete log stays in {}", frames, partial);
           return;
         }
+        // The truth first: whoever waits for FILE finds its truth there too.
+        if (!truth_file.empty()) fs::rename(truth_file + ".partial", truth_file);
         fs::rename(partial, file);
         log().info("wrote {} frames ({} samples) to {}", frames,
                    SampleSchedule(options.rate_hz).samples_before(options.duration_s), file);
@@ -226,6 +236,11 @@ class PixartBoxSim final : public Component {
         log().error("{}: {}", partial, e.what());
       }
     });
+  }
+
+  static void open_for_writing(std::ofstream& stream, const std::string& path) {
+    stream.open(path, std::ios::out | std::ios::trunc);
+    if (!stream) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
   }
 
   // --- pty output ----------------------------------------------------------------------------
@@ -338,6 +353,7 @@ class PixartBoxSim final : public Component {
   bool writing_fails_ = false;
   // candump output
   std::ofstream log_stream_;
+  std::ofstream truth_stream_;
   std::jthread worker_;  // last: starts once everything it uses exists
 };
 

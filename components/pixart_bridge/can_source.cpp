@@ -101,8 +101,7 @@ class CandumpSource final : public CanSource {
     if (!options_.recorded_timing) {
       // As fast as possible, in batches that keep the consumer's queues short.
       for (; next_ < records_.size() && frames.size() < 256; ++next_) {
-        frames.push_back(records_[next_].frame);
-        frames.back().stamp_ns = now_ns();
+        frames.push_back(recorded_frame(next_));
       }
       return frames;
     }
@@ -116,8 +115,7 @@ class CandumpSource final : public CanSource {
     std::this_thread::sleep_until(std::min(due(next_), start + timeout));
     auto now = std::chrono::steady_clock::now();
     for (; next_ < records_.size() && due(next_) <= now; ++next_) {
-      frames.push_back(records_[next_].frame);
-      frames.back().stamp_ns = now_ns();
+      frames.push_back(recorded_frame(next_));
     }
     return frames;
   }
@@ -129,6 +127,12 @@ class CandumpSource final : public CanSource {
   }
 
  private:
+  CanFrame recorded_frame(size_t index) const {
+    CanFrame frame = records_[index].frame;
+    frame.stamp_ns = records_[index].stamp_ns;
+    return frame;
+  }
+
   CandumpSourceOptions options_;
   std::vector<CandumpRecord> records_;
   size_t next_ = 0;

@@ -22,8 +22,9 @@ class CanSource {
  public:
   virtual ~CanSource() = default;
   // The frames that arrive within `timeout` (none on a quiet bus), stamped with the time they
-  // were read (a log replays its recorded timing but stamps with the replay's clock). Throws
-  // CanSourceError when the device is gone.
+  // were read; a log's frames keep their recorded stamps, as rosbag2 replays keep theirs, so
+  // a replay at any pace localizes as the live run did and pairs with what was recorded
+  // beside it (the simulator's ground truth). Throws CanSourceError when the device is gone.
   virtual std::vector<CanFrame> read(std::chrono::milliseconds timeout) = 0;
   // A log that has been replayed to its end; live sources never finish.
   virtual bool finished() const { return false; }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <set>
@@ -767,6 +768,16 @@ TEST(PixartBoxSimPlugin, WritesACandumpLog) {
   // The shipped rig's 4 cameras, 2 frames each, 135 samples in 0.5 s at 270 Hz.
   ASSERT_EQ(records.size(), 4u * 2u * 135u);
   EXPECT_EQ(records.front().stamp_ns, 1'700'000'000'000'000'000);
+  // Ground truth beside it: both robots every 20 ms of scene time, on the log's time scale.
+  std::ifstream truth(file.string() + ".truth.csv");
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(truth, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 1u + 2u * 25u);
+  EXPECT_EQ(rows[0], kTruthCsvHeader);
+  EXPECT_EQ(rows[1].rfind("1700000000000000000,robot_a,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[3].rfind("1700000000020000000,robot_a,", 0), 0u) << rows[3];
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".truth.csv.partial"));
   // The default scene (two robots, shipped rig): the same frames as the library's.
   Rig rig = shipped_rig();
   PixartBoxSimulator simulator(
