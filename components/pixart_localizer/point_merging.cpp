@@ -36,7 +36,7 @@ MergedPoints merge_views(const std::vector<CameraView>& views, const MergeOption
   const int64_t oldest_fresh_ns = merged.stamp_ns - to_ns(options.stale_after_s);
   const int64_t window_ns = to_ns(options.merge_window_s);
   std::vector<ViewPoint> points;
-  for (size_t camera = 0; camera < views.size(); ++camera) {
+  for (size_t camera = 0; camera < std::min(views.size(), kMaxCameras); ++camera) {
     const CameraView& view = views[camera];
     if (!view.received || view.stamp_ns < oldest_fresh_ns) continue;
     ++merged.cameras;
@@ -79,7 +79,10 @@ MergedPoints merge_views(const std::vector<CameraView>& views, const MergeOption
   for (const std::vector<size_t>& group : members) {
     if (group.empty()) continue;
     MergedPoint point;
-    for (size_t i : group) point.position += points[i].position;
+    for (size_t i : group) {
+      point.position += points[i].position;
+      point.cameras |= CameraSet{1} << points[i].camera;
+    }
     point.position /= static_cast<double>(group.size());
     point.views = static_cast<int>(group.size());
     merged.points.push_back(point);

@@ -34,9 +34,14 @@ struct MergeOptions {
   double stale_after_s = 0.02;
 };
 
+// The cameras that saw a point: bit i for the rig's camera i (rigs have at most 64 cameras).
+using CameraSet = uint64_t;
+inline constexpr size_t kMaxCameras = 64;
+
 struct MergedPoint {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // world x, y on the LED plane
   int views = 1;                                       // cameras that saw it
+  CameraSet cameras = 0;
 };
 
 struct MergedPoints {
@@ -45,7 +50,8 @@ struct MergedPoints {
   int cameras = 0;       // views that took part (fresh enough), with or without points
 };
 
-// The LEDs seen at the newest view's time. Views not yet received take no part.
+// The LEDs seen at the newest view's time. Views not yet received take no part; views beyond
+// the first kMaxCameras are ignored.
 MergedPoints merge_views(const std::vector<CameraView>& views, const MergeOptions& options = {});
 
 }  // namespace mocap::pixart::localization

@@ -41,8 +41,10 @@ RobotLocalizer::RobotLocalizer(Rig rig, LocalizerOptions options)
       recognizer_(rig_.robots, options_.recognition),
       tracker_(robot_names(rig_), options_.tracking),
       views_(rig_.cameras.size()) {
-  if (rig_.cameras.empty()) {
-    throw std::invalid_argument(fmt::format("the rig {} has no cameras", rig_.source));
+  if (rig_.cameras.empty() || rig_.cameras.size() > kMaxCameras) {
+    throw std::invalid_argument(
+        fmt::format("the rig {} has {} cameras; the localizer takes 1 to {}", rig_.source,
+                    rig_.cameras.size(), kMaxCameras));
   }
   if (recognizer_.unsupported().size() == rig_.robots.size()) {
     throw std::invalid_argument(fmt::format(
@@ -80,9 +82,14 @@ RobotLocalizer::SampleStatus RobotLocalizer::add_sample(
   // A robot unread for too long must not be revived by a lone LED near its old place.
   tracker_.expire(last_points_.stamp_ns);
   std::vector<Eigen::Vector2d> points;
+  std::vector<CameraSet> cameras;
   points.reserve(last_points_.points.size());
-  for (const MergedPoint& point : last_points_.points) points.push_back(point.position);
-  last_recognition_ = recognizer_.recognize(points, tracker_.tracked_poses());
+  cameras.reserve(last_points_.points.size());
+  for (const MergedPoint& point : last_points_.points) {
+    points.push_back(point.position);
+    cameras.push_back(point.cameras);
+  }
+  last_recognition_ = recognizer_.recognize(points, tracker_.tracked_poses(), cameras);
   tracker_.apply(last_recognition_.robots, last_points_.stamp_ns);
 
   stats_.ambiguous_pairs += static_cast<uint64_t>(last_recognition_.ambiguous_pairs);

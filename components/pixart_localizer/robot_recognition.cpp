@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -32,6 +33,15 @@ std::optional<std::string> layout_problem(const RobotModel& robot, double tolera
         d01, d02, d12, tolerance);
   }
   return std::nullopt;
+}
+
+// Whether one camera saw all of `points` (with no camera sets given, one camera saw all).
+bool seen_by_one_camera(const std::vector<CameraSet>& cameras,
+                        std::initializer_list<size_t> points) {
+  if (cameras.empty()) return true;
+  CameraSet common = ~CameraSet{0};
+  for (size_t p : points) common &= cameras[p];
+  return common != 0;
 }
 
 }  // namespace
@@ -106,9 +116,13 @@ double RobotRecognizer::smallest_led_distance_m() const {
   return std::isfinite(smallest) ? smallest : 0.0;
 }
 
-RecognitionResult RobotRecognizer::recognize(
-    const std::vector<Eigen::Vector2d>& points,
-    const std::vector<std::optional<PlanarPose>>& tracked) const {
+RecognitionResult RobotRecognizer::recognize(const std::vector<Eigen::Vector2d>& points,
+                                             const std::vector<std::optional<PlanarPose>>& tracked,
+                                             const std::vector<CameraSet>& cameras) const {
+  if (!cameras.empty() && cameras.size() != points.size()) {
+    throw std::invalid_argument(
+        fmt::format("{} camera sets for {} points", cameras.size(), points.size()));
+  }
   RecognitionResult result;
   std::vector<bool> used(points.size(), false);
   std::vector<bool> found(patterns_.size(), false);
@@ -116,8 +130,8 @@ RecognitionResult RobotRecognizer::recognize(
   std::vector<std::optional<PlanarPose>> priors(patterns_.size());
   for (size_t r = 0; r < priors.size() && r < tracked.size(); ++r) priors[r] = tracked[r];
 
-  find_triples(points, used, found, result);
-  find_pairs(points, priors, used, found, result);
+  find_triples(points, cameras, used, found, result);
+  find_pairs(points, priors, cameras, used, found, result);
   find_single_leds(points, priors, used, found, result);
   for (size_t i = 0; i < points.size(); ++i) {
     if (!used[i]) result.unexplained_points.push_back(i);
@@ -126,10 +140,14 @@ RecognitionResult RobotRecognizer::recognize(
 }
 
 void RobotRecognizer::find_triples(const std::vector<Eigen::Vector2d>& points,
-                                   std::vector<bool>& used, std::vector<bool>& found,
-                                   RecognitionResult& result) const {
+                                   const std::vector<CameraSet>& cameras, std::vector<bool>& used,
+                                   std::vector<bool>& found, RecognitionResult& result) const {
   const double tolerance = options_.pattern_tolerance_m;
-  std::vector<Recognition> candidates;
+  struct Candidate {
+    Recognition recognition;
+    bool one_camera;
+  };
+  std::vector<Candidate> candidates;
   const size_t n = points.size();
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
@@ -150,35 +168,39 @@ void RobotRecognizer::find_triples(const std::vector<Eigen::Vector2d>& points,
                                             {points[i], points[j], points[k]});
             if (fit.max_residual_m > tolerance) continue;  // the mirror image of the layout
             candidates.push_back(
-                {r, fit.pose, PoseEvidence::AllLeds, {i, j, k}, fit.rms_residual_m});
+                {{r, fit.pose, PoseEvidence::AllLeds, {i, j, k}, fit.rms_residual_m},
+                 seen_by_one_camera(cameras, {i, j, k})});
           }
         }
       }
     }
   }
-  std::sort(candidates.begin(), candidates.end(), [](const Recognition& l, const Recognition& r) {
-    return l.rms_residual_m < r.rms_residual_m;
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& l, const Candidate& r) {
+    if (l.one_camera != r.one_camera) return l.one_camera;
+    return l.recognition.rms_residual_m < r.recognition.rms_residual_m;
   });
-  for (Recognition& candidate : candidates) {
-    if (found[candidate.robot]) continue;
-    if (std::any_of(candidate.points.begin(), candidate.points.end(),
+  for (Candidate& candidate : candidates) {
+    Recognition& recognition = candidate.recognition;
+    if (found[recognition.robot]) continue;
+    if (std::any_of(recognition.points.begin(), recognition.points.end(),
                     [&](size_t p) { return used[p]; })) {
       continue;
     }
-    found[candidate.robot] = true;
-    for (size_t p : candidate.points) used[p] = true;
-    result.robots.push_back(std::move(candidate));
+    found[recognition.robot] = true;
+    for (size_t p : recognition.points) used[p] = true;
+    result.robots.push_back(std::move(recognition));
   }
 }
 
 void RobotRecognizer::find_pairs(const std::vector<Eigen::Vector2d>& points,
                                  const std::vector<std::optional<PlanarPose>>& tracked,
-                                 std::vector<bool>& used, std::vector<bool>& found,
-                                 RecognitionResult& result) const {
+                                 const std::vector<CameraSet>& cameras, std::vector<bool>& used,
+                                 std::vector<bool>& found, RecognitionResult& result) const {
   const double tolerance = options_.pattern_tolerance_m;
   struct Candidate {
     Recognition recognition;
-    double distance_to_track;  // of the steady LED: the nearest are taken first
+    bool one_camera;
+    double distance_to_track;  // of both LEDs, summed: the nearest are taken first
   };
   std::vector<Candidate> candidates;
   const size_t n = points.size();
@@ -208,20 +230,28 @@ void RobotRecognizer::find_pairs(const std::vector<Eigen::Vector2d>& points,
       auto [r, end] = *identified;
       if (found[r] || !tracked[r]) continue;
       const Pattern& pattern = *patterns_[r];
-      Eigen::Vector2d expected_steady = tracked[r]->to_world(pattern.leds[pattern.steady]);
-      double di = (points[i] - expected_steady).norm();
-      double dj = (points[j] - expected_steady).norm();
-      size_t steady_point = di <= dj ? i : j, end_point = di <= dj ? j : i;
-      double distance_to_track = std::min(di, dj);
-      if (distance_to_track > options_.tracking_gate_m) continue;
+      const Eigen::Vector2d expected_steady = tracked[r]->to_world(pattern.leds[pattern.steady]);
+      const Eigen::Vector2d expected_end = tracked[r]->to_world(pattern.leds[end]);
+      // Both LEDs, not the steady one alone: a camera off by half the spacing puts the end LED
+      // as near the tracked steady LED as the steady one.
+      const double i_steady =
+                       (points[i] - expected_steady).norm() + (points[j] - expected_end).norm(),
+                   j_steady =
+                       (points[j] - expected_steady).norm() + (points[i] - expected_end).norm();
+      const size_t steady_point = i_steady <= j_steady ? i : j;
+      const size_t end_point = steady_point == i ? j : i;
+      if ((points[steady_point] - expected_steady).norm() > options_.tracking_gate_m) continue;
+      const double distance_to_track = std::min(i_steady, j_steady);
       PlanarFit fit = fit_planar_pose({pattern.leds[pattern.steady], pattern.leds[end]},
                                       {points[steady_point], points[end_point]});
       candidates.push_back(
           {{r, fit.pose, PoseEvidence::TwoLeds, {steady_point, end_point}, fit.rms_residual_m},
+           seen_by_one_camera(cameras, {i, j}),
            distance_to_track});
     }
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& l, const Candidate& r) {
+    if (l.one_camera != r.one_camera) return l.one_camera;
     return l.distance_to_track < r.distance_to_track;
   });
   for (Candidate& candidate : candidates) {

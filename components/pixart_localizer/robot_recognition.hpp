@@ -17,14 +17,21 @@
 //      robot's steady-to-end spacing identifies that robot only if no other LED distance of
 //      any robot lies within twice the tolerance of that spacing (else it is ambiguous, the
 //      pair is left to step 3 and the heading is kept). Which of the two points is the steady
-//      LED the pair cannot say; the robot's tracked pose can: the point nearer the tracked
-//      position of the steady LED, within `tracking_gate_m`. An untracked robot is not
-//      initialised from two LEDs.
+//      LED the pair cannot say; the robot's tracked pose can: of the two assignments, the one
+//      that puts both LEDs nearer (summed distance) where the tracked pose has them, accepted
+//      when the steady LED is within `tracking_gate_m` of its tracked place. An untracked
+//      robot is not initialised from two LEDs.
 //   3. One LED: a point left over from 1 and 2 that lies within `tracking_gate_m` of where one
 //      of a tracked robot's LEDs (not yet found) should be moves that robot so that LED lands
 //      on it, keeping its heading; the nearest point–LED pairs are taken first. Usually it is
 //      the steady LED, but a sensor reports only 4 points, and with more LEDs in its view the
 //      steady one may be among those dropped while a blinking end is reported.
+//
+// In steps 1 and 2, LEDs seen together by one camera are preferred to LEDs combined across
+// cameras: one camera places its points consistently with each other, while two cameras
+// disagree by their calibration errors (centimetres for cameras not yet calibrated), and a
+// pair or triple across them can fit a layout in a wrong orientation. Across cameras is the
+// fallback, for a robot no single camera sees enough of.
 //
 // Robots the recognizer cannot tell apart or orient are set aside when it is built, each
 // with the reason (unsupported()): it needs exactly three LEDs, one of them steady (off_s 0)
@@ -40,6 +47,7 @@
 
 #include "pixart_rig.hpp"
 #include "planar_fit.hpp"
+#include "point_merging.hpp"
 
 namespace mocap::pixart::localization {
 
@@ -78,9 +86,11 @@ class RobotRecognizer {
   explicit RobotRecognizer(const std::vector<RobotModel>& robots, RecognitionOptions options = {});
 
   // `tracked[i]`: robot i's last pose if it is being tracked, else nullopt (size: the rig's
-  // robot count; missing entries count as untracked).
+  // robot count; missing entries count as untracked). `cameras[i]`: the cameras that saw
+  // point i; empty: one camera saw them all.
   RecognitionResult recognize(const std::vector<Eigen::Vector2d>& points,
-                              const std::vector<std::optional<PlanarPose>>& tracked) const;
+                              const std::vector<std::optional<PlanarPose>>& tracked,
+                              const std::vector<CameraSet>& cameras = {}) const;
 
   // Whether robot `robot` (rig index) can be recognised; the reasons for those that cannot,
   // "robot 'name': why".
@@ -101,10 +111,12 @@ class RobotRecognizer {
     std::array<bool, 3> identifying_spacing{};
   };
 
-  void find_triples(const std::vector<Eigen::Vector2d>& points, std::vector<bool>& used,
+  void find_triples(const std::vector<Eigen::Vector2d>& points,
+                    const std::vector<CameraSet>& cameras, std::vector<bool>& used,
                     std::vector<bool>& found, RecognitionResult& result) const;
   void find_pairs(const std::vector<Eigen::Vector2d>& points,
-                  const std::vector<std::optional<PlanarPose>>& tracked, std::vector<bool>& used,
+                  const std::vector<std::optional<PlanarPose>>& tracked,
+                  const std::vector<CameraSet>& cameras, std::vector<bool>& used,
                   std::vector<bool>& found, RecognitionResult& result) const;
   void find_single_leds(const std::vector<Eigen::Vector2d>& points,
                         const std::vector<std::optional<PlanarPose>>& tracked,
