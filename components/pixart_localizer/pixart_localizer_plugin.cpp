@@ -1,5 +1,10 @@
 // pixart_localizer: every PixArt camera's fiducial arrays -> robot poses x, y, θ in the world
 // frame (robot_localizer.hpp), published at a steady rate whether the robots move or not.
+//
+// publish_rate_hz: 0 publishes after every sample used instead, for consumers that want each
+// sample's result at once (a timer adds up to one period of latency, 20 ms at the default
+// 50 Hz). Nothing is published then while no sample arrives: robots whose cameras all fall
+// silent stay in the last array, where the steady rate would drop them after lost_after_s.
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -53,7 +58,10 @@ class PixartLocalizer final : public Component {
                    "how far a robot's steady LED may be from its tracked place, for readings "
                    "of 2 LEDs and of 1")
         .range(1e-3, 10);
-    spec.parameter("publish_rate_hz", 50.0, "rate of /pixart/robots").range(0.1, 1000);
+    spec.parameter("publish_rate_hz", 50.0,
+                   "rate of /pixart/robots; 0 = after every sample used (no timer: nothing is "
+                   "published while no sample arrives)")
+        .range(0, 1000);
     spec.parameter("lost_after_s", 1.0, "a robot not seen for this long is dropped")
         .range(0.01, 3600);
     spec.subscribes<FiducialArray>(
@@ -77,9 +85,13 @@ class PixartLocalizer final : public Component {
           "/pixart/" + camera.name + "/fiducials",
           [this, name = camera.name](const FiducialArray& array) { on_sample(name, array); });
     }
-    auto period = std::chrono::duration<double>(1.0 / param<double>("publish_rate_hz"));
-    create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(period),
-                 [this] { publish(); });
+    if (const double rate = param<double>("publish_rate_hz"); rate > 0) {
+      create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::duration<double>(1.0 / rate)),
+                   [this] { publish(); });
+    } else {
+      publish_every_sample_ = true;
+    }
     log().info("{} robots, {} cameras, LED plane at {} m (rig {})",
                rig.robots.size() - localizer_.recognizer().unsupported().size(), rig.cameras.size(),
                rig.led_plane_height_m, rig.source);
@@ -130,7 +142,11 @@ class PixartLocalizer final : public Component {
     if (localizer_.newest_sample_ns() != newest_before) {
       newest_arrived_ = std::chrono::steady_clock::now();
     }
-    report_events();
+    if (publish_every_sample_ && status == RobotLocalizer::SampleStatus::Used) {
+      publish();  // reports the events too
+    } else {
+      report_events();
+    }
   }
 
   void publish() {
@@ -181,6 +197,7 @@ class PixartLocalizer final : public Component {
   std::chrono::steady_clock::time_point newest_arrived_ = std::chrono::steady_clock::now();
   std::set<std::string> unknown_cameras_;
   std::set<std::string> mismatched_topics_;
+  bool publish_every_sample_ = false;  // publish_rate_hz 0
   uint64_t published_ = 0;
 };
 
