@@ -83,8 +83,8 @@ Summary summarize(std::vector<double> us) {
 // `bytes` written on the master, until a reader blocked on the slave (the bridge's SerialPort)
 // has all of them: the floor under the runtime's rows.
 std::vector<double> bare_pty(const std::string& bytes, int samples) {
-  can::PseudoTerminal pty;
-  can::SerialPort port(pty.slave_path());
+  serial::PseudoTerminal pty;
+  serial::SerialPort port(pty.slave_path());
   const auto lines = static_cast<size_t>(std::count(bytes.begin(), bytes.end(), '\r'));
   std::vector<int64_t> arrived(static_cast<size_t>(samples));
   std::atomic<int> complete{0};
@@ -230,7 +230,7 @@ class Adaptor {
   }
 
  private:
-  can::PseudoTerminal pty_;
+  serial::PseudoTerminal pty_;
   pixart::SimulatedSlcanAdaptor adaptor_;
 };
 

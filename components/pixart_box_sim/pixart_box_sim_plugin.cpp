@@ -156,7 +156,7 @@ class PixartBoxSim final : public Component {
     bitrate_ = param<int>("bitrate");
     can::slcan_open_commands(bitrate_);  // throws, naming the supported bitrates, for others
     truths_ = create_publisher<mocap_msgs::msg::RobotPoseArray>(kTruthTopic);
-    pty_.emplace(can::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
+    pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
     const std::string link = param<std::string>("device_link");
     if (!link.empty()) {
       point_link(link, pty_->slave_path());
@@ -264,7 +264,7 @@ class PixartBoxSim final : public Component {
       size_t count = 0;
       try {
         count = pty_->read(buffer, sizeof buffer, wait);
-      } catch (const can::SerialError& e) {
+      } catch (const serial::SerialError& e) {
         log().error("{}; the simulated adaptor stops", e.what());
         return;
       }
@@ -298,7 +298,7 @@ class PixartBoxSim final : public Component {
     if (answers.empty()) return;
     try {
       pty_->write_all(answers);
-    } catch (const can::SerialError& e) {
+    } catch (const serial::SerialError& e) {
       log().warn("cannot answer the host: {}", e.what());
     }
   }
@@ -317,7 +317,7 @@ class PixartBoxSim final : public Component {
       pty_->write_all(bytes);
       ++sent_;
       writing_fails_ = false;
-    } catch (const can::SerialError& e) {
+    } catch (const serial::SerialError& e) {
       ++failed_writes_;
       if (!writing_fails_) log().warn("dropping samples: {}", e.what());
       writing_fails_ = true;
@@ -346,7 +346,7 @@ class PixartBoxSim final : public Component {
   Steady::time_point scene_start_;
   Publisher<mocap_msgs::msg::RobotPoseArray> truths_;
   // pty output; the adaptor and the counters belong to the worker thread until it ends.
-  std::optional<can::PseudoTerminal> pty_;
+  std::optional<serial::PseudoTerminal> pty_;
   std::string device_link_;
   SimulatedSlcanAdaptor adaptor_;
   uint64_t sent_ = 0, skipped_ = 0, held_back_ = 0, failed_writes_ = 0;

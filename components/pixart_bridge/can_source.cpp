@@ -23,9 +23,9 @@ class SlcanSource final : public CanSource {
   explicit SlcanSource(const SlcanSourceOptions& options) : options_(options) {
     std::vector<std::string> commands = slcan_open_commands(options.bitrate);  // may throw
     try {
-      port_.emplace(options.device, SerialPortOptions{.baud_rate = options.baud});
+      port_.emplace(options.device, serial::SerialPortOptions{.baud_rate = options.baud});
       for (const std::string& command : commands) port_->write_all(command);
-    } catch (const SerialError& e) {
+    } catch (const serial::SerialError& e) {
       throw CanSourceError(e.what());
     }
   }
@@ -34,7 +34,7 @@ class SlcanSource final : public CanSource {
     // Leave the adaptor closed, as a set-up script's `slcand` would; it may be gone already.
     try {
       if (port_) port_->write_all(slcan_close_command());
-    } catch (const SerialError&) {
+    } catch (const serial::SerialError&) {
     }
   }
 
@@ -43,7 +43,7 @@ class SlcanSource final : public CanSource {
     try {
       size_t n = port_->read(buffer, sizeof buffer, timeout);
       if (n > 0) parser_.feed(std::string_view(buffer, n), now_ns());
-    } catch (const SerialError& e) {
+    } catch (const serial::SerialError& e) {
       throw CanSourceError(e.what());
     }
     return parser_.take_frames();
@@ -56,7 +56,7 @@ class SlcanSource final : public CanSource {
 
  private:
   SlcanSourceOptions options_;
-  std::optional<SerialPort> port_;
+  std::optional<serial::SerialPort> port_;
   SlcanParser parser_;
 };
 

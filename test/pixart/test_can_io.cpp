@@ -1,7 +1,7 @@
 // The PixArt bridge's CAN input layer (components/pixart_bridge, library can_io): frames in
 // candump notation, the SLCAN protocol, candump -L logs, serial ports over real
-// pseudo-terminals, and SocketCAN (frame conversion always; a live round trip where a vcan0
-// interface exists).
+// pseudo-terminals (components/serial_io), and SocketCAN (frame conversion always; a live round
+// trip where a vcan0 interface exists).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,6 +23,11 @@
 #include "test_support.hpp"
 
 namespace mocap::can {
+
+using serial::PseudoTerminal;
+using serial::SerialError;
+using serial::SerialPort;
+using serial::supported_baud_rates;
 
 // Readable frames in failure messages.
 void PrintTo(const CanFrame& frame, std::ostream* out) {

@@ -681,7 +681,7 @@ robots:
     ASSERT_NE(std::filesystem::read_symlink(link), "/dev/null");
 
     // The host's side, as the bridge does it: open the device, open the channel at 1 Mbit/s.
-    can::SerialPort port(link.string());
+    serial::SerialPort port(link.string());
     port.write_all("C\rS8\rO\r");
     std::string received;
     can::SlcanParser parser;

@@ -71,7 +71,7 @@ HostOptions in_process() { return {.name = "test", .threads = 2, .dds = {.enable
 
 TEST(PixartBridge, SlcanFramesBecomeFiducialsAndTheAdaptorMayBeUnplugged) {
   test::TempDir dir;
-  auto adaptor = std::make_unique<can::PseudoTerminal>();
+  auto adaptor = std::make_unique<serial::PseudoTerminal>();
   // The bridge opens a stable name, as udev gives a real adaptor; replugging re-points it.
   std::filesystem::path device = dir / "ttyPIXART";
   std::filesystem::create_symlink(adaptor->slave_path(), device);
@@ -112,7 +112,7 @@ TEST(PixartBridge, SlcanFramesBecomeFiducialsAndTheAdaptorMayBeUnplugged) {
   // Unplugged: the master end goes away. Plugged in again as a new device under the same
   // name; the bridge reopens it, opens the channel again and carries on.
   adaptor.reset();
-  adaptor = std::make_unique<can::PseudoTerminal>();
+  adaptor = std::make_unique<serial::PseudoTerminal>();
   std::filesystem::remove(device);
   std::filesystem::create_symlink(adaptor->slave_path(), device);
   commands.clear();

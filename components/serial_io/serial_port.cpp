@@ -15,7 +15,7 @@
 
 #include <fmt/format.h>
 
-namespace mocap::can {
+namespace mocap::serial {
 namespace {
 
 using SteadyClock = std::chrono::steady_clock;
@@ -301,4 +301,4 @@ size_t PseudoTerminal::read(char* buffer, size_t size, std::chrono::milliseconds
 
 void PseudoTerminal::close_master() { close_quietly(std::exchange(master_fd_, -1)); }
 
-}  // namespace mocap::can
+}  // namespace mocap::serial

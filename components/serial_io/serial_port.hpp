@@ -1,6 +1,7 @@
-// Serial devices in raw mode (the USB-CAN adaptor's /dev/ttyACM0), and pseudo-terminals that
-// stand in for them: the simulated PixArt box writes on a pty's master what a real adaptor
-// would send, and the bridge reads its slave side like any serial device.
+// Serial devices in raw mode (a USB-CAN adaptor's /dev/ttyACM0, a USB2Dynamixel's
+// /dev/ttyUSB0), and pseudo-terminals that stand in for them: a simulator (the PixArt box, the
+// AX-12A servo chain) writes on a pty's master what the real device would send, and the
+// driver reads and writes its slave side like any serial device.
 #pragma once
 
 #include <chrono>
@@ -10,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-namespace mocap::can {
+namespace mocap::serial {
 
 // A serial device that cannot be opened, configured, read or written, or went away; the
 // message names the device and the system's reason.
@@ -114,4 +115,4 @@ class PseudoTerminal {
   std::string slave_path_;
 };
 
-}  // namespace mocap::can
+}  // namespace mocap::serial
