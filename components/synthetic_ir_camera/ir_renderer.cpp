@@ -315,9 +315,9 @@ std::vector<double> IrRenderer::exposure_times(const SceneObject& object, double
   int steps = scene_.render.motion_blur_steps;
   if (steps == 0) {
     // Enough poses that no marker jumps more than kMotionBlurStep_px between two.
-    Eigen::Isometry3d start = pose_at(object.trajectory, time_s - exposure_s / 2);
-    Eigen::Isometry3d middle = pose_at(object.trajectory, time_s);
-    Eigen::Isometry3d end = pose_at(object.trajectory, time_s + exposure_s / 2);
+    Eigen::Isometry3d start = object_pose(object, time_s - exposure_s / 2);
+    Eigen::Isometry3d middle = object_pose(object, time_s);
+    Eigen::Isometry3d end = object_pose(object, time_s + exposure_s / 2);
     double travel_px = 0;
     for (const Eigen::Vector3d& marker : object.markers) {
       auto a = camera_->project(start * marker);
@@ -373,7 +373,9 @@ IrRenderer::Rect IrRenderer::object_occlusion(const SceneObject& object,
   return clip(x0, y0, x1, y1);
 }
 
-RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number) {
+RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
+                                 const Eigen::Isometry3d& camera_from_world) {
+  camera_from_world_ = camera_from_world;
   std::mt19937_64 random(splitmix64(scene_.seed ^ splitmix64(frame_number)));
   cv::Mat noise = noise_.frame(random);
   if (noise.empty()) {
@@ -388,7 +390,7 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number) {
   for (const SceneObject& object : scene_.objects) {
     ObjectTruth truth;
     truth.constellation = object.constellation;
-    truth.pose = pose_at(object.trajectory, time_s);
+    truth.pose = object_pose(object, time_s);
     truth.in_front = truth.pose.translation().z() > 0;
     truth.facing_camera = truth.pose.linear().col(2).dot(truth.pose.translation()) < 0;
     for (const Eigen::Vector3d& marker : object.markers) {
@@ -403,7 +405,7 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number) {
 
     std::vector<double> times = exposure_times(object, time_s);
     std::vector<Eigen::Isometry3d> poses;
-    for (double t : times) poses.push_back(pose_at(object.trajectory, t));
+    for (double t : times) poses.push_back(object_pose(object, t));
     for (const Eigen::Vector3d& marker : object.markers) draw_marker(poses, marker, work_);
 
     Rect occlusion = object_occlusion(object, truth);

@@ -70,8 +70,12 @@ class IrRenderer {
   IrRenderer(Scene scene, std::shared_ptr<const calibration::CameraModel> camera);
 
   // The frame whose exposure is centred on scene time `time_s`. `frame_number` selects the
-  // frame's random draws.
-  RenderedFrame render(double time_s, uint64_t frame_number = 0);
+  // frame's random draws. `camera_from_world` places the camera: the scene's trajectories are
+  // in the world frame, which is the camera frame by default (a fixed camera). A moving camera
+  // (on a turret, on a base) is held still over one exposure: motion blur comes from the
+  // objects' motion only.
+  RenderedFrame render(double time_s, uint64_t frame_number = 0,
+                       const Eigen::Isometry3d& camera_from_world = Eigen::Isometry3d::Identity());
 
   const Scene& scene() const { return scene_; }
   const calibration::CameraModel& camera() const { return *camera_; }
@@ -83,6 +87,10 @@ class IrRenderer {
     bool empty() const { return x1 < x0 || y1 < y0; }
   };
 
+  // The object's constellation frame in the camera frame at scene time `time_s`.
+  Eigen::Isometry3d object_pose(const SceneObject& object, double time_s) const {
+    return camera_from_world_ * pose_at(object.trajectory, time_s);
+  }
   std::vector<double> exposure_times(const SceneObject& object, double time_s) const;
   bool view_disc(const Eigen::Isometry3d& pose, const Eigen::Vector3d& marker,
                  DiscView& view) const;
@@ -97,6 +105,7 @@ class IrRenderer {
 
   Scene scene_;
   std::shared_ptr<const calibration::CameraModel> camera_;
+  Eigen::Isometry3d camera_from_world_ = Eigen::Isometry3d::Identity();  // of the current frame
   RayTable rays_;
   SensorNoise noise_;
   double marker_radius_m_;

@@ -5,10 +5,17 @@
 // the frame count, not the wall clock, so a run renders the same frames whatever the load of
 // the machine. Headers carry the wall-clock time of publication; an image and its ground truth
 // share header stamp and frame id, so consumers pair them by stamp.
+//
+// With moving_camera the camera is carried around (a turret on a mobile base, see
+// mobile_base_sim): its pose in the world arrives on /sim/camera_pose, the scene's trajectories
+// are in the world frame, and each frame is rendered from the latest pose. Frames wait for the
+// first pose.
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include <geometry_msgs/msg/pose_stamped.hpp>
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/component.hpp>
 #include <mocap/message_time.hpp>
@@ -25,6 +32,7 @@ namespace {
 
 constexpr const char* kImageTopic = "/camera/ir/image_raw";
 constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
+constexpr const char* kCameraPoseTopic = "/sim/camera_pose";
 // With rate_hz 0 frames follow each other as fast as they render: the timer only has to fire
 // again before a frame is done, and a faster timer would only wake its thread for nothing.
 constexpr std::chrono::microseconds kBackToBackPeriod{200};
@@ -62,6 +70,13 @@ class SyntheticIrCamera final : public Component {
     spec.parameter("wait_for_subscriber", true,
                    "hold the first frame until the image topic has a subscriber, so a run "
                    "across processes starts with frame 0 however long discovery takes");
+    spec.parameter("moving_camera", false,
+                   "false: the camera stands still and the scene is in its frame; true: its pose "
+                   "in the world comes on " +
+                       std::string(kCameraPoseTopic) + " and the scene is in the world frame");
+    spec.subscribes<geometry_msgs::msg::PoseStamped>(
+        kCameraPoseTopic, Qos::reliable(),
+        "moving_camera: the camera's optical frame in the world (e.g. from mobile_base_sim)");
     spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
                                             "rendered frames, mono8");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
@@ -87,6 +102,20 @@ class SyntheticIrCamera final : public Component {
     time_step_s_ = param<double>("time_step_s");
     if (time_step_s_ == 0) time_step_s_ = rate_hz > 0 ? 1 / rate_hz : kDefaultTimeStep_s;
 
+    if (param<bool>("moving_camera")) {
+      create_subscription<geometry_msgs::msg::PoseStamped>(
+          kCameraPoseTopic, [this](const geometry_msgs::msg::PoseStamped& pose) {
+            const auto& p = pose.pose().position();
+            const auto& q = pose.pose().orientation();
+            Eigen::Isometry3d world_from_camera = Eigen::Isometry3d::Identity();
+            world_from_camera.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
+            world_from_camera.linear() =
+                Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
+            camera_from_world_ = world_from_camera.inverse();
+          });
+    } else {
+      camera_from_world_ = Eigen::Isometry3d::Identity();
+    }
     images_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
     truths_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kTruthTopic);
     std::chrono::nanoseconds period = rate_hz > 0
@@ -117,7 +146,13 @@ class SyntheticIrCamera final : public Component {
       }
       return;
     }
-    RenderedFrame frame = renderer_->render(static_cast<double>(frames_) * time_step_s_, frames_);
+    if (!camera_from_world_) {
+      if (!reported_no_pose_) log().info("waiting for the camera's pose on {}", kCameraPoseTopic);
+      reported_no_pose_ = true;
+      return;
+    }
+    RenderedFrame frame = renderer_->render(static_cast<double>(frames_) * time_step_s_, frames_,
+                                            *camera_from_world_);
     ++frames_;
 
     std_msgs::msg::Header header;
@@ -160,6 +195,10 @@ class SyntheticIrCamera final : public Component {
   double time_step_s_ = 0;
   uint64_t frames_ = 0;
   bool reported_end_ = false;
+  bool reported_no_pose_ = false;
+  // The camera's place; none until the first pose arrives (moving_camera). Callbacks of one
+  // component never overlap, so the pose callback and tick() share it without a lock.
+  std::optional<Eigen::Isometry3d> camera_from_world_;
   Publisher<sensor_msgs::msg::Image> images_;
   Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
 };

@@ -455,6 +455,28 @@ TEST(IrRenderer, GroundTruthIsTheCameraModelsProjection) {
   EXPECT_EQ(truth.visible_markers(), 12);
 }
 
+TEST(IrRenderer, AMovingCameraSeesTheWorldFromWhereItStands) {
+  const Eigen::Vector3d board_in_world(1.3, 0.4, 1.5), rpy(5, 20, -30);
+  IrRenderer moving(board_scene(StaticTrajectory{board_in_world, rpy}), shipped_camera());
+  // Moved by (1, 0.5, −0.3): the same picture as a fixed camera with the board that much
+  // nearer, pixel for pixel.
+  Eigen::Isometry3d world_from_camera(Eigen::Translation3d(1.0, 0.5, -0.3));
+  RenderedFrame seen = moving.render(0, 0, world_from_camera.inverse());
+  IrRenderer fixed(
+      board_scene(StaticTrajectory{board_in_world - Eigen::Vector3d(1.0, 0.5, -0.3), rpy}),
+      shipped_camera());
+  RenderedFrame expected = fixed.render(0, 0);
+  ASSERT_EQ(seen.objects.size(), 1u);
+  expect_near(seen.objects[0].pose.translation(), {0.3, -0.1, 1.8});
+  EXPECT_EQ(seen.objects[0].visible_markers(), 12);
+  EXPECT_EQ(cv::norm(seen.image, expected.image, cv::NORM_INF), 0);
+  // Turned as well: the truth is the board in the camera's frame.
+  world_from_camera.rotate(Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1, 0).normalized()));
+  RenderedFrame turned = moving.render(0, 0, world_from_camera.inverse());
+  const Eigen::Isometry3d board = pose_at(StaticTrajectory{board_in_world, rpy}, 0);
+  EXPECT_TRUE(turned.objects[0].pose.isApprox(world_from_camera.inverse() * board, 1e-12));
+}
+
 TEST(IrRenderer, MarkerCentroidsLieOnTheProjectedCentres) {
   // Fronto-parallel, off the pixel grid, with the default blur and no noise.
   Scene scene = board_scene(StaticTrajectory{{0.0213, -0.0137, 1.2}, {0, 0, 0}});
