@@ -7,9 +7,11 @@
 // share header stamp and frame id, so consumers pair them by stamp.
 //
 // With moving_camera the camera is carried around (a turret on a mobile base, see
-// mobile_base_sim): its pose in the world arrives on /sim/camera_pose, the scene's trajectories
-// are in the world frame, and each frame is rendered from the latest pose. Frames wait for the
-// first pose.
+// mobile_base_sim): its pose in the world (x forward, y left, z up) arrives on /sim/camera_pose
+// and each frame is rendered from the latest pose; frames wait for the first pose. The scene
+// then describes the world as a camera at the world's origin looking along its x axis would
+// see it (scene x = world −y, y = world −z, z = world x), so a scene reads the same for a
+// fixed camera and for one that starts at the origin.
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -39,6 +41,14 @@ constexpr std::chrono::microseconds kBackToBackPeriod{200};
 constexpr double kDefaultTimeStep_s = 1.0 / 30;
 
 std::string config_file(const char* relative) { return std::string(MOCAP_CONFIG_DIR) + relative; }
+
+// The scene's frame in the world's, for moving_camera: an optical frame at the origin looking
+// along world x.
+Eigen::Isometry3d world_from_scene() {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  return pose;
+}
 
 class SyntheticIrCamera final : public Component {
  public:
@@ -73,7 +83,8 @@ class SyntheticIrCamera final : public Component {
     spec.parameter("moving_camera", false,
                    "false: the camera stands still and the scene is in its frame; true: its pose "
                    "in the world comes on " +
-                       std::string(kCameraPoseTopic) + " and the scene is in the world frame");
+                       std::string(kCameraPoseTopic) +
+                       " and the scene is as seen from the world's origin looking along x");
     spec.subscribes<geometry_msgs::msg::PoseStamped>(
         kCameraPoseTopic, Qos::reliable(),
         "moving_camera: the camera's optical frame in the world (e.g. from mobile_base_sim)");
@@ -111,7 +122,7 @@ class SyntheticIrCamera final : public Component {
             world_from_camera.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
             world_from_camera.linear() =
                 Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-            camera_from_world_ = world_from_camera.inverse();
+            camera_from_world_ = world_from_camera.inverse() * world_from_scene();
           });
     } else {
       camera_from_world_ = Eigen::Isometry3d::Identity();
