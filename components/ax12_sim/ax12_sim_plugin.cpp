@@ -1,0 +1,191 @@
+// ax12_sim: a chain of simulated AX-12A servos (simulated_ax12_chain.hpp) behind a USB
+// adaptor, played on a pseudo-terminal, the embedded default when no servos are attached.
+// The driver opens the pseudo-terminal (or the device_link to it) like a USB2Dynamixel and
+// speaks Protocol 1.0 to it, so the real driver code path runs.
+//
+// A worker thread reads the host's bytes, feeds them to the chain on the steady clock's time
+// since the component was created, writes the answers back, and moves the servos at least
+// every 2 ms while the host is quiet. It publishes nothing.
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include <mocap/component.hpp>
+
+#include "ax12_control_table.hpp"
+#include "serial_port.hpp"
+#include "simulated_ax12_chain.hpp"
+
+namespace mocap::dynamixel {
+namespace {
+
+namespace fs = std::filesystem;
+using Steady = std::chrono::steady_clock;
+
+// How long the worker waits for the host's bytes before it moves the servos anyway.
+constexpr std::chrono::milliseconds kStepPeriod{2};
+// A host that stops reading fills the pty's buffer; the answer is dropped after this long,
+// as on a bus where nobody listens.
+constexpr std::chrono::milliseconds kPtyWriteTimeout{100};
+
+// Points `link` at `target`, replacing an older symbolic link (from a previous run) in one
+// step, so that a host opening the link never finds it missing. Refuses to replace anything
+// that is not a symbolic link.
+void point_link(const fs::path& link, const std::string& target) {
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(link, error);
+  if (fs::exists(status) && !fs::is_symlink(status)) {
+    throw std::invalid_argument("device_link " + link.string() +
+                                " exists and is not a symbolic link; not replacing it");
+  }
+  fs::path temporary = link;
+  temporary += ".new" + std::to_string(::getpid());
+  fs::remove(temporary, error);
+  try {
+    fs::create_symlink(target, temporary);
+    fs::rename(temporary, link);
+  } catch (const fs::filesystem_error& e) {
+    fs::remove(temporary, error);
+    throw std::runtime_error("device_link " + link.string() + ": " + e.code().message());
+  }
+}
+
+std::vector<uint8_t> servo_ids(const std::vector<int64_t>& values) {
+  if (values.empty()) throw std::invalid_argument("parameter 'ids' is empty: no servos");
+  std::vector<uint8_t> ids;
+  for (int64_t id : values) ids.push_back(static_cast<uint8_t>(id));  // range-checked: 0..253
+  return ids;
+}
+
+class Ax12Sim final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Simulated AX-12A servo chain on a pseudo-terminal: answers Dynamixel Protocol 1.0 "
+        "instructions (PING, READ, WRITE, REG_WRITE/ACTION, SYNC_WRITE, RESET) like the real "
+        "servos and moves them toward their goal positions at their moving speeds, for the "
+        "Dynamixel driver when no servos are attached. Publishes nothing.");
+    spec.parameter("ids", std::vector<int>{1, 2}, "the servos' IDs, distinct").range(0, 253);
+    spec.parameter("initial_positions", std::vector<int>{},
+                   "present position of each servo (same order as ids), position units; empty = "
+                   "512 (centre) for all")
+        .range(0, 1023);
+    spec.parameter("faults", std::vector<std::string>{},
+                   "injected faults as ID:FAULT, FAULT one of silent (no answer), corrupt (bad "
+                   "checksums), overheat, overload, none; e.g. [\"2:overheat\"]");
+    spec.parameter("baud", 1000000,
+                   "the bus's bit rate, informational: a pseudo-terminal passes bytes at any rate")
+        .min(1);
+    spec.parameter("device_link", std::string(),
+                   "symbolic link to create to the pseudo-terminal (replacing an older link), "
+                   "for the driver's `device`; empty = none (the log names the pty)")
+        .path();
+  }
+
+  explicit Ax12Sim(Context& context)
+      : Component(context), chain_(servo_ids(param<std::vector<int64_t>>("ids"))) {
+    const std::vector<uint8_t> ids = chain_.ids();
+    const std::vector<int> positions = param<std::vector<int>>("initial_positions");
+    if (!positions.empty() && positions.size() != ids.size()) {
+      throw std::invalid_argument(
+          fmt::format("parameter 'initial_positions' has {} values for {} servos", positions.size(),
+                      ids.size()));
+    }
+    for (size_t i = 0; i < positions.size(); ++i) {
+      chain_.set_position(ids[i], static_cast<uint16_t>(positions[i]));
+    }
+    std::string faults;
+    for (const std::string& text : param<std::vector<std::string>>("faults")) {
+      const auto [id, fault] = parse_ax12_fault_spec(text);
+      if (!chain_.has_servo(id)) {
+        throw std::invalid_argument(
+            fmt::format("fault '{}': no servo with ID {} in 'ids'", text, id));
+      }
+      chain_.set_fault(id, fault);
+      faults += fmt::format(", servo {} {}", id, to_string(fault));
+    }
+    pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
+    const std::string link = param<std::string>("device_link");
+    if (!link.empty()) {
+      point_link(link, pty_->slave_path());
+      device_link_ = link;
+    }
+    log().info("simulated AX-12A chain on {}{}: servos {} at {} bit/s{}", pty_->slave_path(),
+               link.empty() ? "" : " (link " + link + ")", fmt::join(ids, ", "), param<int>("baud"),
+               faults);
+    start_ = Steady::now();
+    worker_ = std::jthread([this](std::stop_token stop) { play(stop); });
+  }
+
+  ~Ax12Sim() override {
+    worker_.request_stop();
+    if (worker_.joinable()) worker_.join();
+    if (!device_link_.empty()) {
+      // Only our own link: another run may have taken the name over since.
+      std::error_code error;
+      if (fs::read_symlink(device_link_, error) == fs::path(pty_->slave_path())) {
+        fs::remove(device_link_, error);
+      }
+    }
+    pty_->close_master();
+    const SimulatedAx12ChainStats& s = chain_.stats();
+    std::string positions;
+    for (uint8_t id : chain_.ids()) {
+      positions += fmt::format("{}servo {} at {}", positions.empty() ? "" : ", ", id,
+                               chain_.register_u16(id, ax12::kPresentPosition));
+    }
+    log().info(
+        "{} instructions ({} with bad checksums, {} for absent IDs), {} answers, {} failed "
+        "writes; {}",
+        s.instructions, s.checksum_errors, s.unaddressed, s.replies, failed_writes_, positions);
+  }
+
+ private:
+  double time_s() const { return std::chrono::duration<double>(Steady::now() - start_).count(); }
+
+  void play(std::stop_token stop) {
+    char buffer[512];
+    while (!stop.stop_requested()) {
+      size_t count = 0;
+      try {
+        count = pty_->read(buffer, sizeof buffer, kStepPeriod);
+      } catch (const serial::SerialError& e) {
+        log().error("{}; the simulated servos stop", e.what());
+        return;
+      }
+      if (count == 0) {
+        chain_.advance(time_s());
+        continue;
+      }
+      const std::string answers = chain_.feed(std::string_view(buffer, count), time_s());
+      if (answers.empty()) continue;
+      try {
+        pty_->write_all(answers);
+      } catch (const serial::SerialError& e) {
+        if (failed_writes_++ == 0) log().warn("cannot answer the host: {}", e.what());
+      }
+    }
+  }
+
+  // The chain and the counter belong to the worker thread until it ends.
+  SimulatedAx12Chain chain_;
+  uint64_t failed_writes_ = 0;
+  std::optional<serial::PseudoTerminal> pty_;
+  std::string device_link_;
+  Steady::time_point start_;
+  std::jthread worker_;  // last: starts once everything it uses exists
+};
+
+}  // namespace
+}  // namespace mocap::dynamixel
+
+MOCAP_REGISTER_COMPONENT(mocap::dynamixel::Ax12Sim, "ax12_sim")

@@ -1,0 +1,82 @@
+#include "turret_follower.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace mocap::turret {
+namespace {
+
+void require_positive(double value, const char* name) {
+  if (!(value > 0) || !std::isfinite(value)) {
+    throw std::invalid_argument(std::string(name) + " is " + std::to_string(value) +
+                                "; it must be a positive number");
+  }
+}
+
+}  // namespace
+
+const char* to_string(TurretMode mode) {
+  switch (mode) {
+    case TurretMode::Idle:
+      return "idle";
+    case TurretMode::Tracking:
+      return "tracking";
+    case TurretMode::Holding:
+      return "holding";
+    case TurretMode::Searching:
+      return "searching";
+  }
+  return "?";
+}
+
+TurretFollower::TurretFollower(TurretModel turret, TurretFollowerOptions options)
+    : turret_(std::move(turret)), options_(options) {
+  require_positive(options_.pan_speed_rps, "pan_speed_rps");
+  require_positive(options_.tilt_speed_rps, "tilt_speed_rps");
+  require_positive(options_.lost_after_s, "lost_after_s");
+  require_positive(options_.search_speed_rps, "search_speed_rps");
+  if (!(options_.hold_s >= 0)) throw std::invalid_argument("hold_s must not be negative");
+}
+
+void TurretFollower::observe(int64_t stamp_ns, const Eigen::Vector3d& in_camera,
+                             const JointAngles& angles) {
+  if (object_in_base_ && stamp_ns < last_seen_ns_) return;  // an older image arriving late
+  object_in_base_ = turret_.base_from_camera(angles) * in_camera;
+  last_seen_ns_ = stamp_ns;
+}
+
+TurretCommand TurretFollower::update(int64_t now_ns, const JointAngles& present) {
+  TurretCommand command;
+  command.speed = {options_.pan_speed_rps, options_.tilt_speed_rps};
+  if (!object_in_base_) {
+    command.goal = present;
+    return command;
+  }
+  const double since_seen_s = static_cast<double>(now_ns - last_seen_ns_) * 1e-9;
+  if (since_seen_s <= options_.lost_after_s) {
+    held_.reset();
+    const Aim aim = turret_.aim_at(*object_in_base_, present);
+    command.mode = TurretMode::Tracking;
+    command.goal = aim.angles;
+    command.out_of_reach = !aim.within_limits;
+    command.pointing_error_rad = turret_.pointing_error(present, *object_in_base_);
+    return command;
+  }
+  if (!held_) held_ = present;
+  if (!options_.search || since_seen_s <= options_.lost_after_s + options_.hold_s) {
+    command.mode = TurretMode::Holding;
+    command.goal = *held_;
+    return command;
+  }
+  // Sweep: head for one pan limit at the search speed; turn round there.
+  command.mode = TurretMode::Searching;
+  const Joint& pan = turret_.pan();
+  if (present.pan >= pan.max_rad - 0.01) search_direction_ = -1;
+  if (present.pan <= pan.min_rad + 0.01) search_direction_ = 1;
+  command.goal = {search_direction_ > 0 ? pan.max_rad : pan.min_rad, 0.0};
+  command.speed = {options_.search_speed_rps, options_.tilt_speed_rps};
+  return command;
+}
+
+}  // namespace mocap::turret

@@ -1,0 +1,80 @@
+// What the turret does, without servos or middleware: keep the tracked object on the optical
+// axis (seed 000 §5.11.3), and when the track is lost, hold still, then optionally search.
+//
+//   TurretFollower follower(turret);
+//   follower.observe(image_stamp_ns, object_in_camera, angles_at_image);  // per pose
+//   TurretCommand command = follower.update(now_ns, present_angles);      // per control cycle
+//
+// The object is kept in the base frame: where it was seen, through the angles the turret had
+// at that moment (joint_history.hpp). Each cycle aims the camera at it from the present angles.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "turret_model.hpp"
+
+namespace mocap::turret {
+
+struct TurretFollowerOptions {
+  // Servo speed limits. The seed ran its heavy Tango turret at 0.1 and 0.05 rad/s (§5.11.3)
+  // and found them too slow to follow a walking person (§7.5); these suit a light camera.
+  double pan_speed_rps = 1.5;
+  double tilt_speed_rps = 1.0;
+  // No pose for this long: the track is lost.
+  double lost_after_s = 0.3;
+  // After losing the track: hold still this long, then search (when `search` is on).
+  double hold_s = 2.0;
+  // Searching sweeps the pan joint between its limits at search_speed_rps, tilt level.
+  bool search = false;
+  double search_speed_rps = 0.3;
+};
+
+enum class TurretMode {
+  Idle,       // no object seen yet: hold where it is
+  Tracking,   // aiming at the object
+  Holding,    // track lost: holding still
+  Searching,  // track lost for hold_s: sweeping
+};
+const char* to_string(TurretMode mode);  // "idle", "tracking", "holding", "searching"
+
+struct TurretCommand {
+  TurretMode mode = TurretMode::Idle;
+  JointAngles goal;   // where the joints should go
+  JointAngles speed;  // how fast, rad/s (positive)
+  // Tracking: the angle between the optical axis at the present angles and the object, as
+  // last seen (0 otherwise).
+  double pointing_error_rad = 0;
+  // Tracking: the object is beyond the joints' limits; `goal` is the nearest reachable.
+  bool out_of_reach = false;
+};
+
+class TurretFollower {
+ public:
+  // Throws std::invalid_argument for speeds or times that are not positive.
+  explicit TurretFollower(TurretModel turret, TurretFollowerOptions options = {});
+
+  // The object seen at `stamp_ns` at `in_camera` (camera frame, metres), when the joints were
+  // at `angles`.
+  void observe(int64_t stamp_ns, const Eigen::Vector3d& in_camera, const JointAngles& angles);
+
+  // The command for now, the joints being at `present`.
+  TurretCommand update(int64_t now_ns, const JointAngles& present);
+
+  // Where the object was last seen, base frame; nothing before the first observation.
+  const std::optional<Eigen::Vector3d>& object_in_base() const { return object_in_base_; }
+  const TurretModel& turret() const { return turret_; }
+  const TurretFollowerOptions& options() const { return options_; }
+
+ private:
+  TurretModel turret_;
+  TurretFollowerOptions options_;
+  std::optional<Eigen::Vector3d> object_in_base_;
+  int64_t last_seen_ns_ = 0;
+  std::optional<JointAngles> held_;  // where the joints stopped when the track was lost
+  double search_direction_ = 1;
+};
+
+}  // namespace mocap::turret

@@ -1,0 +1,52 @@
+#include "follow_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mocap::evaluation {
+
+void FollowEvaluator::add_truth(int64_t stamp_ns, const Eigen::Vector3d& object_in_camera,
+                                const Eigen::Isometry3d& world_from_camera, bool trackable) {
+  const Eigen::Vector2d object = (world_from_camera * object_in_camera).head<2>();
+  if (previous_ && stamp_ns > previous_->first) {
+    speed_mps_ = (object - previous_->second).norm() /
+                 (static_cast<double>(stamp_ns - previous_->first) * 1e-9);
+  }
+  previous_ = {stamp_ns, object};
+  const bool walking = speed_mps_ > options_.walking_speed_mps;
+  if (walking || !trackable) {
+    standing_since_ns_.reset();
+  } else if (!standing_since_ns_) {
+    standing_since_ns_ = stamp_ns;
+  }
+  if (!trackable) return;
+  const double error =
+      std::acos(std::clamp(object_in_camera.normalized().z(), -1.0, 1.0)) * 180 / M_PI;
+  figures_.pointing_error_deg.push_back(error);
+  if (walking) figures_.pointing_error_walking_deg.push_back(error);
+  if (base_ && standing_since_ns_ &&
+      static_cast<double>(stamp_ns - *standing_since_ns_) * 1e-9 >= options_.settle_s) {
+    figures_.steady_distance_m.push_back((object - *base_).norm());
+  }
+}
+
+void FollowEvaluator::add_velocity_command(int64_t received_ns, double linear, double angular) {
+  const bool stop = linear == 0 && angular == 0;
+  if (stop && moving_ && last_pose_ns_) {
+    figures_.stop_latency_s.push_back(static_cast<double>(received_ns - *last_pose_ns_) * 1e-9);
+  }
+  moving_ = !stop;
+}
+
+Spread spread(std::vector<double> values) {
+  if (values.empty()) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {nan, nan, nan};
+  }
+  std::sort(values.begin(), values.end());
+  return {values[values.size() / 2], values[std::min(values.size() - 1, values.size() * 95 / 100)],
+          values.back()};
+}
+
+}  // namespace mocap::evaluation

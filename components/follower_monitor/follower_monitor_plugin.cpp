@@ -1,0 +1,225 @@
+// follower_monitor: the follower demo's live summary and final figures (follow_evaluation.hpp)
+// from the simulation's ground truth: pointing error of the turret, distance the base keeps,
+// time from a lost track to a stopped base, and the rates of the loops.
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include <geometry_msgs/msg/pose_stamped.hpp>
+#include <geometry_msgs/msg/twist.hpp>
+#include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/alert.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <sensor_msgs/msg/joint_state.hpp>
+
+#include "follow_evaluation.hpp"
+
+namespace mocap::evaluation {
+namespace {
+
+using geometry_msgs::msg::PoseStamped;
+using mocap_msgs::msg::ConstellationPoseArray;
+
+constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
+constexpr const char* kCameraPoseTopic = "/sim/camera_pose";
+constexpr const char* kBasePoseTopic = "/base/pose";
+constexpr const char* kPoseTopic = "/mocap/poses";
+constexpr const char* kVelocityTopic = "/cmd_vel";
+constexpr const char* kJointTopic = "/turret/joint_states";
+constexpr const char* kAlertTopic = "/alerts";
+// A board showing this many of its markers can be tracked (three sides of twelve).
+constexpr uint32_t kTrackableMarkers = 10;
+
+Eigen::Isometry3d to_isometry(const PoseStamped& pose) {
+  const auto& p = pose.pose().position();
+  const auto& q = pose.pose().orientation();
+  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
+  result.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
+  result.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
+  return result;
+}
+
+int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Messages per second of one topic over a reporting period and over the run.
+struct RateCounter {
+  uint64_t total = 0, period = 0;
+  int64_t first_ns = 0, last_ns = 0;
+  void add(int64_t now_ns) {
+    if (total++ == 0) first_ns = now_ns;
+    last_ns = now_ns;
+    ++period;
+  }
+  double overall_hz() const {
+    return total > 1
+               ? static_cast<double>(total - 1) / (static_cast<double>(last_ns - first_ns) * 1e-9)
+               : 0.0;
+  }
+};
+
+class FollowerMonitor final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Follower demo figures from the simulation's ground truth: the turret's pointing "
+        "error, the distance the base keeps from the object once it stands still, the time "
+        "from a lost track to a stopped base, and loop rates; a live line and a final table.");
+    spec.parameter("constellation", std::string("board_a"), "the followed constellation");
+    spec.parameter("report_period_s", 2.0, "seconds between summary lines").range(0.1, 3600);
+    spec.parameter("settle_s", 4.0,
+                   "the object standing this long: the base's distance counts as steady")
+        .range(0, 3600);
+    spec.parameter("summary_file", std::string(), "where the final figures go (YAML), optional")
+        .path();
+    spec.subscribes<ConstellationPoseArray>(kTruthTopic, Qos::reliable(),
+                                            "the synthetic camera's ground truth");
+    spec.subscribes<PoseStamped>(kCameraPoseTopic, Qos::reliable(), "the camera in the world");
+    spec.subscribes<PoseStamped>(kBasePoseTopic, Qos::reliable(), "the base in the world");
+    spec.subscribes<ConstellationPoseArray>(kPoseTopic, Qos::reliable(), "tracked poses");
+    spec.subscribes<geometry_msgs::msg::Twist>(kVelocityTopic, Qos::reliable(),
+                                               "the drive follower's commands");
+    spec.subscribes<sensor_msgs::msg::JointState>(kJointTopic, Qos::reliable(),
+                                                  "the turret's joint states (its cycle rate)");
+    spec.subscribes<mocap_msgs::msg::Alert>(kAlertTopic, Qos::reliable(), "alerts, counted");
+  }
+
+  explicit FollowerMonitor(Context& context) : Component(context) {
+    constellation_ = param<std::string>("constellation");
+    summary_file_ = param<std::string>("summary_file");
+    evaluator_ = FollowEvaluator({.settle_s = param<double>("settle_s")});
+    create_subscription<PoseStamped>(kCameraPoseTopic, [this](const PoseStamped& pose) {
+      world_from_camera_ = to_isometry(pose);
+    });
+    create_subscription<PoseStamped>(kBasePoseTopic, [this](const PoseStamped& pose) {
+      evaluator_.add_base({pose.pose().position().x(), pose.pose().position().y()});
+    });
+    create_subscription<ConstellationPoseArray>(
+        kTruthTopic, [this](const ConstellationPoseArray& truth) {
+          rates_["camera"].add(steady_ns());
+          if (!world_from_camera_) return;
+          for (const auto& pose : truth.poses()) {
+            if (pose.name() != constellation_) continue;
+            const auto& p = pose.pose().pose().position();
+            evaluator_.add_truth(to_nanoseconds(pose.pose().header().stamp()),
+                                 Eigen::Vector3d(p.x(), p.y(), p.z()), *world_from_camera_,
+                                 pose.points_used() >= kTrackableMarkers);
+          }
+        });
+    create_subscription<ConstellationPoseArray>(kPoseTopic,
+                                                [this](const ConstellationPoseArray& poses) {
+                                                  for (const auto& pose : poses.poses()) {
+                                                    if (pose.name() != constellation_) continue;
+                                                    const int64_t now = steady_ns();
+                                                    evaluator_.add_pose(now);
+                                                    rates_["poses"].add(now);
+                                                  }
+                                                });
+    create_subscription<geometry_msgs::msg::Twist>(
+        kVelocityTopic, [this](const geometry_msgs::msg::Twist& twist) {
+          const int64_t now = steady_ns();
+          rates_["drive"].add(now);
+          evaluator_.add_velocity_command(now, twist.linear().x(), twist.angular().z());
+        });
+    create_subscription<sensor_msgs::msg::JointState>(
+        kJointTopic,
+        [this](const sensor_msgs::msg::JointState&) { rates_["turret"].add(steady_ns()); });
+    create_subscription<mocap_msgs::msg::Alert>(
+        kAlertTopic, [this](const mocap_msgs::msg::Alert&) { ++alerts_; });
+    const double period_s = param<double>("report_period_s");
+    create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                     std::chrono::duration<double>(period_s)),
+                 [this, period_s] { report(period_s); });
+  }
+
+  ~FollowerMonitor() override {
+    const FollowFigures& f = evaluator_.figures();
+    const Spread pointing = spread(f.pointing_error_deg);
+    const Spread walking = spread(f.pointing_error_walking_deg);
+    const Spread distance = spread(f.steady_distance_m);
+    const Spread stop = spread(f.stop_latency_s);
+    size_t within = 0;
+    for (double d : f.steady_distance_m) within += std::abs(d - 1.5) <= 0.1 ? 1 : 0;
+    const double within_percent =
+        f.steady_distance_m.empty() ? NAN : 100.0 * within / f.steady_distance_m.size();
+    log().info("| figure | frames or events | median | p95 | max |");
+    log().info("|---|---:|---:|---:|---:|");
+    log().info("| pointing error, deg | {} | {:.2f} | {:.2f} | {:.2f} |",
+               f.pointing_error_deg.size(), pointing.median, pointing.p95, pointing.max);
+    log().info("| pointing error while walking, deg | {} | {:.2f} | {:.2f} | {:.2f} |",
+               f.pointing_error_walking_deg.size(), walking.median, walking.p95, walking.max);
+    log().info(
+        "| distance kept, standing, m ({:.0f} % within 1.5 ± 0.1) | {} | {:.3f} | {:.3f} "
+        "| {:.3f} |",
+        within_percent, f.steady_distance_m.size(), distance.median, distance.p95, distance.max);
+    log().info("| lost track -> zero velocity, s | {} | {:.3f} | {:.3f} | {:.3f} |",
+               f.stop_latency_s.size(), stop.median, stop.p95, stop.max);
+    log().info(
+        "rates over the run: camera {:.1f} Hz, poses {:.1f} Hz, turret {:.1f} Hz, drive "
+        "{:.1f} Hz; {} alerts",
+        rates_["camera"].overall_hz(), rates_["poses"].overall_hz(), rates_["turret"].overall_hz(),
+        rates_["drive"].overall_hz(), alerts_);
+    write_summary(pointing, walking, distance, within_percent, stop);
+  }
+
+ private:
+  void report(double period_s) {
+    const FollowFigures& f = evaluator_.figures();
+    auto recent = [](const std::vector<double>& values, size_t since) {
+      return spread(std::vector<double>(values.begin() + static_cast<long>(since), values.end()));
+    };
+    const Spread pointing = recent(f.pointing_error_deg, reported_pointing_);
+    reported_pointing_ = f.pointing_error_deg.size();
+    auto hz = [&](const char* topic) {
+      RateCounter& counter = rates_[topic];
+      const double rate = static_cast<double>(counter.period) / period_s;
+      counter.period = 0;
+      return rate;
+    };
+    log().info(
+        "pointing error {:.2f} deg median, {:.2f} max; object {:.2f} m/s; distance kept {}; "
+        "rates: camera {:.0f}, poses {:.0f}, turret {:.0f}, drive {:.0f} Hz; {} alerts",
+        pointing.median, pointing.max, evaluator_.object_speed_mps(),
+        f.steady_distance_m.empty() ? std::string("(not standing yet)")
+                                    : fmt::format("{:.3f} m", f.steady_distance_m.back()),
+        hz("camera"), hz("poses"), hz("turret"), hz("drive"), alerts_);
+  }
+
+  void write_summary(const Spread& pointing, const Spread& walking, const Spread& distance,
+                     double within_percent, const Spread& stop) {
+    if (summary_file_.empty()) return;
+    std::ofstream out(summary_file_);
+    out << fmt::format(
+        "pointing_error_deg: {{median: {:.4f}, p95: {:.4f}, max: {:.4f}}}\n"
+        "pointing_error_walking_deg: {{median: {:.4f}, p95: {:.4f}, max: {:.4f}}}\n"
+        "steady_distance_m: {{median: {:.4f}, p95: {:.4f}, max: {:.4f}, within_percent: {:.1f}}}\n"
+        "stop_latency_s: {{count: {}, median: {:.4f}, max: {:.4f}}}\n"
+        "rates_hz: {{camera: {:.2f}, poses: {:.2f}, turret: {:.2f}, drive: {:.2f}}}\n"
+        "alerts: {}\n",
+        pointing.median, pointing.p95, pointing.max, walking.median, walking.p95, walking.max,
+        distance.median, distance.p95, distance.max, within_percent,
+        evaluator_.figures().stop_latency_s.size(), stop.median, stop.max,
+        rates_["camera"].overall_hz(), rates_["poses"].overall_hz(), rates_["turret"].overall_hz(),
+        rates_["drive"].overall_hz(), alerts_);
+    if (!out) log().error("cannot write {}", summary_file_);
+  }
+
+  std::string constellation_;
+  std::string summary_file_;
+  FollowEvaluator evaluator_;
+  std::optional<Eigen::Isometry3d> world_from_camera_;
+  std::map<std::string, RateCounter> rates_;
+  size_t reported_pointing_ = 0;
+  uint64_t alerts_ = 0;
+};
+
+}  // namespace
+}  // namespace mocap::evaluation
+
+MOCAP_REGISTER_COMPONENT(mocap::evaluation::FollowerMonitor, "follower_monitor")
