@@ -5,8 +5,9 @@
 // itself is gone.
 //
 // Poses are used only once the turret's angles are known: with the wrong angles the object
-// would be placed in the wrong direction and the base driven there. The latest angles are
-// used with each pose; while the turret moves they lag the pose by up to one joint state.
+// would be placed in the wrong direction and the base driven there. Each pose is placed with
+// the angles the turret had at its image's time (joint_history.hpp), not the latest ones,
+// which run ahead while the turret turns.
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -21,6 +22,7 @@
 #include <sensor_msgs/msg/joint_state.hpp>
 
 #include "drive_follower.hpp"
+#include "joint_history.hpp"
 #include "object_in_base.hpp"
 #include "turret_model.hpp"
 
@@ -168,7 +170,7 @@ class DriveFollowerComponent final : public Component {
       return;
     }
     ++joint_states_;
-    joints_ = turret::JointAngles{*pan, *tilt};
+    joints_.add(to_nanoseconds(state.header().stamp()), turret::JointAngles{*pan, *tilt});
   }
 
   void on_poses(const ConstellationPoseArray& poses) {
@@ -183,7 +185,9 @@ class DriveFollowerComponent final : public Component {
       ++arrays_without_;
       return;
     }
-    if (!joints_) {
+    const std::optional<turret::JointAngles> joints =
+        joints_.at(to_nanoseconds(followed->pose().header().stamp()));
+    if (!joints) {
       if (poses_before_joints_++ == 0) {
         log().warn("poses are not used until {} carries the angles of '{}' and '{}'", kJointStates,
                    pan_joint_, tilt_joint_);
@@ -198,7 +202,7 @@ class DriveFollowerComponent final : public Component {
     }
     followed_name_ = followed->name();
     const ObjectObservation observation =
-        object_in_base(turret_.base_from_camera(*joints_), *camera_from_object);
+        object_in_base(turret_.base_from_camera(*joints), *camera_from_object);
     follower_.observe(observation.object, steady_seconds());
     ++poses_used_;
   }
@@ -244,7 +248,7 @@ class DriveFollowerComponent final : public Component {
   std::string tilt_joint_;
   Publisher<Twist> command_publisher_;
   Publisher<Alert> alert_publisher_;
-  std::optional<turret::JointAngles> joints_;
+  turret::JointHistory joints_;
   std::string followed_name_;
   uint64_t periods_ = 0, periods_forward_ = 0, periods_backward_ = 0, periods_facing_ = 0,
            periods_stopped_ = 0;

@@ -3,6 +3,7 @@
 // time from a lost track to a stopped base, and the rates of the loops.
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <fstream>
 #include <map>
 #include <string>
@@ -30,6 +31,8 @@ constexpr const char* kPoseTopic = "/mocap/poses";
 constexpr const char* kVelocityTopic = "/cmd_vel";
 constexpr const char* kJointTopic = "/turret/joint_states";
 constexpr const char* kAlertTopic = "/alerts";
+// The camera's poses come at the simulated base's 100 Hz: a second of them.
+constexpr size_t kKeptCameraPoses = 100;
 // A board showing this many of its markers can be tracked (three sides of twelve).
 constexpr uint32_t kTrackableMarkers = 10;
 
@@ -95,7 +98,8 @@ class FollowerMonitor final : public Component {
     summary_file_ = param<std::string>("summary_file");
     evaluator_ = FollowEvaluator({.settle_s = param<double>("settle_s")});
     create_subscription<PoseStamped>(kCameraPoseTopic, [this](const PoseStamped& pose) {
-      world_from_camera_ = to_isometry(pose);
+      camera_poses_.emplace_back(to_nanoseconds(pose.header().stamp()), to_isometry(pose));
+      while (camera_poses_.size() > kKeptCameraPoses) camera_poses_.pop_front();
     });
     create_subscription<PoseStamped>(kBasePoseTopic, [this](const PoseStamped& pose) {
       evaluator_.add_base({pose.pose().position().x(), pose.pose().position().y()});
@@ -103,12 +107,14 @@ class FollowerMonitor final : public Component {
     create_subscription<ConstellationPoseArray>(
         kTruthTopic, [this](const ConstellationPoseArray& truth) {
           rates_["camera"].add(steady_ns());
-          if (!world_from_camera_) return;
+          const std::optional<Eigen::Isometry3d> world_from_camera =
+              camera_pose_at(to_nanoseconds(truth.header().stamp()));
+          if (!world_from_camera) return;
           for (const auto& pose : truth.poses()) {
             if (pose.name() != constellation_) continue;
             const auto& p = pose.pose().pose().position();
             evaluator_.add_truth(to_nanoseconds(pose.pose().header().stamp()),
-                                 Eigen::Vector3d(p.x(), p.y(), p.z()), *world_from_camera_,
+                                 Eigen::Vector3d(p.x(), p.y(), p.z()), *world_from_camera,
                                  pose.points_used() >= kTrackableMarkers);
           }
         });
@@ -169,6 +175,15 @@ class FollowerMonitor final : public Component {
   }
 
  private:
+  // The camera pose the synthetic camera rendered a frame stamped `stamp_ns` with: the newest
+  // published before it (the camera stamps a frame when it renders it, with the latest pose).
+  std::optional<Eigen::Isometry3d> camera_pose_at(int64_t stamp_ns) const {
+    for (auto pose = camera_poses_.rbegin(); pose != camera_poses_.rend(); ++pose) {
+      if (pose->first <= stamp_ns) return pose->second;
+    }
+    return std::nullopt;
+  }
+
   void report(double period_s) {
     const FollowFigures& f = evaluator_.figures();
     auto recent = [](const std::vector<double>& values, size_t since) {
@@ -213,7 +228,7 @@ class FollowerMonitor final : public Component {
   std::string constellation_;
   std::string summary_file_;
   FollowEvaluator evaluator_;
-  std::optional<Eigen::Isometry3d> world_from_camera_;
+  std::deque<std::pair<int64_t, Eigen::Isometry3d>> camera_poses_;  // stamp, pose; oldest first
   std::map<std::string, RateCounter> rates_;
   size_t reported_pointing_ = 0;
   uint64_t alerts_ = 0;
