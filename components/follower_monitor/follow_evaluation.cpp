@@ -9,11 +9,14 @@ namespace mocap::evaluation {
 void FollowEvaluator::add_truth(int64_t stamp_ns, const Eigen::Vector3d& object_in_camera,
                                 const Eigen::Isometry3d& world_from_camera, bool trackable) {
   const Eigen::Vector2d object = (world_from_camera * object_in_camera).head<2>();
-  if (previous_ && stamp_ns > previous_->first) {
-    speed_mps_ = (object - previous_->second).norm() /
-                 (static_cast<double>(stamp_ns - previous_->first) * 1e-9);
+  if (!recent_.empty() && stamp_ns <= recent_.back().first) return;  // out of order
+  recent_.emplace_back(stamp_ns, object);
+  const auto window_ns = static_cast<int64_t>(options_.speed_window_s * 1e9);
+  while (recent_.size() > 2 && recent_[1].first <= stamp_ns - window_ns) recent_.pop_front();
+  if (recent_.size() > 1) {
+    speed_mps_ = (object - recent_.front().second).norm() /
+                 (static_cast<double>(stamp_ns - recent_.front().first) * 1e-9);
   }
-  previous_ = {stamp_ns, object};
   const bool walking = speed_mps_ > options_.walking_speed_mps;
   if (walking || !trackable) {
     standing_since_ns_.reset();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <vector>
 
@@ -14,8 +15,11 @@
 namespace mocap::evaluation {
 
 struct FollowEvaluationOptions {
-  // The object counts as walking above this speed, as standing below it.
-  double walking_speed_mps = 0.2;
+  // The object counts as walking above this speed, as standing below it; the speed is
+  // measured over speed_window_s, so that a pose of the camera paired with the wrong frame
+  // does not look like a step.
+  double walking_speed_mps = 0.1;
+  double speed_window_s = 0.5;
   // Standing this long: the follower has had time to settle, distances count as steady.
   double settle_s = 4.0;
 };
@@ -57,8 +61,8 @@ class FollowEvaluator {
   std::optional<Eigen::Vector2d> base_;
   std::optional<int64_t> last_pose_ns_;
   bool moving_ = false;  // the last command was not a stop
-  // Object motion.
-  std::optional<std::pair<int64_t, Eigen::Vector2d>> previous_;
+  // Object motion: its recent positions (stamp, x y), oldest first.
+  std::deque<std::pair<int64_t, Eigen::Vector2d>> recent_;
   double speed_mps_ = 0;
   std::optional<int64_t> standing_since_ns_;
 };
