@@ -8,27 +8,24 @@
 // every 2 ms while the host is quiet. It publishes nothing.
 #include <chrono>
 #include <cstdint>
-#include <filesystem>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include <unistd.h>
-
 #include <fmt/format.h>
 
 #include <mocap/component.hpp>
 
 #include "ax12_control_table.hpp"
+#include "device_link.hpp"
 #include "serial_port.hpp"
 #include "simulated_ax12_chain.hpp"
 
 namespace mocap::dynamixel {
 namespace {
 
-namespace fs = std::filesystem;
 using Steady = std::chrono::steady_clock;
 
 // How long the worker waits for the host's bytes before it moves the servos anyway.
@@ -36,28 +33,6 @@ constexpr std::chrono::milliseconds kStepPeriod{2};
 // A host that stops reading fills the pty's buffer; the answer is dropped after this long,
 // as on a bus where nobody listens.
 constexpr std::chrono::milliseconds kPtyWriteTimeout{100};
-
-// Points `link` at `target`, replacing an older symbolic link (from a previous run) in one
-// step, so that a host opening the link never finds it missing. Refuses to replace anything
-// that is not a symbolic link.
-void point_link(const fs::path& link, const std::string& target) {
-  std::error_code error;
-  const fs::file_status status = fs::symlink_status(link, error);
-  if (fs::exists(status) && !fs::is_symlink(status)) {
-    throw std::invalid_argument("device_link " + link.string() +
-                                " exists and is not a symbolic link; not replacing it");
-  }
-  fs::path temporary = link;
-  temporary += ".new" + std::to_string(::getpid());
-  fs::remove(temporary, error);
-  try {
-    fs::create_symlink(target, temporary);
-    fs::rename(temporary, link);
-  } catch (const fs::filesystem_error& e) {
-    fs::remove(temporary, error);
-    throw std::runtime_error("device_link " + link.string() + ": " + e.code().message());
-  }
-}
 
 std::vector<uint8_t> servo_ids(const std::vector<int64_t>& values) {
   if (values.empty()) throw std::invalid_argument("parameter 'ids' is empty: no servos");
@@ -116,8 +91,7 @@ class Ax12Sim final : public Component {
     pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
     const std::string link = param<std::string>("device_link");
     if (!link.empty()) {
-      point_link(link, pty_->slave_path());
-      device_link_ = link;
+      device_link_.emplace(link, pty_->slave_path());
     }
     log().info("simulated AX-12A chain on {}{}: servos {} at {} bit/s{}", pty_->slave_path(),
                link.empty() ? "" : " (link " + link + ")", fmt::join(ids, ", "), param<int>("baud"),
@@ -129,13 +103,7 @@ class Ax12Sim final : public Component {
   ~Ax12Sim() override {
     worker_.request_stop();
     if (worker_.joinable()) worker_.join();
-    if (!device_link_.empty()) {
-      // Only our own link: another run may have taken the name over since.
-      std::error_code error;
-      if (fs::read_symlink(device_link_, error) == fs::path(pty_->slave_path())) {
-        fs::remove(device_link_, error);
-      }
-    }
+    device_link_.reset();
     pty_->close_master();
     const SimulatedAx12ChainStats& s = chain_.stats();
     std::string positions;
@@ -180,7 +148,7 @@ class Ax12Sim final : public Component {
   SimulatedAx12Chain chain_;
   uint64_t failed_writes_ = 0;
   std::optional<serial::PseudoTerminal> pty_;
-  std::string device_link_;
+  std::optional<serial::DeviceLink> device_link_;
   Steady::time_point start_;
   std::jthread worker_;  // last: starts once everything it uses exists
 };

@@ -27,13 +27,12 @@
 #include <string>
 #include <thread>
 
-#include <unistd.h>
-
 #include <mocap/component.hpp>
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
 #include "candump_recording.hpp"
+#include "device_link.hpp"
 #include "pixart_box_simulator.hpp"
 #include "pixart_rig.hpp"
 #include "pixart_scene.hpp"
@@ -62,28 +61,6 @@ int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-// Points `link` at `target`, replacing an older symbolic link (from a previous run) in one
-// step, so that a host opening the link never finds it missing. Refuses to replace anything
-// that is not a symbolic link.
-void point_link(const fs::path& link, const std::string& target) {
-  std::error_code error;
-  const fs::file_status status = fs::symlink_status(link, error);
-  if (fs::exists(status) && !fs::is_symlink(status)) {
-    throw std::invalid_argument("device_link " + link.string() +
-                                " exists and is not a symbolic link; not replacing it");
-  }
-  fs::path temporary = link;
-  temporary += ".new" + std::to_string(::getpid());
-  fs::remove(temporary, error);
-  try {
-    fs::create_symlink(target, temporary);
-    fs::rename(temporary, link);
-  } catch (const fs::filesystem_error& e) {
-    fs::remove(temporary, error);
-    throw std::runtime_error("device_link " + link.string() + ": " + e.code().message());
-  }
 }
 
 class PixartBoxSim final : public Component {
@@ -159,8 +136,7 @@ class PixartBoxSim final : public Component {
     pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
     const std::string link = param<std::string>("device_link");
     if (!link.empty()) {
-      point_link(link, pty_->slave_path());
-      device_link_ = link;
+      device_link_.emplace(link, pty_->slave_path());
     }
     log().info("simulated SLCAN adaptor on {}{}: {} cameras, {} objects, {} Hz, {} bit/s",
                pty_->slave_path(), link.empty() ? "" : " (link " + link + ")", cameras, objects,
@@ -176,13 +152,7 @@ class PixartBoxSim final : public Component {
   ~PixartBoxSim() override {
     worker_.request_stop();
     if (worker_.joinable()) worker_.join();
-    if (!device_link_.empty()) {
-      // Only our own link: another run may have taken the name over since.
-      std::error_code error;
-      if (pty_ && fs::read_symlink(device_link_, error) == fs::path(pty_->slave_path())) {
-        fs::remove(device_link_, error);
-      }
-    }
+    device_link_.reset();
     if (pty_) {
       pty_->close_master();
       const PixartBoxSimulatorStats& s = simulator_->stats();
@@ -347,7 +317,7 @@ class PixartBoxSim final : public Component {
   Publisher<mocap_msgs::msg::RobotPoseArray> truths_;
   // pty output; the adaptor and the counters belong to the worker thread until it ends.
   std::optional<serial::PseudoTerminal> pty_;
-  std::string device_link_;
+  std::optional<serial::DeviceLink> device_link_;
   SimulatedSlcanAdaptor adaptor_;
   uint64_t sent_ = 0, skipped_ = 0, held_back_ = 0, failed_writes_ = 0;
   bool writing_fails_ = false;
