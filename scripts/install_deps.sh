@@ -11,8 +11,10 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   # runtime
   libyaml-cpp-dev libfmt-dev
-  # vision: images, geometry
-  libopencv-dev libeigen3-dev
+  # calibration: configuration and data files (JSON)
+  nlohmann-json3-dev
+  # vision: images, geometry, least squares (camera calibration)
+  libopencv-dev libeigen3-dev libceres-dev
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
   # benchmarks: instruction counts

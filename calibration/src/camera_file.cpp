@@ -2,17 +2,27 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
+#include <fmt/format.h>
+#include <mocap/calibration/eucm_camera.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
 namespace mocap::calibration {
 namespace {
+
+// How far from 1 a pose quaternion's norm may be: hand-written quaternions with four or five
+// decimals pass, a wrong element or a missing sign does not.
+constexpr double kQuaternionNormTolerance = 1e-3;
 
 class Reader {
  public:
@@ -24,10 +34,30 @@ class Reader {
     throw CameraFileError(where + ": " + what);
   }
 
-  YAML::Node required(const char* key) const {
-    YAML::Node node = root_[key];
-    if (!node) fail(root_, std::string("missing field '") + key + "'");
+  YAML::Node required(const char* key) const { return required(root_, key, ""); }
+
+  // `map[key]`; `prefix` ("eucm.") completes the field's name in the error.
+  YAML::Node required(const YAML::Node& map, const char* key, const std::string& prefix) const {
+    YAML::Node node = map[key];
+    if (!node) fail(map, "missing field '" + prefix + key + "'");
     return node;
+  }
+
+  // A map whose keys are all in `allowed`.
+  void check_map(const YAML::Node& node, const std::string& field,
+                 const std::vector<std::string_view>& allowed) const {
+    if (!node.IsMap()) fail(node, "'" + field + "' must be a map");
+    for (const auto& entry : node) {
+      std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "(not a name)";
+      bool known = false;
+      for (std::string_view name : allowed) known = known || key == name;
+      if (!known) {
+        std::string names;
+        for (std::string_view name : allowed)
+          names += (names.empty() ? "" : ", ") + std::string(name);
+        fail(entry.first, "unknown key '" + key + "' in '" + field + "' (" + names + ")");
+      }
+    }
   }
 
   int positive_int(const char* key) const {
@@ -46,33 +76,111 @@ class Reader {
     return node.Scalar();
   }
 
+  double number(const YAML::Node& node, const std::string& field) const {
+    double value = 0;
+    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
+      fail(node, "'" + field + "' holds '" + (node.IsScalar() ? node.Scalar() : "a non-number") +
+                     "', not a finite number");
+    }
+    return value;
+  }
+
+  // A list of `count` finite numbers.
+  std::vector<double> numbers(const YAML::Node& node, const std::string& field,
+                              size_t count) const {
+    if (!node.IsSequence()) fail(node, "'" + field + "' must be a list of numbers");
+    if (node.size() != count) {
+      fail(node, "'" + field + "' must have " + std::to_string(count) + " numbers, has " +
+                     std::to_string(node.size()));
+    }
+    std::vector<double> values;
+    for (const YAML::Node& element : node) values.push_back(number(element, field));
+    return values;
+  }
+
   // The `data` of a {rows, cols, data} matrix, checked to hold `count` finite numbers.
   std::vector<double> matrix(const char* key, size_t count) const {
     YAML::Node node = required(key);
     YAML::Node data = node.IsMap() ? node["data"] : YAML::Node();
     if (!data || !data.IsSequence()) fail(node, std::string("'") + key + "' needs a 'data' list");
-    if (data.size() != count) {
-      fail(data, std::string("'") + key + ".data' must have " + std::to_string(count) +
-                     " numbers, has " + std::to_string(data.size()));
-    }
-    std::vector<double> values;
-    for (const YAML::Node& element : data) {
-      double value = 0;
-      if (!element.IsScalar() || !YAML::convert<double>::decode(element, value) ||
-          !std::isfinite(value)) {
-        fail(element, std::string("'") + key + ".data' holds '" +
-                          (element.IsScalar() ? element.Scalar() : "a non-number") +
-                          "', not a finite number");
-      }
-      values.push_back(value);
-    }
-    return values;
+    return numbers(data, std::string(key) + ".data", count);
   }
 
  private:
   YAML::Node root_;
   std::string source_;
 };
+
+std::shared_ptr<const CameraModel> read_pinhole(const Reader& reader, const YAML::Node& root,
+                                                int width, int height) {
+  std::vector<double> k = reader.matrix("camera_matrix", 9);
+  PinholeIntrinsics intrinsics{k[0], k[4], k[2], k[5]};
+  if (root["distortion_coefficients"]) {
+    YAML::Node data = root["distortion_coefficients"]["data"];
+    size_t count = data && data.IsSequence() ? data.size() : 0;
+    if (count != 4 && count != 5) count = 5;  // the error then names the expected count
+    std::vector<double> d = reader.matrix("distortion_coefficients", count);
+    for (size_t i = 0; i < d.size(); ++i) intrinsics.distortion[i] = d[i];
+  }
+  try {
+    return std::make_shared<PinholeCamera>(width, height, intrinsics);
+  } catch (const std::invalid_argument& e) {
+    reader.fail(root["camera_matrix"], e.what());
+  }
+}
+
+// In the order of eucm_project's parameters.
+constexpr std::array<const char*, 6> kEucmKeys = {"alpha", "beta", "fu", "fv", "u0", "v0"};
+
+std::shared_ptr<const CameraModel> read_eucm(const Reader& reader, int width, int height) {
+  YAML::Node node = reader.required("eucm");
+  reader.check_map(node, "eucm", {kEucmKeys.begin(), kEucmKeys.end()});
+  std::array<double, 6> parameters;
+  for (size_t i = 0; i < kEucmKeys.size(); ++i) {
+    std::string field = std::string("eucm.") + kEucmKeys[i];
+    parameters[i] = reader.number(reader.required(node, kEucmKeys[i], "eucm."), field);
+  }
+  try {
+    return std::make_shared<EucmCamera>(width, height, parameters);
+  } catch (const std::invalid_argument& e) {
+    reader.fail(node, e.what());
+  }
+}
+
+Eigen::Isometry3d read_pose(const Reader& reader, const YAML::Node& node) {
+  reader.check_map(node, "pose", {"translation", "rotation"});
+  std::vector<double> t =
+      reader.numbers(reader.required(node, "translation", "pose."), "pose.translation", 3);
+  YAML::Node rotation_node = reader.required(node, "rotation", "pose.");
+  std::vector<double> q = reader.numbers(rotation_node, "pose.rotation", 4);
+  Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
+  double norm = rotation.norm();
+  if (!(std::abs(norm - 1) <= kQuaternionNormTolerance)) {
+    reader.fail(rotation_node, fmt::format("'pose.rotation' [qx, qy, qz, qw] has norm {:.6g}, must "
+                                           "be a unit quaternion (within {:g})",
+                                           norm, kQuaternionNormTolerance));
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation.normalized().toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return pose;
+}
+
+// The shortest text that reads back as the same double.
+std::string number_text(double value) { return fmt::format("{}", value); }
+
+std::string list_text(std::initializer_list<double> values) {
+  std::string text = "[";
+  for (double value : values) text += (text.size() > 1 ? ", " : "") + number_text(value);
+  return text + "]";
+}
+
+// camera_name and frame_id are free text: quoted, so that names like "yes" or "1" stay strings.
+std::string quoted(const std::string& text) {
+  YAML::Emitter emitter;
+  emitter << YAML::DoubleQuoted << text;
+  return emitter.c_str();
+}
 
 }  // namespace
 
@@ -91,24 +199,15 @@ CameraFile parse_camera_file(const std::string& text, const std::string& source)
   int width = reader.positive_int("image_width");
   int height = reader.positive_int("image_height");
   std::string model = reader.text("distortion_model", "plumb_bob");
-  if (model != "plumb_bob" && model != "pinhole") {
+  if (model == "plumb_bob" || model == "pinhole") {
+    camera.model = read_pinhole(reader, root, width, height);
+  } else if (model == "eucm") {
+    camera.model = read_eucm(reader, width, height);
+  } else {
     reader.fail(root["distortion_model"],
-                "distortion_model '" + model + "' is not supported (plumb_bob, pinhole)");
+                "distortion_model '" + model + "' is not supported (plumb_bob, pinhole, eucm)");
   }
-  std::vector<double> k = reader.matrix("camera_matrix", 9);
-  PinholeIntrinsics intrinsics{k[0], k[4], k[2], k[5]};
-  if (root["distortion_coefficients"]) {
-    YAML::Node data = root["distortion_coefficients"]["data"];
-    size_t count = data && data.IsSequence() ? data.size() : 0;
-    if (count != 4 && count != 5) count = 5;  // the error then names the expected count
-    std::vector<double> d = reader.matrix("distortion_coefficients", count);
-    for (size_t i = 0; i < d.size(); ++i) intrinsics.distortion[i] = d[i];
-  }
-  try {
-    camera.model = std::make_shared<PinholeCamera>(width, height, intrinsics);
-  } catch (const std::invalid_argument& e) {
-    reader.fail(root["camera_matrix"], e.what());
-  }
+  if (root["pose"]) camera.world_from_camera = read_pose(reader, root["pose"]);
   return camera;
 }
 
@@ -120,6 +219,69 @@ CameraFile load_camera_file(const std::string& path) {
   std::stringstream text;
   text << stream.rdbuf();
   return parse_camera_file(text.str(), path);
+}
+
+std::string format_camera_file(const CameraFile& camera) {
+  if (!camera.model) throw std::invalid_argument("camera file: no camera model to write");
+  const CameraModel& model = *camera.model;
+  std::string text = "# Camera file of mocap-graph (calibration/camera_file.hpp).\n";
+  text += "camera_name: " + quoted(camera.name) + "\n";
+  if (camera.frame_id != camera.name) text += "frame_id: " + quoted(camera.frame_id) + "\n";
+  text += fmt::format("image_width: {}\nimage_height: {}\n", model.width(), model.height());
+  if (const auto* pinhole = dynamic_cast<const PinholeCamera*>(&model)) {
+    const PinholeIntrinsics& k = pinhole->intrinsics();
+    const auto& [k1, k2, p1, p2, k3] = k.distortion;
+    text += "distortion_model: plumb_bob\n";
+    text += "camera_matrix:\n  rows: 3\n  cols: 3\n  data: " +
+            list_text({k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1}) + "\n";
+    text += "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: " +
+            list_text({k1, k2, p1, p2, k3}) + "\n";
+    text += "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: " +
+            list_text({1, 0, 0, 0, 1, 0, 0, 0, 1}) + "\n";
+    text += "projection_matrix:\n  rows: 3\n  cols: 4\n  data: " +
+            list_text({k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0}) + "\n";
+  } else if (const auto* eucm = dynamic_cast<const EucmCamera*>(&model)) {
+    text += "distortion_model: eucm\neucm:\n";
+    for (size_t i = 0; i < kEucmKeys.size(); ++i) {
+      text += fmt::format("  {}: {}\n", kEucmKeys[i], number_text(eucm->parameters()[i]));
+    }
+  } else {
+    throw std::invalid_argument("camera file: camera model '" + model.type() +
+                                "' has no file form");
+  }
+  if (camera.world_from_camera) {
+    const Eigen::Isometry3d& pose = *camera.world_from_camera;
+    Eigen::Quaterniond q(pose.linear());
+    // q and −q are the same rotation; one sign keeps files of one pose identical.
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    const Eigen::Vector3d& t = pose.translation();
+    text += "pose:\n  translation: " + list_text({t.x(), t.y(), t.z()}) +
+            "\n  rotation: " + list_text({q.x(), q.y(), q.z(), q.w()}) + "  # qx, qy, qz, qw\n";
+  }
+  return text;
+}
+
+void save_camera_file(const std::string& path, const CameraFile& camera) {
+  std::string text = format_camera_file(camera);
+  std::string partial = path + ".partial";
+  {
+    std::ofstream stream(partial, std::ios::trunc);
+    if (!stream) {
+      throw CameraFileError(path + ": cannot write the camera file: " + std::strerror(errno));
+    }
+    stream << text;
+    stream.flush();
+    if (!stream) {
+      int error = errno;
+      std::remove(partial.c_str());
+      throw CameraFileError(path + ": cannot write the camera file: " + std::strerror(error));
+    }
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0) {
+    int error = errno;
+    std::remove(partial.c_str());
+    throw CameraFileError(path + ": cannot write the camera file: " + std::strerror(error));
+  }
 }
 
 }  // namespace mocap::calibration

@@ -16,6 +16,10 @@ PinholeCamera::PinholeCamera(int width, int height, const PinholeIntrinsics& int
       !std::isfinite(intrinsics.fy)) {
     throw std::invalid_argument("pinhole camera: focal lengths must be positive");
   }
+  parameters_ = {intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy};
+  for (size_t i = 0; i < intrinsics.distortion.size(); ++i) {
+    parameters_[4 + i] = intrinsics.distortion[i];
+  }
   has_distortion_ = false;
   for (double k : intrinsics.distortion) {
     if (!std::isfinite(k)) throw std::invalid_argument("pinhole camera: distortion is not finite");
@@ -25,19 +29,15 @@ PinholeCamera::PinholeCamera(int width, int height, const PinholeIntrinsics& int
 
 Eigen::Vector2d PinholeCamera::distort(const Eigen::Vector2d& p) const {
   if (!has_distortion_) return p;
-  const auto& [k1, k2, p1, p2, k3] = intrinsics_.distortion;
-  double x = p.x(), y = p.y();
-  double r2 = x * x + y * y;
-  double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
-          y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
+  Eigen::Vector2d distorted;
+  pinhole_distort(intrinsics_.distortion.data(), p.data(), distorted.data());
+  return distorted;
 }
 
 std::optional<Eigen::Vector2d> PinholeCamera::project(const Eigen::Vector3d& point) const {
-  if (!(point.z() > 0)) return std::nullopt;
-  Eigen::Vector2d d = distort(point.head<2>() / point.z());
-  return Eigen::Vector2d(intrinsics_.fx * d.x() + intrinsics_.cx,
-                         intrinsics_.fy * d.y() + intrinsics_.cy);
+  Eigen::Vector2d pixel;
+  if (!pinhole_project(parameters_.data(), point.data(), pixel.data())) return std::nullopt;
+  return pixel;
 }
 
 std::optional<Eigen::Vector3d> PinholeCamera::unproject(const Eigen::Vector2d& pixel) const {

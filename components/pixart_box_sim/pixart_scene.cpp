@@ -72,7 +72,7 @@ class SceneReader : YamlReader<PixartSceneError> {
   }
 
   SceneObject board(const YAML::Node& map) {
-    check_keys(map, {"name", "size_m", "on_s", "off_s", "height_m", "trajectory"},
+    check_keys(map, {"name", "size_m", "on_s", "off_s", "pause_s", "height_m", "trajectory"},
                "a calibration board");
     const YAML::Node name_node = required(map, "name", "a calibration board");
     SceneObject object;
@@ -82,7 +82,8 @@ class SceneReader : YamlReader<PixartSceneError> {
     const double size = positive(map, "size_m", 0.25, 10);
     const double on = positive(map, "on_s", 0.1, kMaxTime_s);
     const double off = number(map, "off_s", 0.1, 0, kMaxTime_s);
-    object.leds = calibration_board_leds(size, on, off);
+    const double pause = number(map, "pause_s", 0, 0, kMaxTime_s);
+    object.leds = calibration_board_leds(size, on, off, pause);
     object.height_m = number(map, "height_m", rig_.led_plane_height_m, 0, kMaxCoordinate_m);
     object.trajectory = trajectory(required(map, "trajectory", "a calibration board"));
     return object;
@@ -153,11 +154,11 @@ class SceneReader : YamlReader<PixartSceneError> {
 
 }  // namespace
 
-std::vector<Led> calibration_board_leds(double size_m, double on_s, double off_s) {
+std::vector<Led> calibration_board_leds(double size_m, double on_s, double off_s, double pause_s) {
   const double half = size_m / 2;
   const Eigen::Vector2d corners[] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
   const double slot = on_s + off_s;  // one LED's turn: lit, then dark before the next
-  const double cycle = 4 * slot;
+  const double cycle = 4 * slot + pause_s;
   std::vector<Led> leds;
   for (int i = 0; i < 4; ++i) {
     Led led;

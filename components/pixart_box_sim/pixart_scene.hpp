@@ -37,10 +37,13 @@ class PixartSceneError : public std::runtime_error {
 
 // The seed's calibration board (seed 002 §7.3): four LEDs at the corners of a square of side
 // `size_m`, centred on the board's origin, lit one at a time: LED i is on for `on_s` starting
-// at i·(on_s + off_s) of each cycle of 4·(on_s + off_s), so that a camera sees exactly one
-// LED (or none) at any time and the calibration knows which corner it is. LED 0 is at
-// (−s/2, −s/2), then counter-clockwise: (s/2, −s/2), (s/2, s/2), (−s/2, s/2).
-std::vector<Led> calibration_board_leds(double size_m, double on_s = 0.1, double off_s = 0.1);
+// at i·(on_s + off_s) of each cycle of 4·(on_s + off_s) + pause_s, so that a camera sees
+// exactly one LED (or none) at any time and the calibration knows which corner it is. LED 0 is
+// at (−s/2, −s/2), then counter-clockwise: (s/2, −s/2), (s/2, s/2), (−s/2, s/2). The pause
+// after LED 3 tells the recording which LED starts the cycle (board_recording.hpp, 0.3 s there);
+// 0 is the seed's board, whose cycle has no mark.
+std::vector<Led> calibration_board_leds(double size_m, double on_s = 0.1, double off_s = 0.1,
+                                        double pause_s = 0);
 
 // Reads a scene; robots are looked up in `rig` by name (their LED layouts) and carry their
 // LEDs at rig.led_plane_height_m. Throws PixartSceneError "FILE:LINE: what" for unknown or

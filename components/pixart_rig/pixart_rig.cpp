@@ -101,19 +101,35 @@ Rig parse_rig(const std::string& text, const std::string& source,
       reader.fail(node, fmt::format("camera '{}' (id {}) repeats a name or id", camera.name,
                                     camera.camera_id));
     }
-    camera.world_from_camera = downward_camera_pose(
-        reader.vector<3>(reader.required(node, "position", "a camera"), "position", -1e6, 1e6),
-        reader.number(node, "yaw_deg", 0, -360, 360));
+    std::optional<Eigen::Isometry3d> calibrated_pose;
     if (node["camera_file"]) {
       std::filesystem::path file = reader.text(node["camera_file"], "camera_file");
       if (file.is_relative()) file = std::filesystem::path(base_directory) / file;
       try {
-        camera.model = calibration::load_camera_file(file.string()).model;
+        calibration::CameraFile camera_file = calibration::load_camera_file(file.string());
+        camera.model = camera_file.model;
+        calibrated_pose = camera_file.world_from_camera;
       } catch (const calibration::CameraFileError& e) {
         reader.fail(node["camera_file"], e.what());
       }
     } else {
       camera.model = nominal_pixart_camera(reader.number(node, "horizontal_fov_deg", 41, 1, 179));
+    }
+    if (calibrated_pose) {
+      // Two poses for one camera would leave it to chance which one the rig uses.
+      for (const char* key : {"position", "yaw_deg"}) {
+        if (node[key]) {
+          reader.fail(node[key], fmt::format("camera '{}': its camera file gives its pose, so "
+                                             "'{}' must not be given too",
+                                             camera.name, key));
+        }
+      }
+      camera.world_from_camera = *calibrated_pose;
+    } else {
+      camera.world_from_camera = downward_camera_pose(
+          reader.vector<3>(reader.required(node, "position", "a camera without a calibrated pose"),
+                           "position", -1e6, 1e6),
+          reader.number(node, "yaw_deg", 0, -360, 360));
     }
     rig.cameras.push_back(std::move(camera));
   }

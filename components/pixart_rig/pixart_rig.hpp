@@ -59,7 +59,8 @@ class RigError : public std::runtime_error {
 };
 
 // Reads a rig file (config/pixart/README.md documents the keys). Camera files named in it are
-// relative to the rig file.
+// relative to the rig file; a camera file's `pose` is the camera's world_from_camera, and the
+// rig then must not give the camera a `position` or `yaw_deg` of its own.
 Rig load_rig(const std::string& path);
 Rig parse_rig(const std::string& text, const std::string& source,
               const std::string& base_directory = ".");

@@ -40,11 +40,17 @@ class Collector final : public Component {
     create_subscription<Raw>("/pixart/raw", [this](const Raw& raw) {
       std::lock_guard lock(mutex);
       raw_points += raw.points().size();
+      arrived.notify_all();
     });
   }
   bool wait_for(size_t count, std::chrono::seconds timeout) {
     std::unique_lock lock(mutex);
     return arrived.wait_for(lock, timeout, [&] { return arrays.size() >= count; });
+  }
+  // The bridge publishes a read's raw points after the samples they complete.
+  bool wait_for_raw_points(size_t count, std::chrono::seconds timeout) {
+    std::unique_lock lock(mutex);
+    return arrived.wait_for(lock, timeout, [&] { return raw_points >= count; });
   }
   std::mutex mutex;
   std::condition_variable arrived;
@@ -127,6 +133,7 @@ TEST(PixartBridge, SlcanFramesBecomeFiducialsAndTheAdaptorMayBeUnplugged) {
     std::lock_guard lock(collector.mutex);
     EXPECT_EQ(collector.arrays[2].fiducials()[0].x(), 102);
   }
+  EXPECT_TRUE(collector.wait_for_raw_points(6, std::chrono::seconds(10)));
   host.stop();
   EXPECT_EQ(collector.raw_points, 6u);
 }

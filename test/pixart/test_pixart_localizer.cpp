@@ -12,6 +12,8 @@
 #include <set>
 #include <thread>
 
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/calibration/eucm_camera.hpp>
 #include <mocap/component_host.hpp>
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
@@ -659,7 +661,7 @@ TEST(PixartLocalization, AccuracyOverTheWholeFloor) {
 // Poses shift by that much, but a pair or triple mixing two cameras' points must never turn a
 // robot round: the recognizer prefers what one camera saw, and tells the ends of a pair apart
 // by both LEDs' tracked places.
-TEST(PixartLocalization, MisplacedCamerasShiftPosesButNeverTurnThem) {
+Rig misplaced_seed_rig() {
   Rig mounted = seed_rig();
   for (size_t i = 0; i < mounted.cameras.size(); ++i) {
     RigCamera& camera = mounted.cameras[i];
@@ -671,6 +673,11 @@ TEST(PixartLocalization, MisplacedCamerasShiftPosesButNeverTurnThem) {
     camera.world_from_camera.translation() +=
         0.02 * Eigen::Vector3d(-std::sin(angle), std::cos(angle), 0);
   }
+  return mounted;
+}
+
+TEST(PixartLocalization, MisplacedCamerasShiftPosesButNeverTurnThem) {
+  const Rig mounted = misplaced_seed_rig();
   RobotLocalizer localizer(seed_rig());
   // robot_a laps the middle of the floor, where all four cameras overlap, at 0.2 m/s, its
   // ends blinking in turn.
@@ -692,6 +699,107 @@ TEST(PixartLocalization, MisplacedCamerasShiftPosesButNeverTurnThem) {
   EXPECT_EQ(readings, 2000);
   EXPECT_LT(worst_position, 0.06);
   EXPECT_LT(worst_heading, 10 * kDegree) << "worst heading error " << worst_heading / kDegree;
+}
+
+// The same cameras, calibrated: each one's camera file gives its lens (EUCM, a little barrel
+// distortion, principal point off centre) and where it really hangs. The rig read from those
+// files has the cameras where they are, and localizes within millimetres again.
+TEST(PixartLocalization, CalibratedCameraFilesPlaceTheCamerasAndRestoreMillimetres) {
+  test::TempDir dir;
+  Rig mounted = misplaced_seed_rig();
+  std::string rig_text = "led_plane_height_m: 0.45\ncameras:\n";
+  for (size_t i = 0; i < mounted.cameras.size(); ++i) {
+    RigCamera& camera = mounted.cameras[i];
+    const double offset = 3.0 * static_cast<double>(i);
+    camera.model = std::make_shared<calibration::EucmCamera>(
+        1024, 768, std::array<double, 6>{0.15, 1.08, 1372, 1365, 509 + offset, 386 - offset});
+    calibration::CameraFile file;
+    file.name = file.frame_id = camera.name;
+    file.model = camera.model;
+    file.world_from_camera = camera.world_from_camera;
+    calibration::save_camera_file((dir / (camera.name + ".yaml")).string(), file);
+    rig_text += "  - {name: " + camera.name + ", camera_id: " + std::to_string(camera.camera_id) +
+                ", camera_file: " + camera.name + ".yaml}\n";
+  }
+  test::write_file(dir / "rig.yaml", rig_text);
+  Rig rig = load_rig((dir / "rig.yaml").string());
+  rig.robots = seed_rig().robots;
+  ASSERT_EQ(rig.cameras.size(), mounted.cameras.size());
+  for (size_t i = 0; i < rig.cameras.size(); ++i) {
+    const RigCamera& loaded = rig.cameras[i];
+    const RigCamera& truth = mounted.cameras[i];
+    EXPECT_EQ(loaded.name, truth.name);
+    EXPECT_EQ(loaded.model->type(), "eucm");
+    EXPECT_LT((loaded.world_from_camera.matrix() - truth.world_from_camera.matrix())
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-15)
+        << loaded.name;
+    // Not where the rig's nominal layout would have put it.
+    EXPECT_GT((loaded.world_from_camera.translation() -
+               seed_rig().cameras[i].world_from_camera.translation())
+                  .norm(),
+              0.019);
+  }
+  int64_t t = kStart;
+  for (const PlanarPose& truth :
+       {PlanarPose{-0.8, -0.6, 30 * kDegree}, PlanarPose{0.1, -0.6, 90 * kDegree},
+        PlanarPose{0.02, 0.03, -100 * kDegree}, PlanarPose{0.7, 0.45, 170 * kDegree}}) {
+    RobotLocalizer localizer(rig);  // no history: every pose read afresh
+    t += kSamplePeriod;
+    observe(localizer, {{"robot_a", truth}}, t, &mounted);
+    expect_pose(localizer.tracked_robots(t), "robot_a", truth, PoseEvidence::AllLeds);
+  }
+}
+
+TEST(PixartRig, ACameraFilesPoseAndARigPositionCannotBothBeGiven) {
+  test::TempDir dir;
+  calibration::CameraFile file;
+  file.name = file.frame_id = "c";
+  file.model = nominal_pixart_camera();
+  save_camera_file((dir / "unplaced.yaml").string(), file);
+  file.world_from_camera = downward_camera_pose({0.2, 0.1, 2.4}, 33);
+  save_camera_file((dir / "placed.yaml").string(), file);
+  auto error = [&](const std::string& camera) {
+    try {
+      parse_rig("cameras:\n  - name: c\n    camera_id: 0\n" + camera, "rig.yaml", dir.path());
+    } catch (const RigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  std::string message = error("    camera_file: placed.yaml\n    position: [0, 0, 2.5]\n");
+  EXPECT_TRUE(
+      message.starts_with("rig.yaml:5: camera 'c': its camera file gives its pose, so "
+                          "'position' must not be given too"))
+      << message;
+  message = error("    yaw_deg: 90\n    camera_file: placed.yaml\n");
+  EXPECT_TRUE(
+      message.starts_with("rig.yaml:4: camera 'c': its camera file gives its pose, so "
+                          "'yaw_deg' must not be given too"))
+      << message;
+  message = error("    camera_file: unplaced.yaml\n");
+  EXPECT_TRUE(
+      message.starts_with("rig.yaml:2: a camera without a calibrated pose needs "
+                          "'position'"))
+      << message;
+  EXPECT_EQ(error("    camera_file: placed.yaml\n"), "(no error)");
+  Rig rig = parse_rig("cameras:\n  - {name: c, camera_id: 0, camera_file: placed.yaml}\n",
+                      "rig.yaml", dir.path());
+  EXPECT_LT((rig.cameras[0].world_from_camera.matrix() -
+             downward_camera_pose({0.2, 0.1, 2.4}, 33).matrix())
+                .norm(),
+            1e-15);
+  // Without a pose, a camera file gives the lens and the rig places the camera.
+  rig = parse_rig(
+      "cameras:\n  - {name: c, camera_id: 0, camera_file: unplaced.yaml, position: [1, 2, 3], "
+      "yaw_deg: 90}\n",
+      "rig.yaml", dir.path());
+  EXPECT_EQ(rig.cameras[0].world_from_camera.translation(), Eigen::Vector3d(1, 2, 3));
+  EXPECT_LT((rig.cameras[0].world_from_camera.linear() * Eigen::Vector3d::UnitX() -
+             Eigen::Vector3d::UnitY())
+                .norm(),
+            1e-12);
 }
 
 // ---------------------------------------------------------------------------------------------

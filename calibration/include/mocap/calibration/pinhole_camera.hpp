@@ -4,6 +4,7 @@
 #include <array>
 
 #include <mocap/calibration/camera_model.hpp>
+#include <mocap/calibration/lens_models.hpp>
 
 namespace mocap::calibration {
 
@@ -22,6 +23,7 @@ class PinholeCamera final : public CameraModel {
   std::string type() const override { return "pinhole"; }
   int width() const override { return width_; }
   int height() const override { return height_; }
+  // pinhole_project: nullopt for z <= 0.
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const override;
   // Inverts the distortion by fixed-point iteration (as cv::undistortPoints does); nullopt
   // when it does not converge.
@@ -30,6 +32,8 @@ class PinholeCamera final : public CameraModel {
   std::unique_ptr<CameraModel> clone() const override;
 
   const PinholeIntrinsics& intrinsics() const { return intrinsics_; }
+  // fx, fy, cx, cy, k1, k2, p1, p2, k3, the order of pinhole_project.
+  const std::array<double, kPinholeParameters>& parameters() const { return parameters_; }
 
   // Normalised image coordinates (x/z, y/z) after distortion.
   Eigen::Vector2d distort(const Eigen::Vector2d& normalised) const;
@@ -37,6 +41,7 @@ class PinholeCamera final : public CameraModel {
  private:
   int width_, height_;
   PinholeIntrinsics intrinsics_;
+  std::array<double, kPinholeParameters> parameters_;
   bool has_distortion_;
 };
 

@@ -1,0 +1,546 @@
+#include <mocap/calibration/calibration_problem.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <set>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <fmt/format.h>
+#include <Eigen/Eigenvalues>
+#include <mocap/calibration/camera_factory.hpp>
+#include <mocap/calibration/lens_models.hpp>
+#include <opencv2/calib3d.hpp>
+
+namespace mocap::calibration {
+namespace {
+
+using Pose6 = std::array<double, 6>;  // x, y, z, rx, ry, rz
+
+Pose6 to_pose6(const Eigen::Isometry3d& transform) {
+  const std::vector<double> values = transform_to_values6(transform);
+  Pose6 pose;
+  std::copy(values.begin(), values.end(), pose.begin());
+  return pose;
+}
+
+Eigen::Isometry3d to_isometry(const Pose6& pose) { return transform_from_values(pose); }
+
+// `point` moved by a transform block: direct, p' = R p + t; inverse, p' = Rᵀ (p − t).
+template <class T>
+void transform_point(const T* pose, bool direct, T* point) {
+  T moved[3];
+  if (direct) {
+    ceres::AngleAxisRotatePoint(pose + 3, point, moved);
+    for (int i = 0; i < 3; ++i) point[i] = moved[i] + pose[i];
+  } else {
+    const T shifted[3] = {point[0] - pose[0], point[1] - pose[1], point[2] - pose[2]};
+    const T back[3] = {-pose[3], -pose[4], -pose[5]};
+    ceres::AngleAxisRotatePoint(back, shifted, moved);
+    for (int i = 0; i < 3; ++i) point[i] = moved[i];
+  }
+}
+
+// The pixel error of one board point: parameter block 0 is the camera, then one block per
+// link of the chain, left to right (T = T1 T2 ... Tn: Tn is applied first).
+struct PointResidual {
+  bool eucm = true;
+  Eigen::Vector3d object;
+  Eigen::Vector2d observed;
+  std::vector<bool> direct;
+
+  template <class T>
+  bool operator()(T const* const* parameters, T* residuals) const {
+    T point[3] = {T(object.x()), T(object.y()), T(object.z())};
+    for (size_t i = direct.size(); i-- > 0;) transform_point(parameters[1 + i], direct[i], point);
+    T pixel[2];
+    const bool valid = eucm ? eucm_project(parameters[0], point, pixel)
+                            : pinhole_project(parameters[0], point, pixel);
+    if (!valid) return false;
+    residuals[0] = pixel[0] - T(observed.x());
+    residuals[1] = pixel[1] - T(observed.y());
+    return true;
+  }
+};
+
+// A transform's deviation from its prior, weighted: [t − t0; rotation vector of R0ᵀ R].
+struct PriorResidual {
+  Eigen::Isometry3d prior;
+  double stiffness = 1;
+
+  template <class T>
+  bool operator()(const T* pose, T* residuals) const {
+    for (int i = 0; i < 3; ++i) residuals[i] = T(stiffness) * (pose[i] - T(prior.translation()[i]));
+    T rotation[9];
+    ceres::AngleAxisToRotationMatrix(pose + 3, ceres::RowMajorAdapter3x3(rotation));
+    T relative[9];
+    const Eigen::Matrix3d& r0 = prior.linear();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        relative[3 * i + j] = T(r0(0, i)) * rotation[j] + T(r0(1, i)) * rotation[3 + j] +
+                              T(r0(2, i)) * rotation[6 + j];
+      }
+    }
+    ceres::RotationMatrixToAngleAxis(ceres::RowMajorAdapter3x3<const T>(relative), residuals + 3);
+    for (int i = 3; i < 6; ++i) residuals[i] *= T(stiffness);
+    return true;
+  }
+};
+
+int free_intrinsics(const CameraSpec& camera) {
+  if (camera.constant) return 0;
+  return camera.type == "eucm" ? kEucmParameters : static_cast<int>(camera.value.size());
+}
+
+// Whether the points span an area: not all on one line or in one spot (half a pixel).
+bool spans_an_area(const std::vector<Eigen::Vector2d>& points) {
+  if (points.size() < 3) return false;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const auto& p : points) scatter += (p - mean) * (p - mean).transpose();
+  scatter /= static_cast<double>(points.size());
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues().minCoeff() > 0.25;
+}
+
+}  // namespace
+
+struct CalibrationProblem::State {
+  CalibrationConfig config;
+  CalibrationOptions options;
+  ceres::Problem problem;
+  std::vector<std::vector<double>> cameras;  // per CameraSpec
+  std::vector<Pose6> transforms;             // per TransformSpec (globals; per-shot unused)
+  // Per-shot transforms: (transform index, data file, frame) -> pose.
+  std::map<std::tuple<size_t, std::string, size_t>, Pose6> shot_poses;
+  struct ShotResiduals {
+    size_t data, shot;
+    std::vector<ceres::ResidualBlockId> points;
+  };
+  std::vector<ShotResiduals> shot_residuals;
+  std::map<std::string, size_t> camera_index, transform_index;
+
+  // The chain's per-shot link.
+  size_t shot_link(const DataSpec& data) const {
+    for (size_t i = 0; i < data.transform_chain.size(); ++i) {
+      if (!config.transformations[transform_index.at(data.transform_chain[i].name)].global) {
+        return i;
+      }
+    }
+    return 0;  // the configuration reader guarantees one
+  }
+  Eigen::Isometry3d link_value(const ChainLink& link) const {
+    const Eigen::Isometry3d value = to_isometry(transforms[transform_index.at(link.name)]);
+    return link.direct ? value : value.inverse();
+  }
+  double* pose_block(const DataSpec& data, size_t link, size_t frame) {
+    const size_t t = transform_index.at(data.transform_chain[link].name);
+    if (config.transformations[t].global) return transforms[t].data();
+    return shot_poses.at({t, data.data_path, frame}).data();
+  }
+  double rms(bool& any) {
+    double sum = 0;
+    size_t count = 0;
+    for (const ShotResiduals& shot : shot_residuals) {
+      for (ceres::ResidualBlockId id : shot.points) {
+        double residuals[2];
+        double cost = 0;
+        problem.EvaluateResidualBlock(id, false, &cost, residuals, nullptr);
+        sum += residuals[0] * residuals[0] + residuals[1] * residuals[1];
+        ++count;
+      }
+    }
+    any = count > 0;
+    return count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+  }
+};
+
+CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, CalibrationOptions options)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.config = config;
+  s.options = options;
+  for (size_t i = 0; i < config.cameras.size(); ++i) s.camera_index[config.cameras[i].name] = i;
+  for (size_t i = 0; i < config.transformations.size(); ++i) {
+    s.transform_index[config.transformations[i].name] = i;
+    s.transforms.push_back(
+        to_pose6(config.transformations[i].value.value_or(Eigen::Isometry3d::Identity())));
+  }
+
+  // Intrinsics: pinhole with 4 values is solved without distortion (held at 0).
+  for (const CameraSpec& camera : config.cameras) {
+    std::vector<double> value = camera.value;
+    if (camera.type == "pinhole" && value.size() == 4) value.resize(kPinholeParameters, 0.0);
+    s.cameras.push_back(std::move(value));
+  }
+
+  // Enough data for each camera: each shot of n points adds 2n measurements and 6 unknowns.
+  for (size_t c = 0; c < config.cameras.size(); ++c) {
+    const CameraSpec& camera = config.cameras[c];
+    int shots = 0, net = 0, points = 4;
+    for (const DataSpec& data : config.data) {
+      if (data.camera != camera.name) continue;
+      for (const Shot& shot : data.shots) {
+        ++shots;
+        points = static_cast<int>(shot.points.size());
+        net += 2 * points - 6;
+      }
+    }
+    const int unknowns = free_intrinsics(camera);
+    if (unknowns > 0 && net <= unknowns) {
+      const int needed = unknowns / std::max(1, 2 * points - 6) + 1;
+      throw CalibrationError(fmt::format(
+          "{}: camera {}: {} shots are too few for its {} intrinsics: each shot of {} points "
+          "adds {} measurements and 6 unknowns (its board pose), so {} shots are needed at least "
+          "(seed 002 §2.3); more, from different angles, make the result reliable",
+          config.source, camera.name, shots, unknowns, points, 2 * points, needed));
+    }
+  }
+
+  // Starting values of the per-shot transforms: a planar PnP of the first view of each frame
+  // through the initial camera, moved through the chain's other (global) links.
+  for (size_t d = 0; d < config.data.size(); ++d) {
+    const DataSpec& data = config.data[d];
+    const size_t c = s.camera_index.at(data.camera);
+    const CameraSpec& spec = config.cameras[c];
+    std::shared_ptr<const CameraModel> model;
+    try {
+      model = make_camera_model(spec.type, data.image_width, data.image_height, s.cameras[c]);
+    } catch (const std::invalid_argument& e) {
+      throw CalibrationError(fmt::format("{}: camera {}: {}", config.source, spec.name, e.what()));
+    }
+    const size_t link = s.shot_link(data);
+    const size_t t = s.transform_index.at(data.transform_chain[link].name);
+    Eigen::Isometry3d prefix = Eigen::Isometry3d::Identity(), suffix = prefix;
+    for (size_t i = 0; i < link; ++i) prefix = prefix * s.link_value(data.transform_chain[i]);
+    for (size_t i = link + 1; i < data.transform_chain.size(); ++i) {
+      suffix = suffix * s.link_value(data.transform_chain[i]);
+    }
+    std::vector<cv::Point3d> object;
+    for (int corner : data.corners) {
+      const Eigen::Vector3d& p = data.object_points[static_cast<size_t>(corner)];
+      object.emplace_back(p.x(), p.y(), p.z());
+    }
+    for (const Shot& shot : data.shots) {
+      const auto key = std::make_tuple(t, data.data_path, shot.frame);
+      if (s.shot_poses.count(key)) continue;
+      const std::string where = fmt::format("{}: data[{}] ({}), frame {} of {}", config.source, d,
+                                            data.camera, shot.frame, data.data_file);
+      if (!spans_an_area(shot.points)) {
+        throw CalibrationError(where + ": the points are (nearly) on one line or in one spot");
+      }
+      Eigen::Isometry3d camera_from_board = Eigen::Isometry3d::Identity();
+      if (data.init) {
+        camera_from_board = *data.init;
+      } else {
+        std::vector<cv::Point2d> normalised;
+        for (const Eigen::Vector2d& pixel : shot.points) {
+          auto ray = model->unproject(pixel);
+          if (!ray) throw CalibrationError(where + ": a point is outside the initial lens model");
+          normalised.emplace_back(ray->x(), ray->y());
+        }
+        cv::Mat rvec, tvec;
+        const bool planar = std::all_of(object.begin(), object.end(),
+                                        [&](const cv::Point3d& p) { return p.z == object[0].z; });
+        const bool solved =
+            cv::solvePnP(object, normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
+                         false, planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE);
+        if (!solved) throw CalibrationError(where + ": no board pose fits the points");
+        const Pose6 pose = {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2),
+                            rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)};
+        camera_from_board = to_isometry(pose);
+      }
+      Eigen::Isometry3d shot_pose = prefix.inverse() * camera_from_board * suffix.inverse();
+      if (!data.transform_chain[link].direct) shot_pose = shot_pose.inverse();
+      s.shot_poses[key] = to_pose6(shot_pose);
+    }
+  }
+
+  // Residuals.
+  ceres::LossFunction* loss = nullptr;  // the problem owns it (one instance, shared)
+  if (options.robust_scale_px > 0) loss = new ceres::HuberLoss(options.robust_scale_px);
+  for (size_t d = 0; d < config.data.size(); ++d) {
+    const DataSpec& data = config.data[d];
+    const size_t c = s.camera_index.at(data.camera);
+    const bool eucm = config.cameras[c].type == "eucm";
+    std::vector<bool> direct;
+    for (const ChainLink& link : data.transform_chain) direct.push_back(link.direct);
+    for (size_t k = 0; k < data.shots.size(); ++k) {
+      const Shot& shot = data.shots[k];
+      State::ShotResiduals residuals{d, k, {}};
+      std::vector<double*> blocks = {s.cameras[c].data()};
+      for (size_t i = 0; i < data.transform_chain.size(); ++i) {
+        blocks.push_back(s.pose_block(data, i, shot.frame));
+      }
+      for (size_t p = 0; p < shot.points.size(); ++p) {
+        auto* cost = new ceres::DynamicAutoDiffCostFunction<PointResidual, 4>(
+            new PointResidual{eucm, data.object_points[static_cast<size_t>(data.corners[p])],
+                              shot.points[p], direct});
+        cost->AddParameterBlock(static_cast<int>(s.cameras[c].size()));
+        for (size_t i = 0; i < data.transform_chain.size(); ++i) cost->AddParameterBlock(6);
+        cost->SetNumResiduals(2);
+        residuals.points.push_back(s.problem.AddResidualBlock(cost, loss, blocks));
+      }
+      s.shot_residuals.push_back(std::move(residuals));
+    }
+  }
+  if (s.shot_residuals.empty()) {
+    throw CalibrationError(config.source + ": no shots: the data files hold no usable frames");
+  }
+
+  // Priors, constants, bounds.
+  for (size_t t = 0; t < config.transformations.size(); ++t) {
+    const TransformSpec& spec = config.transformations[t];
+    if (!spec.global || !s.problem.HasParameterBlock(s.transforms[t].data())) continue;
+    if (spec.constant) s.problem.SetParameterBlockConstant(s.transforms[t].data());
+    if (spec.prior && !spec.constant) {
+      s.problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<PriorResidual, 6, 6>(new PriorResidual{
+              spec.value.value_or(Eigen::Isometry3d::Identity()), spec.prior_stiffness}),
+          nullptr, s.transforms[t].data());
+    }
+  }
+  for (size_t c = 0; c < config.cameras.size(); ++c) {
+    double* block = s.cameras[c].data();
+    if (!s.problem.HasParameterBlock(block)) continue;
+    const CameraSpec& spec = config.cameras[c];
+    if (spec.constant) {
+      s.problem.SetParameterBlockConstant(block);
+      continue;
+    }
+    if (spec.type == "eucm") {
+      s.problem.SetParameterLowerBound(block, 0, 0.0);  // alpha in [0, 1]
+      s.problem.SetParameterUpperBound(block, 0, 1.0);
+      s.problem.SetParameterLowerBound(block, 1, 1e-6);  // beta > 0
+      s.problem.SetParameterLowerBound(block, 2, 1.0);   // focal lengths
+      s.problem.SetParameterLowerBound(block, 3, 1.0);
+    } else {
+      s.problem.SetParameterLowerBound(block, 0, 1.0);
+      s.problem.SetParameterLowerBound(block, 1, 1.0);
+      if (spec.value.size() == 4) {
+        s.problem.SetManifold(block,
+                              new ceres::SubsetManifold(kPinholeParameters, {4, 5, 6, 7, 8}));
+      }
+    }
+  }
+}
+
+CalibrationProblem::~CalibrationProblem() = default;
+
+CalibrationReport CalibrationProblem::solve() {
+  State& s = *state_;
+  CalibrationReport report;
+  bool any = false;
+  report.initial_rms_px = s.rms(any);
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.max_num_iterations = s.options.max_iterations;
+  // Tighter than Ceres's defaults: lens parameters lie along shallow valleys (EUCM's alpha and
+  // beta act almost only through their product in a narrow view), where the defaults stop early.
+  options.function_tolerance = 1e-10;
+  options.gradient_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-10;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &s.problem, &summary);
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
+  report.termination = summary.message;
+  report.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+  report.rms_px = s.rms(any);
+  report.points = 0;
+
+  // Per shot and per camera.
+  std::vector<double> camera_sum(s.config.cameras.size(), 0.0);
+  std::vector<size_t> camera_points(s.config.cameras.size(), 0), camera_shots(camera_sum.size());
+  for (const State::ShotResiduals& shot : s.shot_residuals) {
+    const DataSpec& data = s.config.data[shot.data];
+    const size_t c = s.camera_index.at(data.camera);
+    double sum = 0;
+    for (ceres::ResidualBlockId id : shot.points) {
+      double residuals[2], cost = 0;
+      s.problem.EvaluateResidualBlock(id, false, &cost, residuals, nullptr);
+      sum += residuals[0] * residuals[0] + residuals[1] * residuals[1];
+    }
+    camera_sum[c] += sum;
+    camera_points[c] += shot.points.size();
+    ++camera_shots[c];
+    report.points += shot.points.size();
+    const double rms = std::sqrt(sum / static_cast<double>(shot.points.size()));
+    report.shots.push_back(
+        {shot.data, data.shots[shot.shot].frame, data.camera, rms, rms > s.options.outlier_rms_px});
+  }
+
+  // Standard deviations, scaled by the residuals' own spread (the pixel noise is not given).
+  std::vector<std::vector<double>> camera_sigma(s.config.cameras.size());
+  std::vector<std::vector<double>> transform_sigma(s.config.transformations.size());
+  if (s.options.compute_covariance) {
+    std::vector<const double*> blocks;
+    for (auto& camera : s.cameras) {
+      if (s.problem.HasParameterBlock(camera.data()) &&
+          !s.problem.IsParameterBlockConstant(camera.data())) {
+        blocks.push_back(camera.data());
+      }
+    }
+    for (size_t t = 0; t < s.transforms.size(); ++t) {
+      if (s.config.transformations[t].global &&
+          s.problem.HasParameterBlock(s.transforms[t].data()) &&
+          !s.problem.IsParameterBlockConstant(s.transforms[t].data())) {
+        blocks.push_back(s.transforms[t].data());
+      }
+    }
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (const double* block : blocks) pairs.emplace_back(block, block);
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    covariance_options.null_space_rank = -1;  // report failure below instead of guessing
+    covariance_options.min_reciprocal_condition_number = 1e-14;
+    ceres::Covariance covariance(covariance_options);
+    const double dof =
+        static_cast<double>(2 * report.points) - static_cast<double>(s.problem.NumParameters());
+    const double variance = dof > 0 ? 2 * summary.final_cost / dof : 1.0;
+    if (pairs.empty()) {
+      // Nothing free: nothing to report.
+    } else if (covariance.Compute(pairs, &s.problem)) {
+      auto sigmas = [&](const double* block, int size) {
+        std::vector<double> result(static_cast<size_t>(size));
+        std::vector<double> matrix(static_cast<size_t>(size * size));
+        covariance.GetCovarianceBlock(block, block, matrix.data());
+        for (int i = 0; i < size; ++i) {
+          result[static_cast<size_t>(i)] =
+              std::sqrt(std::max(0.0, matrix[static_cast<size_t>(i * size + i)] * variance));
+        }
+        return result;
+      };
+      for (size_t c = 0; c < s.cameras.size(); ++c) {
+        if (std::find(blocks.begin(), blocks.end(), s.cameras[c].data()) != blocks.end()) {
+          camera_sigma[c] = sigmas(s.cameras[c].data(), static_cast<int>(s.cameras[c].size()));
+        }
+      }
+      for (size_t t = 0; t < s.transforms.size(); ++t) {
+        if (std::find(blocks.begin(), blocks.end(), s.transforms[t].data()) != blocks.end()) {
+          transform_sigma[t] = sigmas(s.transforms[t].data(), 6);
+        }
+      }
+    } else {
+      report.covariance_problem =
+          "the parameters are not all determined by the data (rank-deficient): more shots, "
+          "from more different angles, are needed";
+    }
+  }
+
+  for (size_t c = 0; c < s.config.cameras.size(); ++c) {
+    const CameraSpec& spec = s.config.cameras[c];
+    CameraResult result;
+    result.name = spec.name;
+    result.type = spec.type;
+    result.initial = spec.value;
+    result.value = s.cameras[c];
+    if (spec.type == "pinhole" && spec.value.size() == 4) result.value.resize(4);
+    result.standard_deviation = camera_sigma[c];
+    if (!result.standard_deviation.empty()) {
+      result.standard_deviation.resize(result.value.size());
+    }
+    result.shots = static_cast<int>(camera_shots[c]);
+    result.rms_px = camera_points[c] > 0
+                        ? std::sqrt(camera_sum[c] / static_cast<double>(camera_points[c]))
+                        : 0.0;
+    report.cameras.push_back(std::move(result));
+  }
+  for (size_t t = 0; t < s.config.transformations.size(); ++t) {
+    if (!s.config.transformations[t].global) continue;
+    report.globals.push_back(
+        {s.config.transformations[t].name, to_isometry(s.transforms[t]), transform_sigma[t]});
+  }
+  return report;
+}
+
+std::vector<std::pair<std::string, Eigen::Isometry3d>> CalibrationProblem::camera_poses(
+    const std::string& reference) const {
+  const State& s = *state_;
+  if (!s.camera_index.count(reference)) {
+    throw CalibrationError(fmt::format("{}: no camera named '{}'", s.config.source, reference));
+  }
+  // camera_from_shot_frame per (camera, data file): the chain's links before the per-shot one.
+  struct View {
+    std::string camera, data_path;
+    Eigen::Isometry3d camera_from_shot;
+  };
+  std::vector<View> views;
+  for (const DataSpec& data : s.config.data) {
+    Eigen::Isometry3d prefix = Eigen::Isometry3d::Identity();
+    for (size_t i = 0; i < s.shot_link(data); ++i)
+      prefix = prefix * s.link_value(data.transform_chain[i]);
+    views.push_back({data.camera, data.data_path, prefix});
+  }
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> poses;
+  for (const CameraSpec& camera : s.config.cameras) {
+    std::optional<Eigen::Isometry3d> pose;
+    for (const View& mine : views) {
+      if (mine.camera != camera.name || pose) continue;
+      for (const View& theirs : views) {
+        if (theirs.camera == reference && theirs.data_path == mine.data_path) {
+          pose = mine.camera_from_shot * theirs.camera_from_shot.inverse();
+          break;
+        }
+      }
+    }
+    if (camera.name == reference) pose = Eigen::Isometry3d::Identity();
+    if (pose) poses.emplace_back(camera.name, *pose);
+  }
+  return poses;
+}
+
+size_t CalibrationReport::outliers() const {
+  return static_cast<size_t>(
+      std::count_if(shots.begin(), shots.end(), [](const ShotResult& s) { return s.outlier; }));
+}
+
+std::string CalibrationReport::summary() const {
+  std::string text = fmt::format(
+      "{} after {} iterations: {}\ncost {:.6g} -> {:.6g}; RMS reprojection error {:.4f} -> {:.4f} "
+      "px over {} points\n",
+      converged ? "converged" : "NOT converged", iterations, termination, initial_cost, final_cost,
+      initial_rms_px, rms_px, points);
+  for (const CameraResult& camera : cameras) {
+    text += fmt::format("camera {} ({}): {} shots, RMS {:.4f} px\n", camera.name, camera.type,
+                        camera.shots, camera.rms_px);
+    for (size_t i = 0; i < camera.value.size(); ++i) {
+      text += fmt::format("  [{}] {:.6g} (from {:.6g})", i, camera.value[i],
+                          i < camera.initial.size() ? camera.initial[i] : 0.0);
+      if (i < camera.standard_deviation.size()) {
+        text += fmt::format(" ± {:.3g}", camera.standard_deviation[i]);
+      }
+      text += "\n";
+    }
+  }
+  for (const TransformResult& transform : globals) {
+    const std::vector<double> v = transform_to_values6(transform.value);
+    text += fmt::format(
+        "transform {}: x y z {:.5f} {:.5f} {:.5f} m, rotation vector {:.5f} "
+        "{:.5f} {:.5f} rad\n",
+        transform.name, v[0], v[1], v[2], v[3], v[4], v[5]);
+    if (transform.standard_deviation.size() == 6) {
+      const auto& d = transform.standard_deviation;
+      text += fmt::format("  ± {:.2g} {:.2g} {:.2g} m, ± {:.2g} {:.2g} {:.2g} rad\n", d[0], d[1],
+                          d[2], d[3], d[4], d[5]);
+    }
+  }
+  if (!covariance_problem.empty()) text += "no standard deviations: " + covariance_problem + "\n";
+  text += fmt::format("{} shots, {} outliers", shots.size(), outliers());
+  for (const ShotResult& shot : shots) {
+    if (shot.outlier) {
+      text += fmt::format("\n  outlier: data[{}] frame {} ({}): RMS {:.3f} px", shot.data,
+                          shot.frame, shot.camera, shot.rms_px);
+    }
+  }
+  return text + "\n";
+}
+
+}  // namespace mocap::calibration
