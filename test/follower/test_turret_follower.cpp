@@ -8,6 +8,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -256,6 +257,41 @@ TEST(DynamixelFollowerPlugin, WaitsForTheAdaptorAndConnectsWhenItAppears) {
   const bool reading = camera.wait([&] { return camera.states.size() >= 10; });
   turret.host.stop();
   EXPECT_TRUE(reading);
+}
+
+TEST(DynamixelFollowerPlugin, AnUnpluggedAdaptorIsReopenedWhenItComesBack) {
+  test::TempDir dir;
+  PluginLoader loader;
+  const std::string port = (dir / "servos").string();
+  // The servos in a host of their own, so they can go away while the follower runs.
+  auto servos = std::make_unique<ComponentHost>(
+      HostOptions{.name = "servos", .threads = 1, .dds = {.enabled = false}});
+  servos->add(*loader.load("ax12_sim").factory,
+              {.name = "servos", .parameters = {{"device_link", port}}});
+  servos->start();
+  ComponentHost host({.name = "test", .threads = 2, .dds = {.enabled = false}});
+  host.add(*loader.load("dynamixel_follower").factory,
+           {.name = "follower", .parameters = {{"port", port}}});
+  auto& camera = static_cast<CameraStandIn&>(
+      host.add(make_component_factory<CameraStandIn>("camera"), {.name = "camera"}));
+  host.start();
+  ASSERT_TRUE(camera.wait([&] { return camera.states.size() >= 10; }));
+
+  servos.reset();  // unplugged: the pseudo-terminal closes, the link goes
+  size_t states_then = 0;
+  {
+    std::lock_guard lock(camera.mutex);
+    states_then = camera.states.size();
+  }
+  servos = std::make_unique<ComponentHost>(
+      HostOptions{.name = "servos", .threads = 1, .dds = {.enabled = false}});
+  servos->add(*loader.load("ax12_sim").factory,
+              {.name = "servos", .parameters = {{"device_link", port}}});
+  servos->start();  // plugged in again, a new device under the same name
+  const bool reading_again = camera.wait([&] { return camera.states.size() >= states_then + 10; });
+  host.stop();
+  servos.reset();
+  EXPECT_TRUE(reading_again);
 }
 
 TEST(DynamixelFollowerPlugin, BadParametersAreClearErrors) {
