@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <set>
 
 #include <ceres/ceres.h>
@@ -244,16 +245,38 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
           if (!ray) throw CalibrationError(where + ": a point is outside the initial lens model");
           normalised.emplace_back(ray->x(), ray->y());
         }
-        cv::Mat rvec, tvec;
         const bool planar = std::all_of(object.begin(), object.end(),
                                         [&](const cv::Point3d& p) { return p.z == object[0].z; });
-        const bool solved =
-            cv::solvePnP(object, normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvec, tvec,
-                         false, planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE);
-        if (!solved) throw CalibrationError(where + ": no board pose fits the points");
-        const Pose6 pose = {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2),
-                            rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)};
-        camera_from_board = to_isometry(pose);
+        // A planar target has two poses that fit about equally (IPPE gives both); of those
+        // with the whole board in front of the camera, the one that fits best.
+        std::vector<cv::Mat> rvecs, tvecs;
+        std::vector<double> errors;
+        cv::solvePnPGeneric(object, normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvecs, tvecs,
+                            false, planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE,
+                            cv::noArray(), cv::noArray(), errors);
+        std::optional<Eigen::Isometry3d> best;
+        double best_error = 0;
+        for (size_t k = 0; k < rvecs.size(); ++k) {
+          const Pose6 pose = {tvecs[k].at<double>(0), tvecs[k].at<double>(1),
+                              tvecs[k].at<double>(2), rvecs[k].at<double>(0),
+                              rvecs[k].at<double>(1), rvecs[k].at<double>(2)};
+          const Eigen::Isometry3d candidate = to_isometry(pose);
+          const bool in_front =
+              std::all_of(object.begin(), object.end(), [&](const cv::Point3d& p) {
+                return (candidate * Eigen::Vector3d(p.x, p.y, p.z)).z() > 0;
+              });
+          const double error = k < errors.size() ? errors[k] : 0.0;
+          if (in_front && (!best || error < best_error)) {
+            best = candidate;
+            best_error = error;
+          }
+        }
+        if (!best) {
+          throw CalibrationError(where +
+                                 ": no board pose in front of the camera fits the points (are "
+                                 "they the board's points, in the order of its corners?)");
+        }
+        camera_from_board = *best;
       }
       Eigen::Isometry3d shot_pose = prefix.inverse() * camera_from_board * suffix.inverse();
       if (!data.transform_chain[link].direct) shot_pose = shot_pose.inverse();
@@ -380,7 +403,8 @@ CalibrationReport CalibrationProblem::solve() {
   // Standard deviations, scaled by the residuals' own spread (the pixel noise is not given).
   std::vector<std::vector<double>> camera_sigma(s.config.cameras.size());
   std::vector<std::vector<double>> transform_sigma(s.config.transformations.size());
-  if (s.options.compute_covariance) {
+  // Only at a solution: after a failed solve the Jacobian may not even be finite.
+  if (s.options.compute_covariance && report.converged) {
     std::vector<const double*> blocks;
     for (auto& camera : s.cameras) {
       if (s.problem.HasParameterBlock(camera.data()) &&

@@ -17,13 +17,16 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pixart_rig.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 using namespace mocap::calibration;
 
 constexpr const char* kUsage = R"(usage:
-  mocap_calibrate CONFIG.json [--output DIR] [--reference CAMERA] [--robust PIXELS]
+  mocap_calibrate CONFIG.json [--output DIR] [--reference CAMERA] [--rig RIG.yaml]
+                  [--robust PIXELS]
   mocap_calibrate --images DIR --board COLSxROWS --square METRES [--output DIR] [--name NAME]
 
   CONFIG.json   transformations, cameras and data as in seed 002 §8 (calibration/README.md);
@@ -31,6 +34,11 @@ constexpr const char* kUsage = R"(usage:
                 cameras, prints the report and writes DIR/<camera>.yaml for each camera: its
                 model, intrinsics and pose relative to the reference camera (default: the
                 first), which pose_estimator and pixart_localizer read
+  --rig         a PixArt rig file: writes every pose in the rig's world frame instead,
+                world_from_reference x reference_from_camera, so that the rig's `camera_file:`
+                entries can use the files as they are. The reference camera (by name) is
+                taken to hang exactly where the rig file says: the board shots tell where
+                the cameras are relative to each other, not where the rig is in the room
   --images      a folder of chessboard images (PNG, JPEG, ...); COLSxROWS counts the inner
                 corners, --square is the side of a square; solves a pinhole camera with
                 distortion (k1 k2 p1 p2 k3) and writes DIR/NAME.yaml (NAME: camera)
@@ -54,7 +62,8 @@ double parse_positive(const std::string& option, const std::string& text) {
   return value;
 }
 
-// Writes one camera file per calibrated camera; returns the paths.
+// Writes one camera file per calibrated camera, placed by `poses` (camera_from_frame, the frame
+// being the reference camera's or the rig's world); returns the paths.
 std::vector<std::string> write_cameras(
     const CalibrationReport& report,
     const std::vector<std::pair<std::string, Eigen::Isometry3d>>& poses,
@@ -75,8 +84,8 @@ std::vector<std::string> write_cameras(
     file.name = camera.name;
     file.frame_id = camera.name;
     file.model = make_camera_model(camera.type, width, height, camera.value);
-    for (const auto& [name, camera_from_reference] : poses) {
-      if (name == camera.name) file.world_from_camera = camera_from_reference.inverse();
+    for (const auto& [name, camera_from_frame] : poses) {
+      if (name == camera.name) file.world_from_camera = camera_from_frame.inverse();
     }
     const fs::path path = output / (camera.name + ".yaml");
     save_camera_file(path.string(), file);
@@ -85,11 +94,25 @@ std::vector<std::string> write_cameras(
   return written;
 }
 
+// Where the rig file `rig_path` hangs the camera `reference`: world_from_reference.
+Eigen::Isometry3d rig_pose(const std::string& rig_path, const std::string& reference) {
+  const mocap::pixart::Rig rig = mocap::pixart::load_rig(rig_path);
+  for (const mocap::pixart::RigCamera& camera : rig.cameras) {
+    if (camera.name == reference) return camera.world_from_camera;
+  }
+  throw CalibrationError(
+      fmt::format("{}: no camera named '{}' (the reference camera) to place the others from",
+                  rig_path, reference));
+}
+
 int calibrate_config(const std::string& config_path, const fs::path& output, std::string reference,
-                     double robust_px) {
+                     const std::string& rig_path, double robust_px) {
   CalibrationConfig config = load_calibration_config(config_path);
   if (config.cameras.empty()) throw CalibrationError(config_path + ": no cameras");
   if (reference.empty()) reference = config.cameras.front().name;
+  // Read before solving, so that a wrong rig file costs no solver time.
+  const Eigen::Isometry3d world_from_reference =
+      rig_path.empty() ? Eigen::Isometry3d::Identity() : rig_pose(rig_path, reference);
   CalibrationProblem problem(config, {.robust_scale_px = robust_px});
   const CalibrationReport report = problem.solve();
   fmt::print("{}", report.summary());
@@ -98,8 +121,11 @@ int calibrate_config(const std::string& config_path, const fs::path& output, std
                report.termination);
     return 1;
   }
-  for (const std::string& path :
-       write_cameras(report, problem.camera_poses(reference), config, output)) {
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> poses = problem.camera_poses(reference);
+  for (auto& [name, camera_from_frame] : poses) {
+    camera_from_frame = camera_from_frame * world_from_reference.inverse();
+  }
+  for (const std::string& path : write_cameras(report, poses, config, output)) {
     fmt::print("wrote {}\n", path);
   }
   return 0;
@@ -207,7 +233,7 @@ int main(int argc, char** argv) {
     fmt::print("{}", kUsage);
     return args.empty() ? 2 : 0;
   }
-  std::string config, images, board, reference, name = "camera";
+  std::string config, images, board, reference, rig, name = "camera";
   fs::path output = ".";
   double square = 0, robust = 0;
   for (size_t i = 0; i < args.size(); ++i) {
@@ -219,6 +245,8 @@ int main(int argc, char** argv) {
       output = value("--output");
     } else if (args[i] == "--reference") {
       reference = value("--reference");
+    } else if (args[i] == "--rig") {
+      rig = value("--rig");
     } else if (args[i] == "--robust") {
       robust = parse_positive("--robust", value("--robust"));
     } else if (args[i] == "--images") {
@@ -240,11 +268,12 @@ int main(int argc, char** argv) {
   try {
     if (!images.empty()) {
       if (!config.empty()) usage_error("either a configuration file or --images, not both");
+      if (!rig.empty()) usage_error("--rig places the cameras of a configuration, not --images");
       if (board.empty() || square == 0) usage_error("--images needs --board and --square");
       return calibrate_chessboard(images, board, square, output, name);
     }
     if (config.empty()) usage_error("no configuration file");
-    return calibrate_config(config, output, reference, robust);
+    return calibrate_config(config, output, reference, rig, robust);
   } catch (const std::exception& e) {
     fmt::print(stderr, "mocap_calibrate: {}\n", e.what());
     return 1;

@@ -41,8 +41,8 @@ struct CalibrationOptions {
   int max_iterations = 500;
   // Shots whose RMS reprojection error exceeds this are flagged as outliers in the report.
   double outlier_rms_px = 3.0;
-  // Standard deviations of the parameters from the covariance at the solution (costs a
-  // dense solve of the normal equations: off for very large problems).
+  // Standard deviations of the parameters from the covariance at the solution, when the solver
+  // converged (costs a dense solve of the normal equations: off for very large problems).
   bool compute_covariance = true;
 };
 
