@@ -339,8 +339,12 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
     if (spec.type == "eucm") {
       s.problem.SetParameterLowerBound(block, 0, 0.0);  // alpha in [0, 1]
       s.problem.SetParameterUpperBound(block, 0, 1.0);
-      s.problem.SetParameterLowerBound(block, 1, 1e-6);  // beta > 0
-      s.problem.SetParameterLowerBound(block, 2, 1.0);   // focal lengths
+      // beta > 0, and not beyond 100: in a narrow view only alpha and beta's combined bending
+      // shows, and without a ceiling the fit creeps along that valley for hundreds of
+      // iterations towards alpha = 0, beta -> infinity, changing nothing that can be seen.
+      s.problem.SetParameterLowerBound(block, 1, 1e-6);
+      s.problem.SetParameterUpperBound(block, 1, 100.0);
+      s.problem.SetParameterLowerBound(block, 2, 1.0);  // focal lengths
       s.problem.SetParameterLowerBound(block, 3, 1.0);
     } else {
       s.problem.SetParameterLowerBound(block, 0, 1.0);
