@@ -5,6 +5,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fmt/format.h>
+#include <mocap/calibration/camera_factory.hpp>
+#include <mocap/calibration/camera_file.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -22,19 +24,20 @@ std::string config(const std::string& file) {
 // config/scenes/demo.yaml; the evaluator stops the run after `frames` frames. The camera keeps
 // publishing until then, so frames sent before the other process's readers were discovered
 // (lost, as with any volatile DDS topic) do not matter.
-std::string pipeline_launch_file(const std::filesystem::path& summary, int frames,
-                                 bool two_processes, int domain) {
+std::string pipeline_launch_file(
+    const std::filesystem::path& summary, int frames, bool two_processes, int domain,
+    const std::string& camera_file = config("cameras/synthetic_ir_1280x720.yaml")) {
   std::string camera = fmt::format(R"(
       - plugin: synthetic_ir_camera
         name: camera
         parameters:
           scene: {}
+          camera: {}
           rate_hz: 60.0
         qos:
           /camera/ir/image_raw: {{profile: reliable, depth: 1000}})",
-                                   config("scenes/demo.yaml"));
-  std::string tracking =
-      fmt::format(R"(
+                                   config("scenes/demo.yaml"), camera_file);
+  std::string tracking = fmt::format(R"(
       - plugin: fiducial_tracker
         name: tracker
         qos:
@@ -45,12 +48,14 @@ std::string pipeline_launch_file(const std::filesystem::path& summary, int frame
           camera: {0}
       - plugin: pose_estimator
         name: pose
+        parameters:
+          camera: {0}
       - plugin: pose_evaluator
         name: evaluator
         parameters:
           stop_after_frames: {1}
           summary_file: {2})",
-                  config("cameras/synthetic_ir_1280x720.yaml"), frames, summary.string());
+                                     camera_file, frames, summary.string());
   std::string dds = fmt::format("dds:\n  enabled: {}\n  domain_id: {}\n",
                                 two_processes ? "true" : "false", domain);
   if (two_processes) {
@@ -70,6 +75,25 @@ void expect_accurate(const std::filesystem::path& summary_file, int frames) {
   EXPECT_EQ(summary["false_identifications"].as<int>(), 0);
   EXPECT_LT(summary["position_error_median_m"].as<double>(), 0.002);
   EXPECT_LT(summary["orientation_error_median_deg"].as<double>(), 0.2);
+}
+
+// The pipeline through a wide EUCM lens (camera file as mocap_calibrate writes it): the
+// synthetic camera renders through it, the identifier and the pose estimator unproject through
+// it, all by the camera-model interface.
+TEST(TrackingPipeline, ThroughAWideEucmLens) {
+  test::TempDir dir;
+  constexpr int kFrames = 40;
+  calibration::CameraFile eucm;
+  eucm.name = eucm.frame_id = "camera_ir_optical";
+  eucm.model = calibration::make_camera_model("eucm", 1280, 720,
+                                              std::vector<double>{0.6, 1.1, 760, 760, 641, 357});
+  calibration::save_camera_file((dir / "eucm.yaml").string(), eucm);
+  test::write_file(dir / "pipeline.yaml", pipeline_launch_file(dir / "summary.yaml", kFrames, false,
+                                                               0, (dir / "eucm.yaml").string()));
+  auto [code, output] = test::run_command({launcher(), (dir / "pipeline.yaml").string()}, {},
+                                          std::chrono::seconds(120));
+  ASSERT_EQ(code, 0) << output;
+  expect_accurate(dir / "summary.yaml", kFrames);
 }
 
 TEST(TrackingPipeline, InOneProcess) {
