@@ -24,6 +24,7 @@
 #include "drive_follower.hpp"
 #include "joint_history.hpp"
 #include "object_in_base.hpp"
+#include "pose_message.hpp"
 #include "turret_model.hpp"
 
 namespace mocap::drive {
@@ -43,21 +44,6 @@ constexpr uint8_t kWarning = 1;
 
 double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-std::optional<Eigen::Isometry3d> to_isometry(const geometry_msgs::msg::Pose& pose) {
-  const auto& p = pose.position();
-  const auto& q = pose.orientation();
-  Eigen::Quaterniond rotation(q.w(), q.x(), q.y(), q.z());
-  const double norm = rotation.norm();
-  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()) ||
-      !std::isfinite(norm) || norm < 1e-6) {
-    return std::nullopt;
-  }
-  Eigen::Isometry3d isometry = Eigen::Isometry3d::Identity();
-  isometry.linear() = rotation.normalized().toRotationMatrix();
-  isometry.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
-  return isometry;
 }
 
 class DriveFollowerComponent final : public Component {

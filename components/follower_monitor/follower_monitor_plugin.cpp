@@ -17,6 +17,7 @@
 #include <sensor_msgs/msg/joint_state.hpp>
 
 #include "follow_evaluation.hpp"
+#include "pose_message.hpp"
 
 namespace mocap::evaluation {
 namespace {
@@ -35,15 +36,6 @@ constexpr const char* kAlertTopic = "/alerts";
 constexpr size_t kKeptCameraPoses = 100;
 // A board showing this many of its markers can be tracked (three sides of twelve).
 constexpr uint32_t kTrackableMarkers = 10;
-
-Eigen::Isometry3d to_isometry(const PoseStamped& pose) {
-  const auto& p = pose.pose().position();
-  const auto& q = pose.pose().orientation();
-  Eigen::Isometry3d result = Eigen::Isometry3d::Identity();
-  result.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
-  result.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-  return result;
-}
 
 int64_t steady_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -98,7 +90,9 @@ class FollowerMonitor final : public Component {
     summary_file_ = param<std::string>("summary_file");
     evaluator_ = FollowEvaluator({.settle_s = param<double>("settle_s")});
     create_subscription<PoseStamped>(kCameraPoseTopic, [this](const PoseStamped& pose) {
-      camera_poses_.emplace_back(to_nanoseconds(pose.header().stamp()), to_isometry(pose));
+      const std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose());
+      if (!world_from_camera) return;
+      camera_poses_.emplace_back(to_nanoseconds(pose.header().stamp()), *world_from_camera);
       while (camera_poses_.size() > kKeptCameraPoses) camera_poses_.pop_front();
     });
     create_subscription<PoseStamped>(kBasePoseTopic, [this](const PoseStamped& pose) {

@@ -19,6 +19,7 @@
 #include <mocap/message_time.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
+#include "pose_message.hpp"
 #include "turret_model.hpp"
 #include "unicycle_base.hpp"
 
@@ -36,20 +37,12 @@ constexpr const char* kBasePose = "/base/pose";
 constexpr const char* kCameraPose = "/sim/camera_pose";
 constexpr double kDegree = M_PI / 180;
 
-PoseStamped to_pose_message(const Eigen::Isometry3d& pose,
-                            const builtin_interfaces::msg::Time& stamp) {
+PoseStamped stamped_pose(const Eigen::Isometry3d& pose,
+                         const builtin_interfaces::msg::Time& stamp) {
   PoseStamped message;
   message.header().stamp(stamp);
   message.header().frame_id("world");
-  const Eigen::Vector3d& t = pose.translation();
-  message.pose().position().x(t.x());
-  message.pose().position().y(t.y());
-  message.pose().position().z(t.z());
-  const Eigen::Quaterniond q(pose.linear());
-  message.pose().orientation().x(q.x());
-  message.pose().orientation().y(q.y());
-  message.pose().orientation().z(q.z());
-  message.pose().orientation().w(q.w());
+  message.pose(to_pose_message(pose));
   return message;
 }
 
@@ -160,9 +153,9 @@ class MobileBaseSim final : public Component {
     const auto stamp =
         to_time_msg(anchor_wall_ + std::chrono::duration_cast<Clock::duration>(steady - *anchor_));
     const Eigen::Isometry3d world_from_base = base_.world_from_base();
-    base_publisher_.publish(to_pose_message(world_from_base, stamp));
+    base_publisher_.publish(stamped_pose(world_from_base, stamp));
     camera_publisher_.publish(
-        to_pose_message(world_from_base * turret_.base_from_camera(joints_), stamp));
+        stamped_pose(world_from_base * turret_.base_from_camera(joints_), stamp));
   }
 
   UnicycleBase base_;

@@ -16,6 +16,7 @@
 
 #include "image_message.hpp"
 #include "overlay_drawing.hpp"
+#include "pose_message.hpp"
 
 namespace mocap::overlay {
 namespace {
@@ -103,16 +104,9 @@ class OverlayComponent final : public Component {
     Mono8View view = view_mono8(*pending.image);
     if (!view.problem.empty()) return;  // the tracker reports bad images
     for (const auto& p : poses.poses()) {
-      const auto& pose = p.pose().pose();
-      OverlayPose overlay_pose{p.name(), Eigen::Isometry3d::Identity()};
-      overlay_pose.camera_from_object.translation() =
-          Eigen::Vector3d(pose.position().x(), pose.position().y(), pose.position().z());
-      overlay_pose.camera_from_object.linear() =
-          Eigen::Quaterniond(pose.orientation().w(), pose.orientation().x(), pose.orientation().y(),
-                             pose.orientation().z())
-              .normalized()
-              .toRotationMatrix();
-      pending.content.poses.push_back(overlay_pose);
+      if (std::optional<Eigen::Isometry3d> pose = to_isometry(p.pose().pose())) {
+        pending.content.poses.push_back({p.name(), *pose});
+      }
     }
     cv::Mat picture = draw_overlay(view.pixels, pending.content, camera_.model.get());
     auto message = std::make_shared<sensor_msgs::msg::Image>();

@@ -10,6 +10,7 @@
 
 #include "constellation_pose.hpp"
 #include "planar_pose.hpp"
+#include "pose_message.hpp"
 
 namespace mocap::pose {
 namespace {
@@ -106,15 +107,7 @@ class PoseEstimatorComponent final : public Component {
     mocap_msgs::msg::ConstellationPose out;
     out.name(name);
     out.pose().header(header);
-    const Eigen::Vector3d& t = pose.camera_from_object.translation();
-    Eigen::Quaterniond q(pose.camera_from_object.linear());
-    out.pose().pose().position().x(t.x());
-    out.pose().pose().position().y(t.y());
-    out.pose().pose().position().z(t.z());
-    out.pose().pose().orientation().x(q.x());
-    out.pose().pose().orientation().y(q.y());
-    out.pose().pose().orientation().z(q.z());
-    out.pose().pose().orientation().w(q.w());
+    out.pose().pose(to_pose_message(pose.camera_from_object));
     for (int i = 0; i < 6; ++i) {
       for (int j = 0; j < 6; ++j) out.covariance()[6 * i + j] = pose.covariance(i, j);
     }

@@ -8,6 +8,7 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
 #include "pose_evaluation.hpp"
+#include "pose_message.hpp"
 
 namespace mocap::evaluation {
 namespace {
@@ -18,15 +19,11 @@ constexpr const char* kPoses = "/mocap/poses";
 std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array) {
   std::vector<ObjectPose> out;
   for (const auto& pose : array.poses()) {
-    const auto& p = pose.pose().pose();
+    const std::optional<Eigen::Isometry3d> isometry = to_isometry(pose.pose().pose());
+    if (!isometry) continue;  // no pose at all: as if not reported
     ObjectPose object;
     object.name = pose.name();
-    object.pose.translation() =
-        Eigen::Vector3d(p.position().x(), p.position().y(), p.position().z());
-    object.pose.linear() = Eigen::Quaterniond(p.orientation().w(), p.orientation().x(),
-                                              p.orientation().y(), p.orientation().z())
-                               .normalized()
-                               .toRotationMatrix();
+    object.pose = *isometry;
     object.visible_markers = static_cast<int>(pose.points_used());
     out.push_back(std::move(object));
   }

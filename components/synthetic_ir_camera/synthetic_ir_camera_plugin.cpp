@@ -27,6 +27,7 @@
 #include "constellation_database.hpp"
 #include "image_message.hpp"
 #include "ir_renderer.hpp"
+#include "pose_message.hpp"
 #include "scene.hpp"
 
 namespace mocap::synthetic {
@@ -116,13 +117,9 @@ class SyntheticIrCamera final : public Component {
     if (param<bool>("moving_camera")) {
       create_subscription<geometry_msgs::msg::PoseStamped>(
           kCameraPoseTopic, [this](const geometry_msgs::msg::PoseStamped& pose) {
-            const auto& p = pose.pose().position();
-            const auto& q = pose.pose().orientation();
-            Eigen::Isometry3d world_from_camera = Eigen::Isometry3d::Identity();
-            world_from_camera.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
-            world_from_camera.linear() =
-                Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-            camera_from_world_ = world_from_camera.inverse() * world_from_scene();
+            if (std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose())) {
+              camera_from_world_ = world_from_camera->inverse() * world_from_scene();
+            }
           });
     } else {
       camera_from_world_ = Eigen::Isometry3d::Identity();
@@ -181,15 +178,7 @@ class SyntheticIrCamera final : public Component {
       mocap_msgs::msg::ConstellationPose pose;
       pose.name(object.constellation);
       pose.pose().header(header);
-      const Eigen::Vector3d& position = object.pose.translation();
-      pose.pose().pose().position().x(position.x());
-      pose.pose().pose().position().y(position.y());
-      pose.pose().pose().position().z(position.z());
-      Eigen::Quaterniond orientation(object.pose.linear());
-      pose.pose().pose().orientation().x(orientation.x());
-      pose.pose().pose().orientation().y(orientation.y());
-      pose.pose().pose().orientation().z(orientation.z());
-      pose.pose().pose().orientation().w(orientation.w());
+      pose.pose().pose(to_pose_message(object.pose));
       pose.reprojection_rms_px(0);
       pose.points_used(static_cast<uint32_t>(object.visible_markers()));
       truth->poses().push_back(std::move(pose));

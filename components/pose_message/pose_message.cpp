@@ -1,0 +1,36 @@
+#include "pose_message.hpp"
+
+#include <cmath>
+
+namespace mocap {
+
+geometry_msgs::msg::Pose to_pose_message(const Eigen::Isometry3d& pose) {
+  geometry_msgs::msg::Pose message;
+  const Eigen::Vector3d& t = pose.translation();
+  message.position().x(t.x());
+  message.position().y(t.y());
+  message.position().z(t.z());
+  const Eigen::Quaterniond q(pose.linear());
+  message.orientation().x(q.x());
+  message.orientation().y(q.y());
+  message.orientation().z(q.z());
+  message.orientation().w(q.w());
+  return message;
+}
+
+std::optional<Eigen::Isometry3d> to_isometry(const geometry_msgs::msg::Pose& pose) {
+  const auto& p = pose.position();
+  const auto& q = pose.orientation();
+  const Eigen::Quaterniond rotation(q.w(), q.x(), q.y(), q.z());
+  const double norm = rotation.norm();
+  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()) ||
+      !std::isfinite(norm) || norm < 1e-6) {
+    return std::nullopt;
+  }
+  Eigen::Isometry3d isometry = Eigen::Isometry3d::Identity();
+  isometry.linear() = rotation.normalized().toRotationMatrix();
+  isometry.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
+  return isometry;
+}
+
+}  // namespace mocap
