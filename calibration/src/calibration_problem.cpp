@@ -144,19 +144,24 @@ struct CalibrationProblem::State {
     if (config.transformations[t].global) return transforms[t].data();
     return shot_poses.at({t, data.data_path, frame}).data();
   }
-  double rms(bool& any) {
+  // The squared pixel errors of a shot's points, summed.
+  double squared_error(const ShotResiduals& shot) {
+    double sum = 0;
+    for (ceres::ResidualBlockId id : shot.points) {
+      double residuals[2], cost = 0;
+      problem.EvaluateResidualBlock(id, false, &cost, residuals, nullptr);
+      sum += residuals[0] * residuals[0] + residuals[1] * residuals[1];
+    }
+    return sum;
+  }
+  // Over every point, pixels.
+  double rms() {
     double sum = 0;
     size_t count = 0;
     for (const ShotResiduals& shot : shot_residuals) {
-      for (ceres::ResidualBlockId id : shot.points) {
-        double residuals[2];
-        double cost = 0;
-        problem.EvaluateResidualBlock(id, false, &cost, residuals, nullptr);
-        sum += residuals[0] * residuals[0] + residuals[1] * residuals[1];
-        ++count;
-      }
+      sum += squared_error(shot);
+      count += shot.points.size();
     }
-    any = count > 0;
     return count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
   }
 };
@@ -362,8 +367,7 @@ CalibrationProblem::~CalibrationProblem() = default;
 CalibrationReport CalibrationProblem::solve() {
   State& s = *state_;
   CalibrationReport report;
-  bool any = false;
-  report.initial_rms_px = s.rms(any);
+  report.initial_rms_px = s.rms();
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_SCHUR;
@@ -380,21 +384,17 @@ CalibrationReport CalibrationProblem::solve() {
   report.iterations = static_cast<int>(summary.iterations.size()) - 1;
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
-  report.rms_px = s.rms(any);
   report.points = 0;
 
   // Per shot and per camera.
   std::vector<double> camera_sum(s.config.cameras.size(), 0.0);
   std::vector<size_t> camera_points(s.config.cameras.size(), 0), camera_shots(camera_sum.size());
+  double total = 0;
   for (const State::ShotResiduals& shot : s.shot_residuals) {
     const DataSpec& data = s.config.data[shot.data];
     const size_t c = s.camera_index.at(data.camera);
-    double sum = 0;
-    for (ceres::ResidualBlockId id : shot.points) {
-      double residuals[2], cost = 0;
-      s.problem.EvaluateResidualBlock(id, false, &cost, residuals, nullptr);
-      sum += residuals[0] * residuals[0] + residuals[1] * residuals[1];
-    }
+    const double sum = s.squared_error(shot);
+    total += sum;
     camera_sum[c] += sum;
     camera_points[c] += shot.points.size();
     ++camera_shots[c];
@@ -403,6 +403,7 @@ CalibrationReport CalibrationProblem::solve() {
     report.shots.push_back(
         {shot.data, data.shots[shot.shot].frame, data.camera, rms, rms > s.options.outlier_rms_px});
   }
+  report.rms_px = std::sqrt(total / static_cast<double>(report.points));
 
   // Standard deviations, scaled by the residuals' own spread (the pixel noise is not given).
   std::vector<std::vector<double>> camera_sigma(s.config.cameras.size());
