@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string_view>
 
+#include <mocap/spelling.hpp>
 #include <nlohmann/json.hpp>
 
 namespace mocap::calibration {
@@ -40,42 +41,11 @@ std::string join(const std::vector<std::string>& words, std::string_view separat
   return out;
 }
 
-size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-// The candidate a misspelt `word` most likely meant: a typo, or the word cut short. Names get
-// a tighter bound than keys: "xi13" is more likely another transform than a typo of "xi12".
-const std::string* nearest(std::string_view word, const std::vector<std::string>& candidates,
-                           size_t min_edits = 2) {
-  const std::string* best = nullptr;
-  size_t best_distance = 0;
-  for (const std::string& candidate : candidates) {
-    const bool prefix = word.size() >= 3 && std::string_view(candidate).starts_with(word);
-    const size_t distance = prefix ? 1 : edit_distance(word, candidate);
-    if (best == nullptr || distance < best_distance) {
-      best = &candidate;
-      best_distance = distance;
-    }
-  }
-  if (best != nullptr && best_distance <= std::max(min_edits, word.size() / 4)) return best;
-  return nullptr;
-}
-
 // " (did you mean 'x'?)" for a near miss of a declared name, otherwise nothing.
 std::string suggestion(std::string_view word, const std::vector<std::string>& candidates) {
-  const std::string* best = nearest(word, candidates, 1);
+  // Names get a tighter bound than keys: "xi13" is more likely another transform than a typo
+  // of "xi12".
+  const std::string* best = nearest_spelling(word, candidates, 1);
   return best != nullptr ? " (did you mean '" + *best + "'?)" : std::string();
 }
 
@@ -211,9 +181,7 @@ class Reader {
       if (key.starts_with("_") || std::find(allowed.begin(), allowed.end(), key) != allowed.end()) {
         continue;
       }
-      const std::string* best = nearest(key, allowed);
-      fail(path / key, best != nullptr ? "unknown key (did you mean '" + *best + "'?)"
-                                       : "unknown key (keys: " + join(allowed) + ")");
+      fail(path / key, "unknown key" + did_you_mean(key, allowed, "keys"));
     }
   }
 

@@ -113,8 +113,8 @@ bool valid_component_name(std::string_view name) {
   });
 }
 
-std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates,
-                         std::string_view what) {
+const std::string* nearest_spelling(std::string_view word,
+                                    const std::vector<std::string>& candidates, size_t max_edits) {
   const std::string* best = nullptr;
   size_t best_distance = 0;
   for (const std::string& candidate : candidates) {
@@ -126,7 +126,13 @@ std::string did_you_mean(std::string_view word, const std::vector<std::string>& 
       best_distance = distance;
     }
   }
-  if (best != nullptr && best_distance <= std::max<size_t>(2, word.size() / 4)) {
+  if (best != nullptr && best_distance <= std::max(max_edits, word.size() / 4)) return best;
+  return nullptr;
+}
+
+std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates,
+                         std::string_view what) {
+  if (const std::string* best = nearest_spelling(word, candidates)) {
     return fmt::format(" (did you mean '{}'?)", *best);
   }
   if (candidates.empty()) return fmt::format(" (there are no {})", what);
