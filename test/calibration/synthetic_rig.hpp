@@ -53,6 +53,27 @@ struct RigScenario {
   std::vector<Eigen::Isometry3d> boards;  // world_from_board, one per frame
 };
 
+// Board poses spread over one camera's whole view at 1.2 to 2.5 m, tilted up to 35 degrees
+// either way: corners of the image show the lens's distortion, tilts its focal length.
+inline std::vector<Eigen::Isometry3d> spread_board_poses(int count, std::mt19937& random) {
+  std::uniform_real_distribution<double> across(-0.3, 0.3), down(-0.22, 0.22), depth(1.2, 2.5),
+      tilt(-35 * kDegree, 35 * kDegree), yaw(-M_PI, M_PI);
+  std::vector<Eigen::Isometry3d> poses;
+  while (static_cast<int>(poses.size()) < count) {
+    const double d = depth(random);
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = (Eigen::AngleAxisd(yaw(random), Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
+                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
+                        .toRotationMatrix();
+    // The board's centre at the chosen place.
+    pose.translation() = Eigen::Vector3d(across(random) * d, down(random) * d, d) -
+                         pose.linear() * Eigen::Vector3d(0.131, 0.06, 0);
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
 // Pixels within the image with a margin, so that noise cannot push a point out of it.
 inline std::optional<Eigen::Vector2d> rig_project(const std::vector<double>& intrinsics,
                                                   const Eigen::Vector3d& point) {

@@ -11,6 +11,8 @@
 #include <mocap/calibration/calibration_problem.hpp>
 #include <mocap/calibration/lens_models.hpp>
 
+#include "synthetic_rig.hpp"
+
 namespace mocap::calibration {
 namespace {
 
@@ -29,27 +31,6 @@ std::optional<Eigen::Vector2d> project(const std::vector<double>& camera,
   if (!eucm_project(camera.data(), point.data(), pixel.data())) return std::nullopt;
   if (pixel.x() < 0 || pixel.y() < 0 || pixel.x() > 1023 || pixel.y() > 767) return std::nullopt;
   return pixel;
-}
-
-// Board poses spread over camera 0's whole view at 1.2 to 2.5 m, tilted up to 35 degrees
-// either way: corners of the image show the lens's distortion, tilts its focal length.
-std::vector<Eigen::Isometry3d> board_poses(int count, std::mt19937& random) {
-  std::uniform_real_distribution<double> across(-0.3, 0.3), down(-0.22, 0.22), depth(1.2, 2.5),
-      tilt(-35 * kDegree, 35 * kDegree), yaw(-M_PI, M_PI);
-  std::vector<Eigen::Isometry3d> poses;
-  while (static_cast<int>(poses.size()) < count) {
-    const double d = depth(random);
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = (Eigen::AngleAxisd(yaw(random), Eigen::Vector3d::UnitZ()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
-                        .toRotationMatrix();
-    // The board's centre at the chosen place.
-    pose.translation() = Eigen::Vector3d(across(random) * d, down(random) * d, d) -
-                         pose.linear() * Eigen::Vector3d(0.131, 0.06, 0);
-    poses.push_back(pose);
-  }
-  return poses;
 }
 
 // One data entry of `camera` seeing the boards through `camera_from_reference`, with noise.
@@ -88,7 +69,8 @@ CalibrationConfig one_camera(int shots, double sigma_px, uint32_t seed = 1) {
   // Started as the seed did (Code 8.2): far from the truth.
   config.cameras.push_back({"cam0", "eucm", false, {0.01, 1, 1175, 1175, 512, 384}});
   config.data.push_back(shots_of("cam0", kTrueCamera0, Eigen::Isometry3d::Identity(),
-                                 board_poses(shots, random), sigma_px, random, {{"board", true}}));
+                                 synthetic::spread_board_poses(shots, random), sigma_px, random,
+                                 {{"board", true}}));
   return config;
 }
 
@@ -142,7 +124,7 @@ TEST(CalibrationProblem, TwoCamerasAndTheTransformBetweenThem) {
       Eigen::AngleAxisd(10 * kDegree, Eigen::Vector3d(0.1, 1, 0.05).normalized())
           .toRotationMatrix();
   camera1_from_camera0.translation() = Eigen::Vector3d(-0.3, 0.02, 0.01);
-  const std::vector<Eigen::Isometry3d> boards = board_poses(25, random);
+  const std::vector<Eigen::Isometry3d> boards = synthetic::spread_board_poses(25, random);
 
   CalibrationConfig config;
   config.source = "synthetic";

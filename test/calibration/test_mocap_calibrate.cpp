@@ -10,12 +10,12 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/lens_models.hpp>
 
+#include "synthetic_rig.hpp"
 #include "test_support.hpp"
 
 namespace mocap::calibration {
 namespace {
 
-constexpr double kDegree = M_PI / 180;
 const std::vector<double> kTruth = {0.3, 1.2, 1210.0, 1206.0, 520.0, 380.0};
 
 std::string calibrate() { return (test::bin_dir() / "mocap_calibrate").string(); }
@@ -26,19 +26,10 @@ void write_inputs(const test::TempDir& dir, int shots, const std::string& camera
   const std::vector<Eigen::Vector3d> board = {
       {0, 0.12, 0}, {0, 0, 0}, {0.262, 0, 0}, {0.262, 0.12, 0}};
   std::mt19937 random(5);
-  std::uniform_real_distribution<double> across(-0.3, 0.3), down(-0.22, 0.22), depth(1.2, 2.5),
-      tilt(-35 * kDegree, 35 * kDegree), yaw(-M_PI, M_PI);
   std::normal_distribution<double> noise(0, 0.1);
   std::string frames;
   for (int made = 0; made < shots;) {
-    const double d = depth(random);
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = (Eigen::AngleAxisd(yaw(random), Eigen::Vector3d::UnitZ()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
-                        .toRotationMatrix();
-    pose.translation() = Eigen::Vector3d(across(random) * d, down(random) * d, d) -
-                         pose.linear() * Eigen::Vector3d(0.131, 0.06, 0);
+    const Eigen::Isometry3d pose = synthetic::spread_board_poses(1, random).front();
     std::vector<std::string> points;
     for (const Eigen::Vector3d& led : board) {
       const Eigen::Vector3d p = pose * led;
