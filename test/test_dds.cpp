@@ -150,6 +150,9 @@ TEST(Dds, TopicToolListsEchoesAndMeasures) {
   test::write_file(dir / "source.yaml",
                    source_yaml("count: 0, batch: 1, period_s: 0.01, subscribers: 0"));
   test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+  // The list waits 3 s for discovery: from a publisher that exists, not from one still starting
+  // (a loaded machine can take that long to start a process).
+  ASSERT_TRUE(source.wait_for_output("publishing", std::chrono::seconds(60))) << source.output();
 
   auto [list_code, list] = test::run_command({topic_tool(), "list", "--wait", "3"}, env);
   EXPECT_EQ(list_code, 0);
