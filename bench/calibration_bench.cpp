@@ -48,10 +48,11 @@ struct RigRun {
   double expected_rms_px = 0, ms = 0;
 };
 
-RigRun run_rig(const synthetic::RigScenario& scenario, double sigma, uint32_t noise_seed) {
+RigRun run_rig(const synthetic::RigScenario& scenario, double sigma, uint32_t noise_seed,
+               bool covariance) {
   const CalibrationConfig config = synthetic::rig_config(scenario, sigma, noise_seed);
   const Clock::time_point start = Clock::now();
-  CalibrationProblem problem(config, {.compute_covariance = false});
+  CalibrationProblem problem(config, {.compute_covariance = covariance});
   RigRun run{problem.solve(), {}, synthetic::expected_rms_px(config, sigma), 0};
   run.ms = milliseconds_since(start);
   run.errors = synthetic::rig_errors(scenario, run.report);
@@ -91,7 +92,7 @@ void rig_table(bool quick) {
   if (quick) sigmas = {0.1};
   std::optional<RigRun> first_draw;  // σ = 0.1, noise draw 1: the next table's first row
   for (double sigma : sigmas) {
-    RigRun run = run_rig(scenario, sigma, 1);
+    RigRun run = run_rig(scenario, sigma, 1, sigma == 0.1);
     const synthetic::RigErrors& e = run.errors;
     fmt::print(
         "| {} | {:.3f} / {:.3f} | {:.2f} / {:.2f} | {:.2f} / {:.2f} | {:.3f} / {:.3f} | {:.3f} "
@@ -108,18 +109,23 @@ void rig_table(bool quick) {
   fmt::print(
       "\n### Targets at σ = 0.1 px, the same shots, {} noise draw(s)\n\n"
       "Worst camera of each draw against the issue's targets (RMS: within {:.0f} % of the "
-      "expected). A focal error scales a camera's distance to the boards, so 2 mm between "
-      "cameras 2.05 m above the boards asks every focal length to about 0.1 %; a principal "
-      "point error turns a camera (1 px: 0.05 deg).\n\n"
-      "| draw | focal err % (<= {}) | principal pt err px (<= {}) | transl. err mm (<= {}) | "
-      "rot. err deg (<= {}) | RMS px (expected) | solve ms | iterations |\n"
+      "expected); in brackets the worst camera's root-mean-square error the solution's "
+      "covariance predicts, the Cramér-Rao bound of these shots (no unbiased estimator does "
+      "better on average). A focal error scales a camera's distance to the boards, so 2 mm "
+      "between cameras 2.05 m above the boards asks every focal length to about 0.1 %; a "
+      "principal point error turns a camera (1 px: 0.05 deg). Solve time includes the "
+      "covariance.\n\n"
+      "| draw | focal err % (<= {}) | principal pt err px (<= {}) [predicted] | transl. err mm "
+      "(<= {}) [predicted] | rot. err deg (<= {}) [predicted] | RMS px (expected) | solve ms | "
+      "iterations |\n"
       "|---:|---:|---:|---:|---:|---:|---:|---:|\n",
       draws, 100 * kRmsTolerance, kFocalTargetPercent, kPrincipalTargetPx, kTranslationTargetMm,
       kRotationTargetDeg);
   int met[5] = {0, 0, 0, 0, 0};
+  std::vector<double> predicted_principal, predicted_translation;
   for (int draw = 1; draw <= draws; ++draw) {
     const RigRun run =
-        draw == 1 ? *first_draw : run_rig(scenario, 0.1, static_cast<uint32_t>(draw));
+        draw == 1 ? *first_draw : run_rig(scenario, 0.1, static_cast<uint32_t>(draw), true);
     const synthetic::RigErrors& e = run.errors;
     const double worst[4] = {maximum(e.focal_percent), maximum(e.principal_px),
                              maximum(e.translation_mm), maximum(e.rotation_deg)};
@@ -128,14 +134,37 @@ void rig_table(bool quick) {
     for (int i = 0; i < 4; ++i) met[i] += worst[i] <= targets[i];
     met[4] +=
         std::abs(run.report.rms_px - run.expected_rms_px) <= kRmsTolerance * run.expected_rms_px;
-    fmt::print("| {} | {:.3f} | {:.2f} | {:.2f} | {:.3f} | {:.4f} ({:.4f}) | {:.0f} | {} |\n", draw,
-               worst[0], worst[1], worst[2], worst[3], run.report.rms_px, run.expected_rms_px,
-               run.ms, iterations(run.report));
+    // No covariance where the solve stopped at the iteration limit.
+    auto predicted = [](const std::vector<double>& v, int digits) {
+      return v.empty() ? std::string("–") : fmt::format("{:.{}f}", maximum(v), digits);
+    };
+    if (!e.predicted_principal_px.empty()) {
+      predicted_principal.push_back(maximum(e.predicted_principal_px));
+      predicted_translation.push_back(maximum(e.predicted_translation_mm));
+    }
+    fmt::print(
+        "| {} | {:.3f} | {:.2f} [{}] | {:.2f} [{}] | {:.3f} [{}] | {:.4f} ({:.4f}) | {:.0f} | {} "
+        "|\n",
+        draw, worst[0], worst[1], predicted(e.predicted_principal_px, 2), worst[2],
+        predicted(e.predicted_translation_mm, 2), worst[3], predicted(e.predicted_rotation_deg, 3),
+        run.report.rms_px, run.expected_rms_px, run.ms, iterations(run.report));
   }
+  // The bound falls as 1/√shots: the shots it would take to bring it to half the target, where
+  // most draws would meet it.
+  const double shots =
+      median(std::vector<double>(counts.per_camera.begin(), counts.per_camera.end()));
+  auto shots_needed = [&](double predicted, double target) {
+    return shots * std::pow(std::max(1.0, 2 * predicted / target), 2);
+  };
   fmt::print(
       "\nDraws of {} meeting each target: focal {}, principal point {}, translation {}, "
-      "rotation {}, RMS {}.\n\n",
-      draws, met[0], met[1], met[2], met[3], met[4]);
+      "rotation {}, RMS {}. The predicted errors put the principal point and translation "
+      "targets below what these {:.0f} shots per camera can give; this geometry would need about "
+      "{:.0f} (principal point) and {:.0f} (translation) shots per camera to bring the bound to "
+      "half the target.\n\n",
+      draws, met[0], met[1], met[2], met[3], met[4], shots,
+      shots_needed(median(predicted_principal), kPrincipalTargetPx),
+      shots_needed(median(predicted_translation), kTranslationTargetMm));
 }
 
 // A 1280x720 pinhole camera with OpenCV's distortion and a 9x6 chessboard of 25 mm squares.

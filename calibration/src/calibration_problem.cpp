@@ -154,6 +154,16 @@ struct CalibrationProblem::State {
     }
     return sum;
   }
+  // Residuals (point coordinates and priors) less the free parameters' degrees of freedom.
+  double degrees_of_freedom() const {
+    std::vector<double*> blocks;
+    problem.GetParameterBlocks(&blocks);
+    int free = 0;
+    for (double* block : blocks) {
+      if (!problem.IsParameterBlockConstant(block)) free += problem.ParameterBlockTangentSize(block);
+    }
+    return static_cast<double>(problem.NumResiduals() - free);
+  }
   // Over every point, pixels.
   double rms() {
     double sum = 0;
@@ -427,12 +437,11 @@ CalibrationReport CalibrationProblem::solve() {
     std::vector<std::pair<const double*, const double*>> pairs;
     for (const double* block : blocks) pairs.emplace_back(block, block);
     ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::DENSE_SVD;
-    covariance_options.null_space_rank = -1;  // report failure below instead of guessing
-    covariance_options.min_reciprocal_condition_number = 1e-14;
+    // Sparse: a rig has thousands of per-shot pose values (a dense SVD of them took a minute).
+    // A rank-deficient Jacobian makes Compute fail, reported below, rather than guess.
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
     ceres::Covariance covariance(covariance_options);
-    const double dof =
-        static_cast<double>(2 * report.points) - static_cast<double>(s.problem.NumParameters());
+    const double dof = s.degrees_of_freedom();
     const double variance = dof > 0 ? 2 * summary.final_cost / dof : 1.0;
     if (pairs.empty()) {
       // Nothing free: nothing to report.

@@ -231,6 +231,10 @@ struct RigErrors {
   std::vector<double> focal_percent, principal_px;
   // Per camera but the reference: its pose relative to the reference against the truth.
   std::vector<double> translation_mm, rotation_deg;
+  // The same as the report's covariance predicts them, root mean square: √(σu0² + σv0²),
+  // √(σx² + σy² + σz²), √(σrx² + σry² + σrz²); empty without covariance. These are the
+  // Cramér-Rao bounds of the shots: no unbiased estimator does better on average.
+  std::vector<double> predicted_principal_px, predicted_translation_mm, predicted_rotation_deg;
 };
 
 inline RigErrors rig_errors(const RigScenario& scenario, const CalibrationReport& report) {
@@ -242,7 +246,18 @@ inline RigErrors rig_errors(const RigScenario& scenario, const CalibrationReport
     errors.focal_percent.push_back(100 * std::max(std::abs(found[2] - truth[2]) / truth[2],
                                                   std::abs(found[3] - truth[3]) / truth[3]));
     errors.principal_px.push_back(std::hypot(found[4] - truth[4], found[5] - truth[5]));
+    const std::vector<double>& sd = report.cameras[i].standard_deviation;
+    if (sd.size() == 6) errors.predicted_principal_px.push_back(std::hypot(sd[4], sd[5]));
     if (i == 0) continue;
+    const std::vector<double>& pose_sd = report.globals[i - 1].standard_deviation;
+    if (pose_sd.size() == 6) {
+      errors.predicted_translation_mm.push_back(
+          1e3 *
+          std::sqrt(pose_sd[0] * pose_sd[0] + pose_sd[1] * pose_sd[1] + pose_sd[2] * pose_sd[2]));
+      errors.predicted_rotation_deg.push_back(
+          std::sqrt(pose_sd[3] * pose_sd[3] + pose_sd[4] * pose_sd[4] + pose_sd[5] * pose_sd[5]) /
+          kDegree);
+    }
     const Eigen::Isometry3d camera_from_reference =
         scenario.cameras[i].mounted.inverse() * reference.mounted;
     const Eigen::Isometry3d& solved = report.globals[i - 1].value;

@@ -190,6 +190,49 @@ TEST(CalibrationProblem, DegenerateShotsAreNamed) {
   }
 }
 
+// Boards held square to an undistorted camera look the same if the focal length and every
+// board's distance grow together, or the principal point and every board move across together:
+// the solver may settle anywhere along those lines, and the report must say that the data leave
+// the parameters undetermined rather than print standard deviations for them.
+TEST(CalibrationProblem, UndeterminedParametersGetNoStandardDeviations) {
+  const std::vector<double> truth = {900, 900, 512, 384, 0, 0, 0, 0, 0};  // no distortion
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> across(-0.4, 0.4), spin(-M_PI, M_PI);
+  CalibrationConfig config;
+  config.source = "synthetic";
+  config.transformations.push_back({"board", false, false, false, 1.0, std::nullopt});
+  config.cameras.push_back({"cam0", "pinhole", false, {880, 880, 500, 380}});
+  DataSpec data;
+  data.type = "ir_data";
+  data.camera = "cam0";
+  data.transform_chain = {{"board", true}};
+  data.image_width = 1024;
+  data.image_height = 768;
+  data.data_file = data.data_path = "square.json";
+  data.object_points = kBoard;
+  data.corners = {0, 1, 2, 3};
+  for (size_t frame = 0; frame < 12; ++frame) {
+    const Eigen::Isometry3d board = Eigen::Translation3d(across(random), across(random), 1.5) *
+                                    Eigen::AngleAxisd(spin(random), Eigen::Vector3d::UnitZ());
+    Shot shot;
+    shot.frame = frame;
+    for (const Eigen::Vector3d& led : kBoard) {
+      Eigen::Vector2d pixel;
+      ASSERT_TRUE(pinhole_project(truth.data(), (board * led).eval().data(), pixel.data()));
+      shot.points.push_back(pixel);
+    }
+    data.shots.push_back(std::move(shot));
+  }
+  config.data.push_back(std::move(data));
+  CalibrationProblem problem(config);
+  const CalibrationReport report = problem.solve();
+  EXPECT_TRUE(report.cameras[0].standard_deviation.empty()) << report.summary();
+  EXPECT_NE(report.covariance_problem.find("not all determined by the data"), std::string::npos)
+      << report.summary();
+  // Any point on those lines fits the noiseless points exactly.
+  EXPECT_LT(report.rms_px, 1e-6) << report.summary();
+}
+
 TEST(CalibrationProblem, ABadShotIsFlaggedAndARobustLossKeepsTheFit) {
   CalibrationConfig config = one_camera(20, 0.1, 11);
   config.data[0].shots[5].points[2] += Eigen::Vector2d(25, -18);  // a reflection, say

@@ -42,7 +42,7 @@ struct CalibrationOptions {
   // Shots whose RMS reprojection error exceeds this are flagged as outliers in the report.
   double outlier_rms_px = 3.0;
   // Standard deviations of the parameters from the covariance at the solution, when the solver
-  // converged (costs a dense solve of the normal equations: off for very large problems).
+  // converged (a sparse QR factorization of the Jacobian: about as long as the solve).
   bool compute_covariance = true;
 };
 
@@ -73,7 +73,7 @@ struct ShotResult {
 
 struct CalibrationReport {
   bool converged = false;
-  std::string termination;  // Ceres's message
+  std::string termination;  // why the solve stopped
   int iterations = 0;
   double initial_cost = 0, final_cost = 0;
   double initial_rms_px = 0, rms_px = 0;  // over every point
