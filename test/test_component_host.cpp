@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include <mocap/component_host.hpp>
+#include <mocap_msgs/msg/fiducial.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 #include "fastdds_transport.hpp"
@@ -140,6 +141,69 @@ TEST_F(ComponentHostTest, TopicFamiliesAreInstantiatedAndRemappedByTheirPlacehol
   host.add(kSink, {.name = "sink", .remaps = {{"/numbers", "/right/numbers"}}});
   EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
   EXPECT_EQ(record.received.size(), 50u);
+}
+
+// Relays every known topic published by someone else to /relayed/<last segment>, with the
+// type the deployment declares: a recorder's and a player's use of any-topic declarations.
+class AnyRelay final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.subscribes_any("every published topic");
+    spec.publishes_any("their copies");
+  }
+  explicit AnyRelay(Context& context) : Component(context) {
+    for (const KnownTopic& topic : context.known_topics()) {
+      if (topic.publishers.empty() || topic.topic.starts_with("/relayed")) continue;
+      auto out = context.advertise_any("/relayed" + topic.topic.substr(topic.topic.rfind('/')),
+                                       *topic.type, topic.publishers.front());
+      context.subscribe_any(topic.topic, *topic.type, topic.publishers.front(),
+                            [out](const std::shared_ptr<const void>& m) { out->publish(m); });
+    }
+  }
+};
+
+TEST_F(ComponentHostTest, AnyTopicComponentsUseTheDeploymentsTypesAndRemaps) {
+  ComponentHost host(in_process());
+  host.add(kSource, {.name = "source"});
+  // The relay's /relayed/numbers is remapped like any declared topic.
+  host.add(make_component_factory<AnyRelay>("any_relay"),
+           {.name = "relay", .remaps = {{"/relayed/numbers", "/copies"}}});
+  host.add(kSink, {.name = "sink", .remaps = {{"/numbers", "/copies"}}});
+  EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
+  ASSERT_EQ(record.received.size(), 50u);
+  EXPECT_EQ(record.received, record.published);  // relayed by pointer
+}
+
+TEST_F(ComponentHostTest, AnyTopicsAreTypeCheckedWhenUsed) {
+  // A component that uses an any-topic with a type other than the one the topic carries.
+  class WrongType final : public Component {
+   public:
+    static void declare(ComponentSpec& spec) { spec.publishes_any("anything"); }
+    explicit WrongType(Context& context) : Component(context) {
+      context.advertise_any("/numbers", message_type<mocap_msgs::msg::Fiducial>(), Qos::reliable());
+    }
+  };
+  ComponentHost host(in_process());
+  host.add(kSink, {.name = "sink"});
+  try {
+    host.add(make_component_factory<WrongType>("wrong_type"), {.name = "wrong"});
+    ADD_FAILURE() << "no error";
+  } catch (const ComponentError& e) {
+    EXPECT_NE(std::string(e.what()).find("topic '/numbers' carries mocap_msgs/msg/FiducialArray"),
+              std::string::npos)
+        << e.what();
+  }
+  // Without an any-topic declaration, the any-topic calls are refused.
+  class Undeclared final : public Component {
+   public:
+    static void declare(ComponentSpec&) {}
+    explicit Undeclared(Context& context) : Component(context) {
+      context.subscribe_any("/numbers", message_type<Array>(), Qos::reliable(),
+                            [](const std::shared_ptr<const void>&) {});
+    }
+  };
+  EXPECT_THROW(host.add(make_component_factory<Undeclared>("undeclared"), {.name = "undeclared"}),
+               ComponentError);
 }
 
 TEST(TopicFamilies, NamesMatchSegmentBySegment) {

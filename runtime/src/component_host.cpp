@@ -98,8 +98,14 @@ std::vector<std::string> check_component_config(const ComponentSpec& spec,
   }
   std::vector<std::string> topic_names;
   for (const TopicSpec& t : spec.topics()) topic_names.push_back(t.topic);
+  // A component that declares any topic may have any topic name remapped or given a QoS.
+  auto declared = [&](const std::string& topic) {
+    return spec.find_topic(topic) != nullptr ||
+           (valid_topic_name(topic) && (spec.find_any_topic(TopicDirection::Publish) != nullptr ||
+                                        spec.find_any_topic(TopicDirection::Subscribe) != nullptr));
+  };
   for (const auto& [from, to] : config.remaps) {
-    if (spec.find_topic(from) == nullptr) {
+    if (!declared(from)) {
       problems.push_back(fmt::format("remap of unknown topic '{}'{}", from,
                                      did_you_mean(from, topic_names, "topics")));
     }
@@ -116,7 +122,7 @@ std::vector<std::string> check_component_config(const ComponentSpec& spec,
     }
   }
   for (const auto& [topic, qos] : config.qos) {
-    if (spec.find_topic(topic) == nullptr) {
+    if (!declared(topic)) {
       problems.push_back(fmt::format("QoS for unknown topic '{}'{}", topic,
                                      did_you_mean(topic, topic_names, "topics")));
     }
@@ -159,6 +165,8 @@ struct ComponentHost::Impl {
   std::atomic<bool> shutdown_requested{false};
   std::atomic<int> exit_code{0};
   bool started = false;
+
+  std::vector<KnownTopic> known_topics() const;
 };
 
 class ComponentHost::Impl::ComponentContext final : public Context {
@@ -186,7 +194,51 @@ class ComponentHost::Impl::ComponentContext final : public Context {
 
   std::shared_ptr<PublisherPort> advertise(std::string_view topic,
                                            const MessageType& type) override {
-    Endpoint endpoint = resolve(topic, type, TopicDirection::Publish);
+    return advertise_endpoint(resolve(topic, type, TopicDirection::Publish));
+  }
+
+  std::shared_ptr<PublisherPort> advertise_any(std::string_view topic, const MessageType& type,
+                                               const Qos& qos) override {
+    return advertise_endpoint(resolve_any(topic, type, qos, TopicDirection::Publish));
+  }
+
+  void subscribe(std::string_view topic, const MessageType& type,
+                 MessageCallback callback) override {
+    subscribe_endpoint(resolve(topic, type, TopicDirection::Subscribe), std::move(callback));
+  }
+
+  void subscribe_any(std::string_view topic, const MessageType& type, const Qos& qos,
+                     MessageCallback callback) override {
+    subscribe_endpoint(resolve_any(topic, type, qos, TopicDirection::Subscribe),
+                       std::move(callback));
+  }
+
+  std::vector<KnownTopic> known_topics() const override { return host_.known_topics(); }
+
+  // This component's declared topics as the launch file sets them (remaps, QoS), for
+  // known_topics().
+  void add_declared_topics(std::map<std::string, KnownTopic>& known) const {
+    for (const TopicSpec& declared : spec_.topics()) {
+      if (declared.type == nullptr) continue;
+      KnownTopic& topic = known[remapped(declared.topic)];
+      if (topic.type == nullptr) {
+        topic.topic = remapped(declared.topic);
+        topic.type = declared.type;
+      }
+      if (declared.direction == TopicDirection::Publish) {
+        auto qos = config_.qos.find(declared.topic);
+        topic.publishers.push_back(qos == config_.qos.end() ? declared.qos : qos->second);
+      }
+    }
+  }
+
+ private:
+  std::string remapped(const std::string& topic) const {
+    auto it = config_.remaps.find(topic);
+    return it == config_.remaps.end() ? topic : it->second;
+  }
+
+  std::shared_ptr<PublisherPort> advertise_endpoint(const Endpoint& endpoint) {
     auto publisher = std::make_shared<HostPublisher>(endpoint.topic);
     for (auto& transport : host_.transports) {
       publisher->ports_.push_back(transport->advertise(endpoint));
@@ -195,9 +247,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     return publisher;
   }
 
-  void subscribe(std::string_view topic, const MessageType& type,
-                 MessageCallback callback) override {
-    Endpoint endpoint = resolve(topic, type, TopicDirection::Subscribe);
+  void subscribe_endpoint(const Endpoint& endpoint, MessageCallback callback) {
     auto subscription = std::make_shared<HostSubscription>("subscription to " + endpoint.topic,
                                                            std::move(callback));
     for (auto& transport : host_.transports) {
@@ -210,6 +260,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     strand_.add(subscription);
   }
 
+ public:
   void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) override {
     if (period <= std::chrono::nanoseconds::zero()) {
       throw std::invalid_argument(
@@ -260,6 +311,28 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     return endpoint;
   }
 
+  // A topic under an any-topic declaration: the caller's type and QoS, the launch file's
+  // remap and QoS override of that very name.
+  Endpoint resolve_any(std::string_view topic, const MessageType& type, const Qos& qos,
+                       TopicDirection direction) {
+    std::string_view verb = direction == TopicDirection::Publish ? "publishes" : "subscribes";
+    if (spec_.find_any_topic(direction) == nullptr) {
+      throw std::logic_error(
+          fmt::format("component '{}' {} to '{}' as any topic, but its "
+                      "declare() does not declare {}_any",
+                      config_.name, verb, topic, verb));
+    }
+    if (!valid_topic_name(topic)) {
+      throw std::invalid_argument(
+          fmt::format("component '{}' {} to '{}', which is not a topic name (like /a/b_c)",
+                      config_.name, verb, topic));
+    }
+    const std::string name(topic);
+    Endpoint endpoint{remapped(name), &type, qos, config_.name};
+    if (auto it = config_.qos.find(name); it != config_.qos.end()) endpoint.qos = it->second;
+    return endpoint;
+  }
+
   Impl& host_;
   ComponentSpec spec_;
   ComponentConfig config_;
@@ -272,6 +345,27 @@ class ComponentHost::Impl::ComponentContext final : public Context {
 };
 
 // ---------------------------------------------------------------------------------------
+
+std::vector<KnownTopic> ComponentHost::Impl::known_topics() const {
+  std::map<std::string, KnownTopic> known;
+  for (const KnownTopic& topic : options.known_topics) {
+    KnownTopic& merged = known[topic.topic];
+    if (merged.type == nullptr) {
+      merged.topic = topic.topic;
+      merged.type = topic.type;
+    }
+    merged.publishers.insert(merged.publishers.end(), topic.publishers.begin(),
+                             topic.publishers.end());
+  }
+  // The launch file's list already holds this process's components; only a host built by
+  // hand (tests, benchmarks) needs theirs added.
+  if (options.known_topics.empty()) {
+    for (const auto& context : contexts) context->add_declared_topics(known);
+  }
+  std::vector<KnownTopic> topics;
+  for (auto& [name, topic] : known) topics.push_back(std::move(topic));
+  return topics;
+}
 
 ComponentHost::ComponentHost(HostOptions options)
     : impl_(std::make_unique<Impl>(std::move(options))) {}

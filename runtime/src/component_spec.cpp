@@ -61,7 +61,21 @@ ComponentSpec::ParameterDeclaration ComponentSpec::add_parameter(std::string nam
   return ParameterDeclaration(*this, parameters_.size() - 1);
 }
 
+const TopicSpec* ComponentSpec::find_any_topic(TopicDirection direction) const {
+  for (const TopicSpec& t : topics_) {
+    if (t.topic == kAnyTopic && t.direction == direction) return &t;
+  }
+  return nullptr;
+}
+
 void ComponentSpec::add_topic(TopicSpec topic) {
+  if (topic.topic == kAnyTopic) {
+    if (find_any_topic(topic.direction) != nullptr) {
+      throw std::logic_error("any-topic declarations: one per direction");
+    }
+    topics_.push_back(std::move(topic));
+    return;
+  }
   if (find_topic(topic.topic) != nullptr) {
     throw std::logic_error(fmt::format("topic '{}' is declared twice", topic.topic));
   }

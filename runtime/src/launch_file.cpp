@@ -167,6 +167,7 @@ void check_topics(const std::vector<const LaunchComponent*>& components, Problem
   for (const LaunchComponent* component : components) {
     const ComponentConfig& config = component->config;
     for (const TopicSpec& topic : component->plugin->spec.topics()) {
+      if (topic.type == nullptr) continue;  // any topic: checked when used
       auto remap = config.remaps.find(topic.topic);
       auto qos = config.qos.find(topic.topic);
       uses[remap == config.remaps.end() ? topic.topic : remap->second].push_back(
@@ -502,6 +503,33 @@ LaunchFile load_launch_file(const std::filesystem::path& path, PluginLoader& plu
     throw LaunchError({fmt::format("{}:{}:{}: YAML error: {}", path.string(), e.mark.line + 1,
                                    e.mark.column + 1, e.msg)});
   }
+}
+
+std::vector<KnownTopic> known_topics(const LaunchFile& file) {
+  std::map<std::string, KnownTopic> known;
+  for (const LaunchGroup& group : file.groups) {
+    for (const LaunchComponent& component : group.components) {
+      if (component.plugin == nullptr) continue;
+      const ComponentConfig& config = component.config;
+      for (const TopicSpec& declared : component.plugin->spec.topics()) {
+        if (declared.type == nullptr) continue;
+        auto remap = config.remaps.find(declared.topic);
+        const std::string& name = remap == config.remaps.end() ? declared.topic : remap->second;
+        KnownTopic& topic = known[name];
+        if (topic.type == nullptr) {
+          topic.topic = name;
+          topic.type = declared.type;
+        }
+        if (declared.direction == TopicDirection::Publish) {
+          auto qos = config.qos.find(declared.topic);
+          topic.publishers.push_back(qos == config.qos.end() ? declared.qos : qos->second);
+        }
+      }
+    }
+  }
+  std::vector<KnownTopic> topics;
+  for (auto& [name, topic] : known) topics.push_back(std::move(topic));
+  return topics;
 }
 
 }  // namespace mocap

@@ -67,4 +67,8 @@ ParameterOverride parse_parameter_override(std::string_view text);
 LaunchFile load_launch_file(const std::filesystem::path& path, PluginLoader& plugins,
                             const std::vector<ParameterOverride>& overrides = {});
 
+// Every topic the file's components declare with a type, in every group, as remapped, with
+// the QoS of each publisher: what Context::known_topics() reports to each group's process.
+std::vector<KnownTopic> known_topics(const LaunchFile& file);
+
 }  // namespace mocap

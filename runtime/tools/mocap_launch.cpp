@@ -57,7 +57,8 @@ std::string describe(const mocap::LoadedPlugin& plugin) {
   for (const mocap::TopicSpec& t : spec.topics()) {
     out += fmt::format("  {} {} [{}] {}\n      {}\n",
                        t.direction == mocap::TopicDirection::Publish ? "publishes " : "subscribes",
-                       t.topic, t.type->name(), t.qos.to_string(), t.description);
+                       t.topic, t.type ? t.type->name() : "any type",
+                       t.type ? t.qos.to_string() : "QoS chosen at run time", t.description);
   }
   return out;
 }
@@ -65,7 +66,7 @@ std::string describe(const mocap::LoadedPlugin& plugin) {
 int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
               std::optional<double> duration) {
   try {
-    mocap::ComponentHost host({group.name, group.threads, file.dds});
+    mocap::ComponentHost host({group.name, group.threads, file.dds, mocap::known_topics(file)});
     for (const mocap::LaunchComponent& component : group.components) {
       try {
         host.add(*component.plugin->factory, component.config);

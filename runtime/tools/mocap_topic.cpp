@@ -13,11 +13,11 @@
 
 #include <mocap/generated_message_types.hpp>
 
+#include <mocap/raw_message_type.hpp>
 #include "cdr_format.hpp"
 #include "fastdds_transport.hpp"
 #include "idl_schema.hpp"
 #include "rate_estimator.hpp"
-#include "raw_message_type.hpp"
 #include "shutdown_signal.hpp"
 
 namespace {

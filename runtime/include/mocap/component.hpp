@@ -26,6 +26,7 @@
 #include <string_view>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include <mocap/component_spec.hpp>
 #include <mocap/logger.hpp>
@@ -70,6 +71,14 @@ class Publisher {
 
 using MessageCallback = std::function<void(const std::shared_ptr<const void>&)>;
 
+// A topic of the deployment whose type is declared: for components that pick topics at run
+// time (a recorder, a player).
+struct KnownTopic {
+  std::string topic;  // as used, after remaps; a family keeps its placeholders: /a/{name}/b
+  const MessageType* type = nullptr;
+  std::vector<Qos> publishers;  // the QoS each declared publisher offers
+};
+
 // What the runtime gives a component. Topic names passed here are the declared ones; the
 // context applies the launch file's remaps and QoS overrides.
 class Context {
@@ -83,6 +92,14 @@ class Context {
                                                    const MessageType& type) = 0;
   virtual void subscribe(std::string_view topic, const MessageType& type,
                          MessageCallback callback) = 0;
+  // For components declared with publishes_any / subscribes_any: a topic, type and QoS
+  // chosen at run time (the launch file's remap and QoS override of that topic still apply).
+  virtual std::shared_ptr<PublisherPort> advertise_any(std::string_view topic,
+                                                       const MessageType& type, const Qos& qos) = 0;
+  virtual void subscribe_any(std::string_view topic, const MessageType& type, const Qos& qos,
+                             MessageCallback callback) = 0;
+  // The topics the launch file's components declare, in every group, with their types.
+  virtual std::vector<KnownTopic> known_topics() const = 0;
   virtual void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) = 0;
   // Ends the process's run once the current callbacks return; the process exits with
   // `exit_code` (the largest requested, if several components ask).
@@ -143,7 +160,7 @@ class Component {
 // What a plugin library exports, through MOCAP_REGISTER_COMPONENT.
 struct ComponentFactory {
   // Raised whenever Component, Context or this struct change layout.
-  static constexpr uint32_t kAbiVersion = 1;
+  static constexpr uint32_t kAbiVersion = 2;
   static constexpr const char* kSymbol = "mocap_component_factory";
 
   uint32_t abi_version;

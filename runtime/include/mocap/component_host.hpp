@@ -36,6 +36,9 @@ struct HostOptions {
   std::string name = "mocap";  // process name; also the DDS participant name
   int threads = 0;             // executor threads; 0: one per CPU core
   DdsOptions dds;
+  // The topics of the whole deployment (every group of the launch file), for
+  // Context::known_topics(). Empty: those of the components added to this host.
+  std::vector<KnownTopic> known_topics = {};
 };
 
 struct ComponentConfig {

@@ -13,9 +13,12 @@ namespace mocap {
 
 enum class TopicDirection { Publish, Subscribe };
 
+// The topic of a declaration that covers every topic (publishes_any / subscribes_any).
+inline constexpr std::string_view kAnyTopic = "*";
+
 struct TopicSpec {
-  std::string topic;  // default name; launch files may remap it
-  const MessageType* type = nullptr;
+  std::string topic;                  // default name; launch files may remap it; or kAnyTopic
+  const MessageType* type = nullptr;  // null for kAnyTopic: any type
   TopicDirection direction = TopicDirection::Publish;
   Qos qos;  // default; launch files may override it
   std::string description;
@@ -72,6 +75,21 @@ class ComponentSpec {
     add_topic({std::move(topic), &message_type<Message>(), TopicDirection::Subscribe, qos,
                std::move(description)});
   }
+
+  // Topics chosen at run time, of any type (a recorder, a player). The component then uses
+  // Context::advertise_any / subscribe_any with the type and QoS it picks. A launch file may
+  // remap or set the QoS of any topic name for it; the one-type-per-topic rule is checked when
+  // the topic is used, not when the launch file is read.
+  void publishes_any(std::string description) {
+    add_topic(
+        {std::string(kAnyTopic), nullptr, TopicDirection::Publish, Qos{}, std::move(description)});
+  }
+  void subscribes_any(std::string description) {
+    add_topic({std::string(kAnyTopic), nullptr, TopicDirection::Subscribe, Qos{},
+               std::move(description)});
+  }
+  // The any-topic declaration in `direction`, or null.
+  const TopicSpec* find_any_topic(TopicDirection direction) const;
 
   const std::string& description() const { return description_; }
   const std::vector<ParameterSpec>& parameters() const { return parameters_; }
