@@ -13,6 +13,8 @@ packages=(
   libyaml-cpp-dev libfmt-dev
   # calibration: configuration and data files (JSON)
   nlohmann-json3-dev
+  # bags: rosbag2's sqlite3 storage (the sqlite3 shell to look inside)
+  libsqlite3-dev sqlite3
   # vision: images, geometry, least squares (camera calibration)
   libopencv-dev libeigen3-dev libceres-dev
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check

@@ -1,0 +1,180 @@
+#include <mocap/bag/recorder.hpp>
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace mocap::bag {
+
+struct Recorder::State {
+  struct Item {
+    uint32_t topic;
+    int64_t timestamp_ns;
+    std::shared_ptr<const void> message;
+    const MessageType* type;
+    size_t size;
+  };
+
+  explicit State(const std::string& directory, const RecorderOptions& recorder_options)
+      : options(recorder_options), writer(directory, recorder_options.writer) {}
+
+  // Serializes and writes until closed and drained; commits whenever the queue runs dry, so
+  // that a quiet topic's messages do not wait for the next one.
+  void run() {
+    std::vector<uint8_t> buffer;
+    std::unique_lock lock(mutex);
+    for (;;) {
+      arrived.wait_for(lock, options.writer.commit_interval,
+                       [&] { return closing || !queue.empty(); });
+      if (queue.empty()) {
+        if (closing) return;
+        lock.unlock();
+        commit();
+        lock.lock();
+        continue;
+      }
+      Item item = std::move(queue.front());
+      queue.pop_front();
+      queued_bytes -= item.size;
+      lock.unlock();
+      write(item, buffer);
+      lock.lock();
+    }
+  }
+
+  void write(const Item& item, std::vector<uint8_t>& buffer) {
+    if (failed()) {
+      std::lock_guard guard(mutex);
+      ++stats.dropped;
+      return;
+    }
+    std::span<const uint8_t> bytes;
+    if (item.type == nullptr) {
+      const auto& raw = *static_cast<const std::vector<uint8_t>*>(item.message.get());
+      bytes = raw;
+    } else {
+      try {
+        // Zeroed: CDR leaves its alignment padding unwritten, and a reused buffer would put
+        // bytes of earlier messages into the bag.
+        buffer.assign(item.type->serialized_size(item.message.get()), 0);
+        bytes = std::span(buffer.data(), item.type->serialize(item.message.get(), buffer));
+      } catch (const std::exception&) {
+        std::lock_guard guard(mutex);
+        ++stats.dropped;
+        return;
+      }
+    }
+    try {
+      {
+        std::lock_guard writing(writer_mutex);
+        writer.write(item.topic, item.timestamp_ns, bytes);
+      }
+      std::lock_guard guard(mutex);
+      ++stats.written;
+      stats.bytes += bytes.size();
+    } catch (const BagError& e) {
+      std::lock_guard guard(mutex);
+      if (!first_error) first_error = e.what();
+      ++stats.dropped;
+    }
+  }
+
+  void commit() {
+    if (failed()) return;
+    try {
+      std::lock_guard writing(writer_mutex);
+      writer.commit();
+    } catch (const BagError& e) {
+      std::lock_guard guard(mutex);
+      if (!first_error) first_error = e.what();
+    }
+  }
+
+  bool failed() {
+    std::lock_guard guard(mutex);
+    return first_error.has_value();
+  }
+
+  RecorderOptions options;
+  std::mutex writer_mutex;  // BagWriter is not thread-safe: the writer thread and add_topic
+  BagWriter writer;
+  mutable std::mutex mutex;  // the queue, the counts, the error
+  std::condition_variable arrived;
+  std::deque<Item> queue;
+  size_t queued_bytes = 0;
+  bool closing = false, closed = false;
+  RecorderStats stats;
+  std::optional<std::string> first_error;
+  std::thread thread;
+};
+
+Recorder::Recorder(const std::string& directory, RecorderOptions options)
+    : state_(std::make_unique<State>(directory, options)) {
+  state_->thread = std::thread([state = state_.get()] { state->run(); });
+}
+
+Recorder::~Recorder() {
+  if (auto error = close()) fmt::print(stderr, "recorder: {}\n", *error);
+}
+
+uint32_t Recorder::add_topic(const BagTopic& topic) {
+  std::lock_guard writing(state_->writer_mutex);
+  return state_->writer.add_topic(topic);
+}
+
+void Recorder::record(uint32_t topic_id, int64_t timestamp_ns, std::shared_ptr<const void> message,
+                      const MessageType* type) {
+  const size_t size = type == nullptr
+                          ? static_cast<const std::vector<uint8_t>*>(message.get())->size()
+                          : type->serialized_size(message.get());
+  {
+    std::lock_guard guard(state_->mutex);
+    if (state_->closing || state_->first_error ||
+        state_->queued_bytes + size > state_->options.max_queued_bytes) {
+      ++state_->stats.dropped;
+      return;
+    }
+    state_->queued_bytes += size;
+    state_->queue.push_back({topic_id, timestamp_ns, std::move(message), type, size});
+  }
+  state_->arrived.notify_one();
+}
+
+std::optional<std::string> Recorder::close() {
+  {
+    std::lock_guard guard(state_->mutex);
+    if (state_->closed) return state_->first_error;
+    state_->closing = true;
+  }
+  state_->arrived.notify_one();
+  if (state_->thread.joinable()) state_->thread.join();
+  try {
+    state_->writer.close();
+  } catch (const BagError& e) {
+    if (!state_->first_error) state_->first_error = e.what();
+  }
+  std::lock_guard guard(state_->mutex);
+  state_->closed = true;
+  return state_->first_error;
+}
+
+std::optional<std::string> Recorder::error() const {
+  std::lock_guard guard(state_->mutex);
+  return state_->first_error;
+}
+
+RecorderStats Recorder::stats() const {
+  std::lock_guard guard(state_->mutex);
+  RecorderStats stats = state_->stats;
+  stats.queued_bytes = state_->queued_bytes;
+  return stats;
+}
+
+const std::string& Recorder::directory() const { return state_->writer.directory(); }
+
+}  // namespace mocap::bag

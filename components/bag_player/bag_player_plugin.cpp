@@ -1,0 +1,136 @@
+// bag_player: plays a bag into a deployment, in place of the sensors that made it (a camera,
+// the PixArt bridge). Each topic is published with its recorded type, deserialized, so that
+// components of this process receive it by pointer, and with the QoS its recorded publishers
+// offered (a launch file's qos: overrides it). Pacing: mocap/bag/playback.hpp.
+#include <algorithm>
+#include <atomic>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <mocap/bag/bag_reader.hpp>
+#include <mocap/bag/playback.hpp>
+#include <mocap/component.hpp>
+#include <mocap/raw_message_type.hpp>
+
+namespace mocap::bag {
+namespace {
+
+class BagPlayer final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Plays a bag (rosbag2 sqlite3) into the deployment at its recorded pace times `rate` "
+        "(0: as fast as subscribers take them, in order; reliable subscribers are never "
+        "overrun). Message stamps are the recorded ones.");
+    spec.parameter("bag", std::string(), "the bag directory or .db3 file").path();
+    spec.parameter("rate", 1.0, "pace relative to the recording; 0: as fast as possible").min(0);
+    spec.parameter("loop", false, "start again after the last message");
+    spec.parameter("topics", std::vector<std::string>{}, "topics to play (empty: all)");
+    spec.parameter("start_delay_s", 0.5,
+                   "seconds to wait before the first message, for subscribers in other "
+                   "processes to be discovered")
+        .range(0, 3600);
+    spec.parameter("exit_after_s", -1.0,
+                   "offline runs: end the process (exit status 0) this many seconds after the "
+                   "last message, the time the graph needs to finish with it; negative: run on")
+        .range(-1, 3600);
+    spec.publishes_any("the bag's topics, with their recorded types");
+  }
+
+  explicit BagPlayer(Context& context) : Component(context) {
+    const std::string path = param<std::string>("bag");
+    if (path.empty()) throw std::invalid_argument("bag: give the bag directory or .db3 file");
+    reader_ = std::make_unique<BagReader>(path);
+    for (const std::string& problem : reader_->problems()) log().warn("{}", problem);
+    options_.rate = param<double>("rate");
+    options_.loop = param<bool>("loop");
+    options_.topics = param<std::vector<std::string>>("topics");
+
+    for (const BagTopic& topic : reader_->metadata().topics) {
+      if (!options_.topics.empty() && std::find(options_.topics.begin(), options_.topics.end(),
+                                                topic.name) == options_.topics.end()) {
+        continue;
+      }
+      const MessageType* type = find_message_type(topic.type);
+      if (type == nullptr) {
+        // Not built into this process: passed on as bytes, which only other processes read.
+        raw_types_.push_back(std::make_unique<RawMessageType>(dds_type_name(topic.type)));
+        type = raw_types_.back().get();
+        log().info("{}: type {} is not built in; played to other processes only", topic.name,
+                   topic.type);
+      }
+      // Keep all: at rate 0 a reliable subscriber holds the player back rather than miss
+      // messages.
+      Qos qos = playback_qos(topic.offered_qos);
+      qos.history = History::KeepAll;
+      qos.depth = 1000;
+      topics_[topic.name] = {type, context.advertise_any(topic.name, *type, qos)};
+    }
+    // Timers tick only once the process runs, when every component of it subscribes: the
+    // first tick starts the playback thread.
+    const double delay = std::max(param<double>("start_delay_s"), 1e-3);
+    const double exit_after = param<double>("exit_after_s");
+    create_timer(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(delay)),
+        [this, exit_after] {
+          if (!thread_.joinable()) thread_ = std::thread([this, exit_after] { run(exit_after); });
+        });
+  }
+
+  ~BagPlayer() override {
+    stop_.store(true);
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  struct Topic {
+    const MessageType* type = nullptr;
+    std::shared_ptr<PublisherPort> publisher;
+  };
+
+  void run(double exit_after) {
+    uint64_t dropped = 0;
+    const PlaybackStats stats = play(
+        *reader_, options_,
+        [&](const BagMessage& message) {
+          auto topic = topics_.find(message.topic->name);
+          if (topic == topics_.end()) return;
+          const MessageType& type = *topic->second.type;
+          std::shared_ptr<void> typed = type.create();
+          try {
+            type.deserialize(message.data, typed.get());
+          } catch (const SerializationError& e) {
+            if (dropped++ == 0)
+              log().warn("{}: a message does not deserialize: {}", message.topic->name, e.what());
+            return;
+          }
+          topic->second.publisher->publish(std::move(typed));
+        },
+        stop_);
+    log().info("played {} message(s){}", stats.published,
+               dropped ? fmt::format(", {} dropped (not deserializable)", dropped) : "");
+    if (exit_after < 0 || options_.loop) return;
+    const auto end = std::chrono::steady_clock::now() +
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(exit_after));
+    while (!stop_.load() && std::chrono::steady_clock::now() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (!stop_.load()) request_shutdown(0);
+  }
+
+  std::unique_ptr<BagReader> reader_;
+  PlaybackOptions options_;
+  std::vector<std::unique_ptr<RawMessageType>> raw_types_;
+  std::map<std::string, Topic> topics_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace
+}  // namespace mocap::bag
+
+MOCAP_REGISTER_COMPONENT(mocap::bag::BagPlayer, "bag_player")

@@ -1,0 +1,125 @@
+// bag_recorder: records topics of the deployment into a rosbag2 sqlite3 bag from inside a
+// launch file. Messages of this process arrive by pointer and are serialized only by the
+// writer thread; the others arrive over DDS. Storage and crash safety: mocap/bag/recorder.hpp.
+#include <chrono>
+#include <ctime>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <mocap/bag/recorder.hpp>
+#include <mocap/component.hpp>
+
+namespace mocap::bag {
+namespace {
+
+std::string default_directory() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char name[64];
+  std::strftime(name, sizeof name, "bag_%Y_%m_%d-%H_%M_%S", &local);
+  return name;
+}
+
+int64_t stamp_ns(Clock::time_point time) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count();
+}
+
+class BagRecorder final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Records topics of the deployment into a bag (rosbag2 sqlite3 layout), each message "
+        "stamped with its receive time. Topics are those the launch file's components declare; "
+        "messages of this process are serialized only when written.");
+    spec.parameter("output", std::string(),
+                   "the bag directory to create (empty: bag_YYYY_MM_DD-HH_MM_SS)")
+        .path();
+    spec.parameter(
+        "topics", std::vector<std::string>{},
+        "topics to record (empty: every topic a component of the launch file publishes)");
+    spec.parameter("commit_interval_ms", int64_t{100},
+                   "the most a kill can lose: messages are committed at least this often")
+        .range(1, 60000);
+    spec.subscribes_any("the recorded topics, with their declared types");
+  }
+
+  explicit BagRecorder(Context& context) : Component(context) {
+    std::string output = param<std::string>("output");
+    if (output.empty()) output = default_directory();
+    const std::vector<std::string> wanted = param<std::vector<std::string>>("topics");
+    const std::vector<KnownTopic> known = context.known_topics();
+
+    std::vector<const KnownTopic*> recorded;
+    for (const std::string& name : wanted) {
+      const KnownTopic* found = nullptr;
+      for (const KnownTopic& topic : known) {
+        if (topic.topic == name) found = &topic;
+      }
+      if (found == nullptr) {
+        std::vector<std::string> names;
+        for (const KnownTopic& topic : known) names.push_back(topic.topic);
+        throw std::invalid_argument(fmt::format(
+            "topics: '{}' is not a topic any component of the launch file declares (known: {})",
+            name, fmt::join(names, ", ")));
+      }
+      recorded.push_back(found);
+    }
+    if (wanted.empty()) {
+      for (const KnownTopic& topic : known) {
+        if (!topic.publishers.empty() && topic.topic.find('{') == std::string::npos) {
+          recorded.push_back(&topic);
+        }
+      }
+    }
+
+    RecorderOptions options;
+    options.writer.commit_interval =
+        std::chrono::milliseconds(param<int64_t>("commit_interval_ms"));
+    recorder_ = std::make_unique<Recorder>(output, options);
+    for (const KnownTopic* topic : recorded) {
+      const MessageType* type = topic->type;
+      const uint32_t id =
+          recorder_->add_topic({topic->topic, type->name(), "cdr", topic->publishers, 0});
+      // Reliable or transient local only where every publisher offers it, so that all match.
+      Qos qos = playback_qos(topic->publishers);
+      qos.history = History::KeepAll;
+      qos.depth = 1000;
+      context.subscribe_any(topic->topic, *type, qos,
+                            [this, id, type](const std::shared_ptr<const void>& message) {
+                              recorder_->record(id, stamp_ns(now()), message, type);
+                              report_error();
+                            });
+    }
+    log().info("recording {} topic(s) to {}", recorded.size(), recorder_->directory());
+  }
+
+  ~BagRecorder() override {
+    const auto error = recorder_->close();
+    const RecorderStats stats = recorder_->stats();
+    log().info("recorded {} message(s), {:.1f} MB, to {}{}", stats.written,
+               static_cast<double>(stats.bytes) / 1e6, recorder_->directory(),
+               stats.dropped ? fmt::format("; {} dropped", stats.dropped) : "");
+    if (error && !reported_) log().error("{}", *error);
+  }
+
+ private:
+  // A full disk ends the recording, not the deployment: said once, then counted as drops.
+  void report_error() {
+    if (reported_) return;
+    if (auto error = recorder_->error()) {
+      reported_ = true;
+      log().error("recording stopped: {}", *error);
+    }
+  }
+
+  std::unique_ptr<Recorder> recorder_;
+  bool reported_ = false;
+};
+
+}  // namespace
+}  // namespace mocap::bag
+
+MOCAP_REGISTER_COMPONENT(mocap::bag::BagRecorder, "bag_recorder")

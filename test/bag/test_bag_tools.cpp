@@ -1,0 +1,259 @@
+// Bags as a user makes and uses them: mocap_bag recording topics of another process over
+// DDS, describing and playing the bag back; the bag_recorder and bag_player components in
+// launch files, with the tracking pipeline run live and then offline from its recording.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <functional>
+#include <mutex>
+#include <numeric>
+#include <thread>
+
+#include <fmt/format.h>
+#include <geometry_msgs/msg/twist.hpp>
+#include <mocap/bag/bag_reader.hpp>
+#include <mocap/bag/bag_writer.hpp>
+#include <mocap/bag/playback.hpp>
+#include <mocap/component_host.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "test_support.hpp"
+
+namespace mocap::bag {
+namespace {
+
+using mocap_msgs::msg::FiducialArray;
+
+constexpr int kMessages = 100;
+constexpr int kDomainSlot = 40;
+
+std::string bag_tool() { return (test::bin_dir() / "mocap_bag").string(); }
+
+std::map<std::string, std::string> domain_environment() {
+  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(kDomainSlot))}};
+}
+
+// Publishes kMessages numbered FiducialArrays on /numbers (reliable) and as many Twists on
+// /velocity (sensor_data), 10 ms apart, once something subscribes to both.
+class NumberedSource final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.publishes<FiducialArray>("/numbers", Qos::reliable(), "numbered arrays");
+    spec.publishes<geometry_msgs::msg::Twist>("/velocity", Qos::sensor_data(), "numbered twists");
+  }
+  explicit NumberedSource(Context& context) : Component(context) {
+    numbers_ = create_publisher<FiducialArray>("/numbers");
+    velocity_ = create_publisher<geometry_msgs::msg::Twist>("/velocity");
+    create_timer(std::chrono::milliseconds(10), [this] {
+      if (sent_ == kMessages || numbers_.matched_subscribers() == 0 ||
+          velocity_.matched_subscribers() == 0) {
+        return;
+      }
+      FiducialArray array;
+      array.header().stamp().sec(sent_);
+      array.header().frame_id(fmt::format("message {}", sent_));
+      array.fiducials().resize(static_cast<size_t>(sent_ % 7));
+      numbers_.publish(std::move(array));
+      geometry_msgs::msg::Twist twist;
+      twist.linear().x(sent_);
+      velocity_.publish(std::move(twist));
+      if (++sent_ == kMessages) log().info("published all");
+    });
+  }
+
+ private:
+  Publisher<FiducialArray> numbers_;
+  Publisher<geometry_msgs::msg::Twist> velocity_;
+  int sent_ = 0;
+};
+
+// What a subscriber on /numbers received, in order.
+struct Received {
+  std::mutex mutex;
+  std::vector<int> sequence;
+};
+Received received;
+
+class NumbersSink final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.subscribes<FiducialArray>("/numbers", Qos::reliable(), "numbered arrays");
+  }
+  explicit NumbersSink(Context& context) : Component(context) {
+    create_subscription<FiducialArray>("/numbers", [](const FiducialArray& array) {
+      std::lock_guard lock(received.mutex);
+      received.sequence.push_back(array.header().stamp().sec());
+    });
+  }
+};
+
+HostOptions dds_host(const std::string& name) {
+  return {.name = name, .threads = 2, .dds = {.enabled = true}};
+}
+
+// The count of `topic`'s messages committed to the bag so far (0 while it cannot be read).
+uint64_t committed(const std::filesystem::path& bag, const std::string& topic) {
+  try {
+    BagReader reader(bag.string());
+    for (const BagTopic& t : reader.metadata().topics) {
+      if (t.name == topic) return t.message_count;
+    }
+  } catch (const BagError&) {
+  }
+  return 0;
+}
+
+bool wait_for(const std::function<bool()>& done, std::chrono::seconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return true;
+}
+
+TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
+  for (const auto& [key, value] : domain_environment()) setenv(key.c_str(), value.c_str(), 1);
+  test::TempDir dir;
+  const std::filesystem::path bag = dir / "numbers";
+
+  // Record both topics, published by this process, until every reliable one is in the bag
+  // (a reader may look while the recorder writes); then Ctrl-C.
+  {
+    test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "/numbers", "/velocity"},
+                                domain_environment(), dir / "record.log");
+    ComponentHost host(dds_host("bag_source"));
+    host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
+    host.start();
+    ASSERT_TRUE(recorder.wait_for_output("subscribed to /velocity", std::chrono::seconds(30)))
+        << recorder.output();
+    ASSERT_TRUE(
+        wait_for([&] { return committed(bag, "/numbers") == kMessages; }, std::chrono::seconds(60)))
+        << recorder.output();
+    recorder.signal(SIGINT);
+    ASSERT_EQ(recorder.wait(std::chrono::seconds(30)), 0) << recorder.output();
+    EXPECT_NE(recorder.output().find("recorded "), std::string::npos) << recorder.output();
+    host.stop();
+  }
+
+  // The bag holds them in order, with their types and QoS, byte for byte what was published.
+  BagReader reader(bag.string());
+  EXPECT_TRUE(reader.problems().empty());
+  const BagMetadata& metadata = reader.metadata();
+  ASSERT_EQ(metadata.topics.size(), 2u);
+  std::map<std::string, const BagTopic*> topics;
+  for (const BagTopic& topic : metadata.topics) topics[topic.name] = &topic;
+  ASSERT_EQ(topics.count("/numbers"), 1u);
+  EXPECT_EQ(topics["/numbers"]->type, "mocap_msgs/msg/FiducialArray");
+  EXPECT_EQ(topics["/velocity"]->type, "geometry_msgs/msg/Twist");
+  ASSERT_EQ(topics["/numbers"]->offered_qos.size(), 1u);
+  EXPECT_EQ(topics["/numbers"]->offered_qos[0].reliability, Reliability::Reliable);
+  ASSERT_EQ(topics["/velocity"]->offered_qos.size(), 1u);
+  EXPECT_EQ(topics["/velocity"]->offered_qos[0].reliability, Reliability::BestEffort);
+  EXPECT_GT(topics["/velocity"]->message_count, 0u);  // best effort: most, maybe not all
+
+  const MessageType& type = message_type<FiducialArray>();
+  std::vector<int> numbers;
+  int64_t previous_stamp = 0;
+  BagMessage message;
+  reader.set_topic_filter({"/numbers"});
+  while (reader.next(message)) {
+    FiducialArray array;
+    type.deserialize(message.data, &array);
+    numbers.push_back(array.header().stamp().sec());
+    EXPECT_EQ(array.header().frame_id(), fmt::format("message {}", numbers.back()));
+    EXPECT_EQ(array.fiducials().size(), static_cast<size_t>(numbers.back() % 7));
+    EXPECT_GE(message.timestamp_ns, previous_stamp);
+    previous_stamp = message.timestamp_ns;
+  }
+  std::vector<int> expected(kMessages);
+  std::iota(expected.begin(), expected.end(), 0);
+  EXPECT_EQ(numbers, expected);
+
+  // info: what ros2 bag info shows.
+  auto [info_code, info] = test::run_command({bag_tool(), "info", bag.string()});
+  EXPECT_EQ(info_code, 0) << info;
+  EXPECT_NE(info.find(fmt::format("Topic: /numbers | Type: mocap_msgs/msg/FiducialArray | Count: "
+                                  "{} | Serialization Format: cdr",
+                                  kMessages)),
+            std::string::npos)
+      << info;
+  EXPECT_NE(info.find("Storage id:        sqlite3"), std::string::npos) << info;
+
+  // play, at the recorded pace and as fast as possible: a subscriber gets every message, in
+  // order, with its content.
+  for (const char* rate : {"1", "0"}) {
+    {
+      std::lock_guard lock(received.mutex);
+      received.sequence.clear();
+    }
+    ComponentHost host(dds_host("bag_sink"));
+    host.add(make_component_factory<NumbersSink>("numbers_sink"), {.name = "sink"});
+    host.start();
+    auto [code, output] = test::run_command(
+        {bag_tool(), "play", bag.string(), "--rate", rate, "--topics", "/numbers"},
+        domain_environment());
+    EXPECT_EQ(code, 0) << output;
+    EXPECT_NE(output.find(fmt::format("played {} message(s)", kMessages)), std::string::npos)
+        << output;
+    EXPECT_TRUE(wait_for(
+        [&] {
+          std::lock_guard lock(received.mutex);
+          return received.sequence.size() >= static_cast<size_t>(kMessages);
+        },
+        std::chrono::seconds(30)))
+        << "rate " << rate;
+    host.stop();
+    std::lock_guard lock(received.mutex);
+    EXPECT_EQ(received.sequence, expected) << "rate " << rate;
+  }
+}
+
+// The player never publishes a message before its time: each is handed over no earlier than
+// its recorded offset from the first, divided by the rate. (How late it is, the benchmark
+// measures: tests do not depend on timing.)
+TEST(Playback, NoMessageLeavesBeforeItsTime) {
+  test::TempDir dir;
+  {
+    BagWriter writer((dir / "paced").string());
+    const uint32_t id = writer.add_topic({"/tick", "std_msgs/msg/Empty", "cdr", {}, 0});
+    const std::vector<uint8_t> empty = {0, 1, 0, 0};
+    for (int i = 0; i < 20; ++i) writer.write(id, 1'000'000'000 + i * 7'000'000LL, empty);
+    writer.close();
+  }
+  BagReader reader((dir / "paced").string());
+  for (double rate : {1.0, 2.0}) {
+    std::vector<std::chrono::steady_clock::time_point> handed;
+    std::vector<int64_t> stamps;
+    std::atomic<bool> stop{false};
+    const PlaybackStats stats = play(
+        reader, PlaybackOptions{.rate = rate, .loop = false, .topics = {}},
+        [&](const BagMessage& message) {
+          handed.push_back(std::chrono::steady_clock::now());
+          stamps.push_back(message.timestamp_ns);
+        },
+        stop);
+    ASSERT_EQ(stats.published, 20u);
+    for (size_t i = 1; i < handed.size(); ++i) {
+      const double due_s = static_cast<double>(stamps[i] - stamps[0]) * 1e-9 / rate;
+      EXPECT_GE(std::chrono::duration<double>(handed[i] - handed[0]).count(), due_s - 1e-6)
+          << "message " << i << " at rate " << rate;
+    }
+  }
+  std::atomic<bool> stop{true};
+  EXPECT_EQ(play(
+                reader, {}, [](const BagMessage&) {}, stop)
+                .published,
+            0u);
+  EXPECT_THROW(play(
+                   reader, PlaybackOptions{.rate = -1, .loop = false, .topics = {}},
+                   [](const BagMessage&) {}, stop),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mocap::bag
