@@ -119,6 +119,13 @@ Recorder::Recorder(const std::string& directory, RecorderOptions options)
 }
 
 Recorder::~Recorder() {
+  bool closed = false;
+  {
+    std::lock_guard guard(state_->mutex);
+    closed = state_->closed;
+  }
+  // An error close() returned is the caller's to report.
+  if (closed) return;
   if (auto error = close()) fmt::print(stderr, "recorder: {}\n", *error);
 }
 

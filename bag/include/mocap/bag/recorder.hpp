@@ -32,7 +32,7 @@ class Recorder {
  public:
   // Creates the bag (BagWriter's rules) and starts the writer thread. Throws BagError.
   explicit Recorder(const std::string& directory, RecorderOptions options = {});
-  ~Recorder();  // close()
+  ~Recorder();  // close(); an error it meets then goes to stderr
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
