@@ -213,6 +213,73 @@ TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
   }
 }
 
+// kill -9 in the middle of a recording: the bag opens and holds the messages up to the last
+// commit, in order and without holes.
+TEST(MocapBag, AKilledRecordingLeavesABagThatOpens) {
+  for (const auto& [key, value] : domain_environment()) setenv(key.c_str(), value.c_str(), 1);
+  test::TempDir dir;
+  const std::filesystem::path bag = dir / "killed";
+  test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "/numbers", "/velocity"},
+                              domain_environment(), dir / "record.log");
+  ComponentHost host(dds_host("bag_source"));
+  host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
+  host.start();
+  ASSERT_TRUE(wait_for([&] { return committed(bag, "/numbers") >= kMessages / 2; },
+                       std::chrono::seconds(60)))
+      << recorder.output();
+  recorder.signal(SIGKILL);
+  EXPECT_EQ(recorder.wait(std::chrono::seconds(30)), 128 + SIGKILL);
+  host.stop();
+
+  auto [code, info] = test::run_command({bag_tool(), "info", bag.string()});
+  EXPECT_EQ(code, 0) << info;
+  EXPECT_EQ(info.find("Damage"), std::string::npos) << info;
+  BagReader reader(bag.string());
+  reader.set_topic_filter({"/numbers"});
+  BagMessage message;
+  int expected = 0;
+  while (reader.next(message)) {
+    FiducialArray array;
+    message_type<FiducialArray>().deserialize(message.data, &array);
+    EXPECT_EQ(array.header().stamp().sec(), expected++);
+  }
+  EXPECT_GE(expected, kMessages / 2);
+}
+
+// A bag cut short (a full disk, a copy interrupted): info says what is lost and play plays the
+// rest, both with exit status 0.
+TEST(MocapBag, InfoAndPlayUseWhatIsReadableAndSayWhatIsNot) {
+  test::TempDir dir;
+  const std::filesystem::path bag = dir / "cut";
+  constexpr int kWritten = 600;
+  {
+    BagWriter writer(bag.string());
+    const uint32_t id = writer.add_topic({"/blob", "std_msgs/msg/Empty", "cdr", {}, 0});
+    for (int i = 0; i < kWritten; ++i) {
+      writer.write(id, 1'000'000'000 + i * 1'000'000LL, std::vector<uint8_t>(1000, uint8_t(i)));
+    }
+    writer.close();
+  }
+  const std::filesystem::path file = bag / "cut_0.db3";
+  std::filesystem::resize_file(file, std::filesystem::file_size(file) * 6 / 10);
+
+  auto [info_code, info] = test::run_command({bag_tool(), "info", bag.string()});
+  EXPECT_EQ(info_code, 0) << info;
+  EXPECT_NE(info.find("Damage:"), std::string::npos) << info;
+  EXPECT_NE(info.find("cut_0.db3"), std::string::npos) << info;
+
+  auto [play_code, played] = test::run_command(
+      {bag_tool(), "play", bag.string(), "--rate", "0", "--delay", "0"}, domain_environment());
+  EXPECT_EQ(play_code, 0) << played;
+  EXPECT_NE(played.find("cut_0.db3"), std::string::npos) << played;  // the damage, said
+  BagReader reader(bag.string());
+  EXPECT_NE(played.find(fmt::format("played {} message(s)", reader.metadata().message_count)),
+            std::string::npos)
+      << played;
+  EXPECT_GT(reader.metadata().message_count, 0u);
+  EXPECT_LT(reader.metadata().message_count, static_cast<uint64_t>(kWritten));
+}
+
 // The player never publishes a message before its time: each is handed over no earlier than
 // its recorded offset from the first, divided by the rate. (How late it is, the benchmark
 // measures: tests do not depend on timing.)
