@@ -2,6 +2,8 @@
 // library, which symbol, and which plugins there are.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <cstdlib>
 
 #include "plugin_loader.hpp"
@@ -78,9 +80,11 @@ TEST_F(PluginLoaderTest, LibraryThatCannotLoad) {
 }
 
 TEST_F(PluginLoaderTest, OtherAbi) {
-  EXPECT_EQ(error_of("wrong_abi"), library("wrong_abi") +
-                                       " was built for component ABI 0, this runtime has ABI 1; "
-                                       "rebuild the plugin");
+  EXPECT_EQ(error_of("wrong_abi"),
+            library("wrong_abi") +
+                fmt::format(" was built for component ABI 0, this runtime has ABI {}; rebuild the "
+                            "plugin",
+                            ComponentFactory::kAbiVersion));
 }
 
 TEST_F(PluginLoaderTest, LibraryRegisteringAnotherName) {

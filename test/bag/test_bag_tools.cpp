@@ -29,12 +29,16 @@ namespace {
 using mocap_msgs::msg::FiducialArray;
 
 constexpr int kMessages = 100;
-constexpr int kDomainSlot = 40;
 
 std::string bag_tool() { return (test::bin_dir() / "mocap_bag").string(); }
 
-std::map<std::string, std::string> domain_environment() {
-  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(kDomainSlot))}};
+// Each test its own DDS domain: ctest runs them side by side.
+std::map<std::string, std::string> domain_environment(int slot) {
+  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))}};
+}
+
+void join_domain(int slot) {
+  for (const auto& [key, value] : domain_environment(slot)) setenv(key.c_str(), value.c_str(), 1);
 }
 
 // Publishes kMessages numbered FiducialArrays on /numbers (reliable) and as many Twists on
@@ -117,7 +121,7 @@ bool wait_for(const std::function<bool()>& done, std::chrono::seconds timeout) {
 }
 
 TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
-  for (const auto& [key, value] : domain_environment()) setenv(key.c_str(), value.c_str(), 1);
+  join_domain(40);
   test::TempDir dir;
   const std::filesystem::path bag = dir / "numbers";
 
@@ -125,7 +129,7 @@ TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
   // (a reader may look while the recorder writes); then Ctrl-C.
   {
     test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "/numbers", "/velocity"},
-                                domain_environment(), dir / "record.log");
+                                domain_environment(40), dir / "record.log");
     ComponentHost host(dds_host("bag_source"));
     host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
     host.start();
@@ -196,7 +200,7 @@ TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
     host.start();
     auto [code, output] = test::run_command(
         {bag_tool(), "play", bag.string(), "--rate", rate, "--topics", "/numbers"},
-        domain_environment());
+        domain_environment(40));
     EXPECT_EQ(code, 0) << output;
     EXPECT_NE(output.find(fmt::format("played {} message(s)", kMessages)), std::string::npos)
         << output;
@@ -213,14 +217,14 @@ TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
   }
 }
 
-// kill -9 in the middle of a recording: the bag opens and holds the messages up to the last
-// commit, in order and without holes.
+// kill -9 in the middle of a recording of everything published: the bag opens and holds the
+// messages up to the last commit, in order and without holes.
 TEST(MocapBag, AKilledRecordingLeavesABagThatOpens) {
-  for (const auto& [key, value] : domain_environment()) setenv(key.c_str(), value.c_str(), 1);
+  join_domain(42);
   test::TempDir dir;
   const std::filesystem::path bag = dir / "killed";
-  test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "/numbers", "/velocity"},
-                              domain_environment(), dir / "record.log");
+  test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "--all"},
+                              domain_environment(42), dir / "record.log");
   ComponentHost host(dds_host("bag_source"));
   host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
   host.start();
@@ -269,7 +273,7 @@ TEST(MocapBag, InfoAndPlayUseWhatIsReadableAndSayWhatIsNot) {
   EXPECT_NE(info.find("cut_0.db3"), std::string::npos) << info;
 
   auto [play_code, played] = test::run_command(
-      {bag_tool(), "play", bag.string(), "--rate", "0", "--delay", "0"}, domain_environment());
+      {bag_tool(), "play", bag.string(), "--rate", "0", "--delay", "0"}, domain_environment(43));
   EXPECT_EQ(play_code, 0) << played;
   EXPECT_NE(played.find("cut_0.db3"), std::string::npos) << played;  // the damage, said
   BagReader reader(bag.string());
