@@ -1,9 +1,9 @@
-// Recording throughput of BagWriter against raw SQLite doing the same work, measured in the
-// same run: rosbag2's schema, WAL with synchronous=NORMAL, one prepared INSERT, transactions
-// of 1000 messages. Two loads: 1280x720 mono8 images as sensor_msgs/Image CDR (921 600 bytes
-// of pixels and a ~60-byte header) and small ~100-byte messages. Writes into a temporary
-// directory under /tmp (deleted afterwards), so the numbers are those of the file system of
-// /tmp, which the output names.
+// Recording throughput of BagWriter, and of the Recorder in front of it, against raw SQLite
+// doing the same work, measured in the same run: rosbag2's schema, WAL with synchronous=NORMAL, one
+// prepared INSERT, transactions of 1000 messages. Two loads: 1280x720 mono8 images as
+// sensor_msgs/Image CDR (921 600 bytes of pixels and a ~60-byte header) and small ~100-byte
+// messages. Writes into a temporary directory under /tmp (deleted afterwards), so the numbers are
+// those of the file system of /tmp, which the output names.
 //   build/bin/bag_record_bench [--quick]
 #include <sqlite3.h>
 
@@ -20,6 +20,8 @@
 #include <fmt/format.h>
 
 #include <mocap/bag/bag_writer.hpp>
+#include <mocap/bag/recorder.hpp>
+#include <sensor_msgs/msg/image.hpp>
 
 namespace {
 
@@ -129,6 +131,45 @@ Result bag_writer(const fs::path& directory, const Load& load,
   return result;
 }
 
+// The recorder as mocap_bag record (raw CDR) and the bag_recorder component (typed messages,
+// serialized by its writer thread) use it: a queue in front of a BagWriter on its own thread.
+// `image`: record typed 1280x720 sensor_msgs/Image messages instead of the raw payloads.
+Result recorder(const fs::path& directory, const Load& load,
+                const std::vector<std::vector<uint8_t>>& payloads, bool image) {
+  std::vector<std::shared_ptr<const void>> messages;
+  for (const auto& payload : payloads) {
+    if (image) {
+      auto typed = std::make_shared<sensor_msgs::msg::Image>();
+      typed->height(720);
+      typed->width(1280);
+      typed->encoding("mono8");
+      typed->step(1280);
+      typed->data(std::vector<uint8_t>(payload.begin(), payload.begin() + 1280 * 720));
+      messages.push_back(std::move(typed));
+    } else {
+      messages.push_back(std::make_shared<const std::vector<uint8_t>>(payload));
+    }
+  }
+  const mocap::MessageType* type =
+      image ? &mocap::message_type<sensor_msgs::msg::Image>() : nullptr;
+  const auto start = Clock::now();
+  mocap::bag::RecorderOptions options;
+  options.writer.commit_messages = 1000;
+  options.writer.commit_interval = std::chrono::hours(1);
+  mocap::bag::Recorder recorder(directory.string(), options);
+  const uint32_t topic = recorder.add_topic({"/bench", "sensor_msgs/msg/Image", "cdr", {}});
+  for (int i = 0; i < load.messages; ++i) {
+    recorder.record(topic, 1'700'000'000'000'000'000 + i,
+                    messages[static_cast<size_t>(i) % messages.size()], type);
+  }
+  if (auto error = recorder.close()) throw std::runtime_error(*error);
+  Result result;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.messages = static_cast<int>(recorder.stats().written);
+  result.bytes = recorder.stats().bytes;
+  return result;
+}
+
 std::string file_system_of(const fs::path& path) {
   // The mount whose point is the longest prefix of `path`.
   std::ifstream mounts("/proc/mounts");
@@ -153,7 +194,8 @@ int main(int argc, char** argv) {
       fs::temp_directory_path() / fmt::format("bag_record_bench_{}", std::random_device()());
   fs::create_directories(root);
   fmt::print(
-      "Bag recording throughput: BagWriter against raw SQLite inserts (same schema, WAL, "
+      "Bag recording throughput: BagWriter and the Recorder against raw SQLite inserts (same "
+      "schema, WAL, "
       "synchronous=NORMAL, one prepared INSERT, transactions of 1000).\n");
   fmt::print("Disk: {}. Best of {} alternating rounds each.\n\n", file_system_of(root), rounds);
 
@@ -172,19 +214,31 @@ int main(int argc, char** argv) {
       const auto payloads = make_payloads(load.payload_bytes, load.payload_bytes > 10000 ? 4 : 256);
       // Rounds of raw then BagWriter, the best of each: on a shared machine one run of either
       // varies by tens of percent, which alternating and taking the best evens out.
-      Result raw, ours;
+      const bool images = load.payload_bytes > 10000;
+      Result raw, ours, queued, typed;
       for (int round = 0; round < rounds; ++round) {
         Result r = raw_sqlite(root / fmt::format("raw{}", run++), load, payloads);
         Result b = bag_writer(root / fmt::format("bag{}", run++), load, payloads);
+        Result q = recorder(root / fmt::format("rec{}", run++), load, payloads, false);
         if (round == 0 || r.seconds < raw.seconds) raw = r;
         if (round == 0 || b.seconds < ours.seconds) ours = b;
+        if (round == 0 || q.seconds < queued.seconds) queued = q;
+        if (images) {
+          Result t = recorder(root / fmt::format("typed{}", run++), load, payloads, true);
+          if (round == 0 || t.seconds < typed.seconds) typed = t;
+        }
         std::error_code ignored;
         for (const auto& entry : fs::directory_iterator(root, ignored)) {
           fs::remove_all(entry, ignored);
         }
       }
-      for (const auto& [name, result] :
-           {std::pair<const char*, const Result&>{"raw SQLite", raw}, {"BagWriter", ours}}) {
+      std::vector<std::pair<const char*, const Result&>> rows = {
+          {"raw SQLite", raw},
+          {"BagWriter", ours},
+          {"Recorder (queue, writer thread; raw CDR as mocap_bag record)", queued}};
+      if (images)
+        rows.push_back({"Recorder, typed Image serialized by its thread (bag_recorder)", typed});
+      for (const auto& [name, result] : rows) {
         fmt::print("| {} ({} B) | {} | {} | {:.0f} | {:.1f} | {:.2f} |\n", load.name,
                    load.payload_bytes, name, result.messages, result.per_second(),
                    result.megabytes_per_second(), result.per_second() / raw.per_second());
