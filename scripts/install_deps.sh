@@ -21,6 +21,8 @@ packages=(
   libgtest-dev libgmock-dev iproute2 clang-format
   # benchmarks: instruction counts
   valgrind
+  # containers: docker-compose validates docker/compose.yaml (no Docker engine needed)
+  docker-compose
 )
 
 missing=()

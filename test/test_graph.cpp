@@ -2,8 +2,6 @@
 // two processes over DDS, and on two "hosts" (network namespaces joined by a veth pair).
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <fmt/format.h>
 
 #include "test_support.hpp"
@@ -69,71 +67,8 @@ TEST(Graph, TwoProcessesOverDds) {
   expect_complete_stream(test::read_summary(dir / "summary.yaml"));
 }
 
-// Two network namespaces joined by a veth pair: each is a host with its own network stack.
-class TwoHosts {
- public:
-  TwoHosts() {
-    std::string id = std::to_string(getpid() % 100000);
-    host_a_ = "mocap_a_" + id;
-    host_b_ = "mocap_b_" + id;
-    std::string link_a = "mva" + id, link_b = "mvb" + id;
-    std::string subnet = fmt::format("10.77.{}", getpid() % 250);
-    for (const auto& command : std::vector<std::vector<std::string>>{
-             {"ip", "netns", "add", host_a_},
-             {"ip", "netns", "add", host_b_},
-             {"ip", "link", "add", link_a, "type", "veth", "peer", "name", link_b},
-             {"ip", "link", "set", link_a, "netns", host_a_},
-             {"ip", "link", "set", link_b, "netns", host_b_},
-             {"ip", "-n", host_a_, "addr", "add", subnet + ".1/24", "dev", link_a},
-             {"ip", "-n", host_b_, "addr", "add", subnet + ".2/24", "dev", link_b},
-             {"ip", "-n", host_a_, "link", "set", "lo", "up"},
-             {"ip", "-n", host_b_, "link", "set", "lo", "up"},
-             {"ip", "-n", host_a_, "link", "set", link_a, "up"},
-             {"ip", "-n", host_b_, "link", "set", link_b, "up"},
-             // DDS discovery is multicast.
-             {"ip", "-n", host_a_, "route", "add", "224.0.0.0/4", "dev", link_a},
-             {"ip", "-n", host_b_, "route", "add", "224.0.0.0/4", "dev", link_b}}) {
-      auto [code, output] = test::run_command(command);
-      if (code != 0) {
-        error_ = fmt::format("{}: {}", fmt::join(command, " "), output);
-        return;
-      }
-    }
-    link_a_ = link_a;
-  }
-
-  ~TwoHosts() {
-    test::run_command({"ip", "netns", "del", host_a_});
-    test::run_command({"ip", "netns", "del", host_b_});
-  }
-
-  // Empty when the hosts are up; otherwise why not (no privileges, no `ip`).
-  const std::string& error() const { return error_; }
-
-  std::vector<std::string> on_a(std::vector<std::string> command) const {
-    return on(host_a_, command);
-  }
-  std::vector<std::string> on_b(std::vector<std::string> command) const {
-    return on(host_b_, command);
-  }
-
-  long long bytes_received_by_a() const {
-    auto [code, output] =
-        test::run_command(on_a({"cat", "/sys/class/net/" + link_a_ + "/statistics/rx_bytes"}));
-    return code == 0 ? std::stoll(output) : -1;
-  }
-
- private:
-  static std::vector<std::string> on(const std::string& host, std::vector<std::string> command) {
-    command.insert(command.begin(), {"ip", "netns", "exec", host});
-    return command;
-  }
-
-  std::string host_a_, host_b_, link_a_, error_;
-};
-
 TEST(Graph, TwoHostsOverANetwork) {
-  TwoHosts hosts;
+  test::TwoHosts hosts;
   if (!hosts.error().empty()) GTEST_SKIP() << "cannot make network namespaces: " << hosts.error();
   test::TempDir dir;
   // No shared memory: the hosts share this machine's /dev/shm, and the test is about the

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -113,6 +114,79 @@ std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
   std::optional<int> code = child.wait(timeout);
   if (!code) return {-1, child.output() + "\n(timed out)"};  // the destructor stops it
   return {*code, child.output()};
+}
+
+TwoHosts::TwoHosts(bool multicast) {
+  // Unique per process and object, so tests may run at once; short enough for a link name.
+  static std::atomic<int> counter{0};
+  int serial = counter.fetch_add(1) % 100;
+  std::string id = std::to_string(getpid() % 100000) + "x" + std::to_string(serial);
+  host_a_ = "mocap_a_" + id;
+  host_b_ = "mocap_b_" + id;
+  std::string link_a = "mva" + id, link_b = "mvb" + id;
+  link_a_ = link_a;
+  std::string subnet = "10.77." + std::to_string((getpid() + serial) % 250);
+  address_a_ = subnet + ".1";
+  address_b_ = subnet + ".2";
+  // Left behind by a killed run of a process with the same id: would make `add` fail.
+  run_command({"ip", "netns", "del", host_a_});
+  run_command({"ip", "netns", "del", host_b_});
+  std::vector<std::vector<std::string>> commands = {
+      {"ip", "netns", "add", host_a_},
+      {"ip", "netns", "add", host_b_},
+      {"ip", "link", "add", link_a, "type", "veth", "peer", "name", link_b},
+      {"ip", "link", "set", link_a, "netns", host_a_},
+      {"ip", "link", "set", link_b, "netns", host_b_},
+      {"ip", "-n", host_a_, "addr", "add", address_a_ + "/24", "dev", link_a},
+      {"ip", "-n", host_b_, "addr", "add", address_b_ + "/24", "dev", link_b},
+      {"ip", "-n", host_a_, "link", "set", "lo", "up"},
+      {"ip", "-n", host_b_, "link", "set", "lo", "up"},
+      {"ip", "-n", host_a_, "link", "set", link_a, "multicast", multicast ? "on" : "off"},
+      {"ip", "-n", host_b_, "link", "set", link_b, "multicast", multicast ? "on" : "off"},
+      {"ip", "-n", host_a_, "link", "set", link_a, "up"},
+      {"ip", "-n", host_b_, "link", "set", link_b, "up"}};
+  if (!multicast) {
+    // IFF_MULTICAST alone stops nothing: a sender naming the interface still sends, and veth
+    // delivers. A host that may join no multicast group receives none.
+    for (const std::string& host : {host_a_, host_b_}) {
+      commands.push_back({"ip", "netns", "exec", host, "sh", "-c",
+                          "echo 0 > /proc/sys/net/ipv4/igmp_max_memberships"});
+    }
+  } else {  // DDS discovery is multicast.
+    commands.push_back({"ip", "-n", host_a_, "route", "add", "224.0.0.0/4", "dev", link_a});
+    commands.push_back({"ip", "-n", host_b_, "route", "add", "224.0.0.0/4", "dev", link_b});
+  }
+  for (const auto& command : commands) {
+    auto [code, output] = run_command(command);
+    if (code != 0) {
+      error_.clear();
+      for (const std::string& word : command) error_ += word + " ";
+      error_ += ": " + output;
+      return;
+    }
+  }
+}
+
+TwoHosts::~TwoHosts() {
+  run_command({"ip", "netns", "del", host_a_});
+  run_command({"ip", "netns", "del", host_b_});
+  if (!error_.empty()) run_command({"ip", "link", "del", link_a_});  // if never moved
+}
+
+std::vector<std::string> TwoHosts::on_a(std::vector<std::string> command) const {
+  command.insert(command.begin(), {"ip", "netns", "exec", host_a_});
+  return command;
+}
+
+std::vector<std::string> TwoHosts::on_b(std::vector<std::string> command) const {
+  command.insert(command.begin(), {"ip", "netns", "exec", host_b_});
+  return command;
+}
+
+long long TwoHosts::bytes_received_by_a() const {
+  auto [code, output] =
+      run_command(on_a({"cat", "/sys/class/net/" + link_a_ + "/statistics/rx_bytes"}));
+  return code == 0 ? std::stoll(output) : -1;
 }
 
 std::map<std::string, long long> read_summary(const fs::path& path) {

@@ -64,6 +64,33 @@ std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
                                         std::map<std::string, std::string> environment = {},
                                         std::chrono::seconds timeout = std::chrono::seconds(60));
 
+// Two network namespaces ("hosts" A and B, each its own network stack) joined by a veth pair,
+// removed when the object goes. Needs root and `ip` (iproute2); error() says what failed.
+class TwoHosts {
+ public:
+  // `multicast` false: no multicast between the hosts (IFF_MULTICAST off, no multicast route,
+  // and no group can be joined: igmp_max_memberships 0), as on networks where DDS's multicast
+  // discovery cannot work.
+  explicit TwoHosts(bool multicast = true);
+  ~TwoHosts();
+  TwoHosts(const TwoHosts&) = delete;
+  TwoHosts& operator=(const TwoHosts&) = delete;
+
+  // Empty when the hosts are up; otherwise why not (no privileges, no `ip`).
+  const std::string& error() const { return error_; }
+  const std::string& namespace_a() const { return host_a_; }
+  const std::string& namespace_b() const { return host_b_; }
+  const std::string& address_a() const { return address_a_; }  // IPv4 of A's end of the link
+  const std::string& address_b() const { return address_b_; }
+  // `command` run inside host A or B (`ip netns exec`).
+  std::vector<std::string> on_a(std::vector<std::string> command) const;
+  std::vector<std::string> on_b(std::vector<std::string> command) const;
+  long long bytes_received_by_a() const;  // over the link; -1 if unknown
+
+ private:
+  std::string host_a_, host_b_, link_a_, address_a_, address_b_, error_;
+};
+
 // "key: integer" lines, as sequence_sink writes them.
 std::map<std::string, long long> read_summary(const std::filesystem::path& path);
 

@@ -1,14 +1,134 @@
 #include "fastdds_qos.hpp"
 
-#include <memory>
+#include <arpa/inet.h>
+#include <netdb.h>
 
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdlib>
+#include <memory>
+#include <stdexcept>
+
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/common/Locator.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+#include <fmt/format.h>
 
 namespace mocap {
 namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+namespace fs = std::filesystem;
 
 namespace {
+
+std::optional<unsigned> parse_number(std::string_view text, unsigned max) {
+  unsigned value = 0;
+  auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size() || value > max) {
+    return std::nullopt;
+  }
+  return value;
+}
+
+// Dotted-quad IPv4, or a host name: labels of letters, digits and '-', not all digits.
+bool valid_host(std::string_view host) {
+  if (host.empty() || host.size() > 253) return false;
+  if (host.find_first_not_of("0123456789.") == std::string_view::npos) {
+    int parts = 0;
+    for (size_t start = 0;; ++parts) {
+      size_t dot = std::min(host.find('.', start), host.size());
+      if (!parse_number(host.substr(start, dot - start), 255)) return false;
+      if (dot == host.size()) return parts == 3;
+      start = dot + 1;
+    }
+  }
+  for (size_t start = 0;;) {
+    size_t dot = std::min(host.find('.', start), host.size());
+    std::string_view label = host.substr(start, dot - start);
+    if (label.empty() || label.size() > 63 || label.front() == '-' || label.back() == '-' ||
+        !std::all_of(label.begin(), label.end(), [](char c) {
+          return std::isalnum(static_cast<unsigned char>(c)) || c == '-';
+        })) {
+      return false;
+    }
+    if (dot == host.size()) return true;
+    start = dot + 1;
+  }
+}
+
+bool valid_identity(std::string_view name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+  });
+}
+
+// The IPv4 address of `host`: itself, or what the resolver says.
+std::string ipv4_address(const std::string& host) {
+  if (rtps::IPLocator::isIPv4(host)) return host;
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  addrinfo* found = nullptr;
+  if (int error = getaddrinfo(host.c_str(), nullptr, &hints, &found); error != 0) {
+    throw std::runtime_error(fmt::format("cannot resolve {}: {}", host, gai_strerror(error)));
+  }
+  char text[INET_ADDRSTRLEN] = {};
+  inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(found->ai_addr)->sin_addr, text, sizeof text);
+  freeaddrinfo(found);
+  return text;
+}
+
+void set_discovery_servers(const std::vector<std::string>& servers,
+                           rtps::DiscoverySettings& discovery) {
+  // A super client rather than a plain client: the server then tells it about every endpoint,
+  // not only those matching its own topics, as multicast discovery does. `mocap_topic list`
+  // and `mocap_bag record` depend on that.
+  discovery.discoveryProtocol = rtps::DiscoveryProtocol_t::SUPER_CLIENT;
+  for (size_t id = 0; id < servers.size(); ++id) {
+    std::optional<HostPort> address = parse_host_port(servers[id]);
+    if (!address) {
+      throw std::runtime_error(fmt::format("discovery server '{}' is not host:port", servers[id]));
+    }
+    rtps::RemoteServerAttributes server;
+    if (!rtps::get_server_client_default_guidPrefix(static_cast<int>(id), server.guidPrefix)) {
+      throw std::runtime_error(
+          fmt::format("{} discovery servers: more than Fast DDS can number", servers.size()));
+    }
+    rtps::Locator_t locator;
+    try {
+      rtps::IPLocator::setIPv4(locator, ipv4_address(address->host));
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(fmt::format("discovery server '{}': {}", servers[id], e.what()));
+    }
+    locator.port = address->port;
+    server.metatrafficUnicastLocatorList.push_back(locator);
+    discovery.m_DiscoveryServers.push_back(server);
+  }
+}
+
+// Fast DDS's builtin plugins: PKI-DH authentication, permissions, AES-GCM-GMAC encryption.
+void set_security(const fs::path& directory, const std::string& identity,
+                  dds::PropertyPolicyQos& properties) {
+  fs::path absolute = fs::absolute(directory).lexically_normal();
+  if (auto problem = check_security(absolute, identity)) {
+    throw std::runtime_error(fmt::format("DDS Security: {}", problem->message));
+  }
+  SecurityFiles files = security_files(absolute, identity);
+  auto uri = [](const fs::path& path) { return "file://" + path.string(); };
+  auto& list = properties.properties();
+  list.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+  list.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", uri(files.ca));
+  list.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", uri(files.certificate));
+  list.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", uri(files.private_key));
+  list.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+  list.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", uri(files.ca));
+  list.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", uri(files.governance));
+  list.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions",
+                    uri(files.permissions));
+  list.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
 
 template <class EndpointQos>
 void apply(const Qos& qos, EndpointQos& out) {
@@ -54,7 +174,91 @@ dds::DataReaderQos to_reader_qos(const Qos& qos) {
   return out;
 }
 
-dds::DomainParticipantQos to_participant_qos(const DdsOptions& options, const std::string& name) {
+std::optional<HostPort> parse_host_port(std::string_view text) {
+  size_t colon = text.rfind(':');
+  if (colon == std::string_view::npos || !valid_host(text.substr(0, colon))) return std::nullopt;
+  std::optional<unsigned> port = parse_number(text.substr(colon + 1), 65535);
+  if (!port || *port == 0) return std::nullopt;
+  return HostPort{std::string(text.substr(0, colon)), static_cast<uint16_t>(*port)};
+}
+
+SecurityFiles security_files(const fs::path& directory, const std::string& identity) {
+  return {directory / "ca.cert.pem", directory / "governance.smime",
+          directory / (identity + ".cert.pem"), directory / (identity + ".key.pem"),
+          directory / (identity + ".permissions.smime")};
+}
+
+std::optional<SecurityProblem> check_security(const fs::path& directory,
+                                              const std::string& identity) {
+  std::error_code error;
+  if (directory.empty()) return SecurityProblem{"directory", "no folder given"};
+  if (!fs::is_directory(directory, error)) {
+    return SecurityProblem{"directory", fmt::format("{} is not a folder", directory.string())};
+  }
+  if (identity.empty()) return SecurityProblem{"identity", "no identity given"};
+  if (!valid_identity(identity)) {
+    return SecurityProblem{"identity", fmt::format("'{}' is not an identity name (letters, "
+                                                   "digits, '_' and '-')",
+                                                   identity)};
+  }
+  SecurityFiles files = security_files(directory, identity);
+  struct Expected {
+    const char* key;
+    const char* what;
+    const fs::path& path;
+  };
+  const Expected expected[] = {{"directory", "CA certificate", files.ca},
+                               {"directory", "signed governance", files.governance},
+                               {"identity", "certificate", files.certificate},
+                               {"identity", "private key", files.private_key},
+                               {"identity", "signed permissions", files.permissions}};
+  for (const Expected& file : expected) {
+    if (!fs::is_regular_file(file.path, error)) {
+      return SecurityProblem{
+          file.key, fmt::format("no {} {} in {} (scripts/make_security.sh makes it)", file.what,
+                                file.path.filename().string(), directory.string())};
+    }
+  }
+  return std::nullopt;
+}
+
+DdsOptions with_environment(DdsOptions options) {
+  auto variable = [](const char* name) -> std::optional<std::string> {
+    const char* text = std::getenv(name);
+    if (text == nullptr || *text == '\0') return std::nullopt;
+    return std::string(text);
+  };
+  if (auto servers = variable("MOCAP_DISCOVERY_SERVER")) {
+    options.discovery_servers.clear();
+    for (size_t start = 0; start <= servers->size();) {
+      size_t end = std::min(servers->find(';', start), servers->size());
+      std::string server = servers->substr(start, end - start);
+      if (!parse_host_port(server)) {
+        throw std::runtime_error(fmt::format(
+            "MOCAP_DISCOVERY_SERVER='{}': '{}' is not host:port (expected host:port;host:port..)",
+            *servers, server));
+      }
+      options.discovery_servers.push_back(server);
+      start = end + 1;
+    }
+  }
+  if (auto directory = variable("MOCAP_SECURITY_DIRECTORY")) {
+    options.security_directory = *directory;
+  }
+  if (auto identity = variable("MOCAP_SECURITY_IDENTITY")) {
+    options.security_identity = *identity;
+  }
+  if (options.security_directory.empty() != options.security_identity.empty()) {
+    throw std::runtime_error(
+        options.security_directory.empty()
+            ? "DDS Security: an identity but no folder (set MOCAP_SECURITY_DIRECTORY)"
+            : "DDS Security: a folder but no identity (set MOCAP_SECURITY_IDENTITY)");
+  }
+  return options;
+}
+
+dds::DomainParticipantQos to_participant_qos(const DdsOptions& given, const std::string& name) {
+  DdsOptions options = with_environment(given);
   dds::DomainParticipantQos out;
   out.name(name);
   // A crashed peer is forgotten after 5 s instead of Fast DDS's 20 s: until then a reliable
@@ -62,6 +266,12 @@ dds::DomainParticipantQos to_participant_qos(const DdsOptions& options, const st
   auto& discovery = out.wire_protocol().builtin.discovery_config;
   discovery.leaseDuration = {5, 0};
   discovery.leaseDuration_announcementperiod = {1, 0};
+  if (!options.discovery_servers.empty()) {
+    set_discovery_servers(options.discovery_servers, discovery);
+  }
+  if (!options.security_directory.empty()) {
+    set_security(options.security_directory, options.security_identity, out.properties());
+  }
   out.transport().use_builtin_transports = false;
   if (options.shared_memory) {
     // Fast DDS's default 512 KiB segment cannot hold a camera image, which then goes over

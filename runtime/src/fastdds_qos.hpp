@@ -1,8 +1,13 @@
 // Our QoS and host options as Fast DDS QoS. Shared by the transport and the benchmark's raw
-// Fast DDS reference, so both run with the very same settings.
+// Fast DDS reference, so both run with the very same settings; and the checks the launch file
+// makes of its `dds:` settings.
 #pragma once
 
+#include <cstdint>
+#include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
@@ -18,7 +23,42 @@ constexpr uint32_t kSharedMemorySegmentBytes = 8 * 1024 * 1024;
 
 eprosima::fastdds::dds::DataWriterQos to_writer_qos(const Qos& qos);
 eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);
+// With `options` as with_environment() amends them. Throws std::runtime_error for a bad
+// environment variable, security files that are missing, or a server host that does not resolve.
 eprosima::fastdds::dds::DomainParticipantQos to_participant_qos(const DdsOptions& options,
                                                                 const std::string& name);
+
+// `options` with the environment's overrides: MOCAP_DISCOVERY_SERVER ("host:port;host:port"),
+// MOCAP_SECURITY_DIRECTORY and MOCAP_SECURITY_IDENTITY. (MOCAP_DOMAIN_ID: resolve_domain_id.)
+// Throws std::runtime_error naming the variable for a bad value.
+DdsOptions with_environment(DdsOptions options);
+
+// A Discovery Server address.
+struct HostPort {
+  std::string host;  // an IPv4 address or a host name
+  uint16_t port = 0;
+};
+// "host:port" with port 1..65535, or nullopt.
+std::optional<HostPort> parse_host_port(std::string_view text);
+
+// The files of DDS Security identity `identity` in `directory`, named as
+// scripts/make_security.sh makes them.
+struct SecurityFiles {
+  std::filesystem::path ca;           // ca.cert.pem: identity and permissions CA
+  std::filesystem::path governance;   // governance.smime
+  std::filesystem::path certificate;  // IDENTITY.cert.pem
+  std::filesystem::path private_key;  // IDENTITY.key.pem
+  std::filesystem::path permissions;  // IDENTITY.permissions.smime
+};
+SecurityFiles security_files(const std::filesystem::path& directory, const std::string& identity);
+
+// What makes security settings unusable, or nullopt. `key` says which setting is at fault:
+// "directory" (not a folder, no CA or governance) or "identity" (bad name, files missing).
+struct SecurityProblem {
+  std::string key;
+  std::string message;  // "no certificate alice.cert.pem in /path"
+};
+std::optional<SecurityProblem> check_security(const std::filesystem::path& directory,
+                                              const std::string& identity);
 
 }  // namespace mocap

@@ -49,6 +49,17 @@ Clock::time_point to_time_point(const rtps::Time_t& time) {
       std::chrono::seconds(time.seconds()) + std::chrono::nanoseconds(time.nanosec())));
 }
 
+// Why creating an endpoint may have failed, when DDS Security's access control is on.
+std::string access_control_hint(dds::DomainParticipant* participant, std::string_view action) {
+  for (const auto& property : participant->get_qos().properties().properties()) {
+    if (property.name() == "dds.sec.access.plugin") {
+      return fmt::format(
+          " (DDS Security is on: do this identity's permissions let it {} the topic?)", action);
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 int resolve_domain_id(int configured) {
@@ -186,7 +197,8 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
     if (writer_ == nullptr) {
       local_writers_->fetch_sub(1);
       transport.release_topic(topic_);
-      throw std::runtime_error(fmt::format("cannot create a DDS writer for {}", endpoint.topic));
+      throw std::runtime_error(fmt::format("cannot create a DDS writer for {}{}", endpoint.topic,
+                                           access_control_hint(transport.participant_, "publish")));
     }
   }
 
@@ -280,7 +292,9 @@ class FastDdsTransport::Reader final : public TransportSubscription,
             << dds::StatusMask::requested_incompatible_qos());
     if (reader_ == nullptr) {
       transport.release_topic(topic_);
-      throw std::runtime_error(fmt::format("cannot create a DDS reader for {}", endpoint.topic));
+      throw std::runtime_error(
+          fmt::format("cannot create a DDS reader for {}{}", endpoint.topic,
+                      access_control_hint(transport.participant_, "subscribe to")));
     }
   }
 
@@ -366,8 +380,13 @@ FastDdsTransport::FastDdsTransport(const DdsOptions& options, const std::string&
       factory->create_participant(domain_id_, to_participant_qos(options, participant_name),
                                   listener_.get(), dds::StatusMask::none());
   if (participant_ == nullptr) {
+    DdsOptions used = with_environment(options);
     throw std::runtime_error(
-        fmt::format("cannot create a DDS participant on domain {}", domain_id_));
+        used.security_directory.empty()
+            ? fmt::format("cannot create a DDS participant on domain {}", domain_id_)
+            : fmt::format("cannot create a DDS participant on domain {} as DDS Security "
+                          "identity '{}' of {} (Fast DDS's error above says why)",
+                          domain_id_, used.security_identity, used.security_directory));
   }
   publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "fastdds_qos.hpp"
 #include "names.hpp"
 #include "yaml_value.hpp"
 
@@ -236,11 +237,15 @@ class Reader {
  private:
   void read_dds(const YAML::Node& dds) {
     if (!dds.IsMap()) {
-      problems_.add(dds, "'dds' must be a map (enabled, domain_id, shared_memory)");
+      problems_.add(dds,
+                    "'dds' must be a map (enabled, domain_id, shared_memory, discovery, "
+                    "security)");
       return;
     }
-    check_keys(dds, std::vector<std::string>{"enabled", "domain_id", "shared_memory"}, "'dds'",
-               problems_);
+    check_keys(
+        dds,
+        std::vector<std::string>{"enabled", "domain_id", "shared_memory", "discovery", "security"},
+        "'dds'", problems_);
     if (YAML::Node n = dds["enabled"]) {
       if (auto v = bool_value(n, "enabled", problems_)) result_.dds.enabled = *v;
     }
@@ -250,6 +255,66 @@ class Reader {
     if (YAML::Node n = dds["shared_memory"]) {
       if (auto v = bool_value(n, "shared_memory", problems_)) result_.dds.shared_memory = *v;
     }
+    if (YAML::Node n = dds["discovery"]) read_discovery(n);
+    if (YAML::Node n = dds["security"]) read_security(n);
+  }
+
+  // discovery: {server: "host:port"} or {server: ["host:port", ...]}
+  void read_discovery(const YAML::Node& node) {
+    if (!node.IsMap()) {
+      problems_.add(node, "dds.discovery must be a map with 'server'");
+      return;
+    }
+    check_keys(node, std::vector<std::string>{"server"}, "'dds.discovery'", problems_);
+    YAML::Node server = node["server"];
+    std::vector<YAML::Node> entries;
+    if (server && server.IsScalar()) {
+      entries.push_back(server);
+    } else if (server && server.IsSequence() && server.size() > 0) {
+      for (const YAML::Node& entry : server) entries.push_back(entry);
+    } else {
+      problems_.add(server ? server : node,
+                    "dds.discovery.server must be \"host:port\" or a non-empty list of them");
+      return;
+    }
+    for (const YAML::Node& entry : entries) {
+      if (entry.IsScalar() && parse_host_port(entry.Scalar())) {
+        result_.dds.discovery_servers.push_back(entry.Scalar());
+      } else {
+        problems_.add(entry, fmt::format("dds.discovery.server: '{}' is not host:port",
+                                         entry.IsScalar() ? entry.Scalar() : "?"));
+      }
+    }
+  }
+
+  // security: {directory: PATH, identity: NAME}; a relative PATH is taken from the file's folder.
+  void read_security(const YAML::Node& node) {
+    if (!node.IsMap()) {
+      problems_.add(node, "dds.security must be a map with 'directory' and 'identity'");
+      return;
+    }
+    check_keys(node, std::vector<std::string>{"directory", "identity"}, "'dds.security'",
+               problems_);
+    YAML::Node directory = node["directory"];
+    YAML::Node identity = node["identity"];
+    if (!directory || !identity) {
+      problems_.add(node, "dds.security needs 'directory' and 'identity'");
+      return;
+    }
+    auto folder = string_value(directory, "dds.security.directory", problems_);
+    auto name = string_value(identity, "dds.security.identity", problems_);
+    if (!folder || !name) return;
+    namespace fs = std::filesystem;
+    fs::path path(*folder);
+    if (path.is_relative()) path = fs::absolute(result_.path).parent_path() / path;
+    path = path.lexically_normal();
+    if (auto problem = check_security(path, *name)) {
+      problems_.add(problem->key == "directory" ? directory : identity,
+                    fmt::format("dds.security.{}: {}", problem->key, problem->message));
+      return;
+    }
+    result_.dds.security_directory = path.string();
+    result_.dds.security_identity = *name;
   }
 
   void read_group(const YAML::Node& node) {

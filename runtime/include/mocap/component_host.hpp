@@ -30,6 +30,18 @@ struct DdsOptions {
   // Off: UDP only. Needed between containers that do not share /dev/shm, and to force the
   // network path between network namespaces.
   bool shared_memory = true;
+  // Discovery through Fast DDS Discovery Servers instead of multicast: "host:port" each (host
+  // an IPv4 address or a name), the i-th being the server started with id i
+  // (`fast-discovery-server -i i -l host -p port`, as ROS_DISCOVERY_SERVER). Empty: multicast
+  // (SIMPLE) discovery. The MOCAP_DISCOVERY_SERVER environment variable ("host:port;..")
+  // overrides it.
+  std::vector<std::string> discovery_servers = {};
+  // DDS Security (authentication, access control, encryption): a folder made by
+  // scripts/make_security.sh and the identity to take from it (NAME.cert.pem and the like).
+  // Empty: no security. The MOCAP_SECURITY_DIRECTORY and MOCAP_SECURITY_IDENTITY environment
+  // variables override them.
+  std::string security_directory = {};
+  std::string security_identity = {};
 };
 
 struct HostOptions {
