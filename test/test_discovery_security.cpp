@@ -237,7 +237,7 @@ groups:
 
   test::write_file(file, one_component("sink", "sequence_sink", "expect: 1",
                                        "{discovery: {server: [\"10.0.0.1:11811\", "
-                                       "\"localhost:11812\"]}, security: {directory: "
+                                       "\"127.0.0.1:11812\"]}, security: {directory: "
                                        "credentials, identity: alice}}"));
   std::tie(code, output) =
       test::run_command({launcher(), file.string(), "--check"}, environment(62));
