@@ -160,7 +160,8 @@ struct CalibrationProblem::State {
     problem.GetParameterBlocks(&blocks);
     int free = 0;
     for (double* block : blocks) {
-      if (!problem.IsParameterBlockConstant(block)) free += problem.ParameterBlockTangentSize(block);
+      if (!problem.IsParameterBlockConstant(block))
+        free += problem.ParameterBlockTangentSize(block);
     }
     return static_cast<double>(problem.NumResiduals() - free);
   }
