@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <ctime>
 #include <deque>
 #include <mutex>
 #include <thread>
@@ -10,6 +11,15 @@
 #include <fmt/format.h>
 
 namespace mocap::bag {
+
+std::string default_bag_directory() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char name[64];
+  std::strftime(name, sizeof name, "bag_%Y_%m_%d-%H_%M_%S", &local);
+  return name;
+}
 
 struct Recorder::State {
   struct Item {

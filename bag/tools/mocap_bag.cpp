@@ -61,15 +61,6 @@ int64_t now_ns() {
       .count();
 }
 
-std::string default_bag_name() {
-  const std::time_t now = std::time(nullptr);
-  std::tm local{};
-  localtime_r(&now, &local);
-  char name[64];
-  std::strftime(name, sizeof name, "bag_%Y_%m_%d-%H_%M_%S", &local);
-  return name;
-}
-
 std::string format_stamp(int64_t ns) {
   const std::time_t seconds = static_cast<std::time_t>(ns / 1000000000);
   std::tm local{};
@@ -333,7 +324,7 @@ int main(int argc, char** argv) {
   mocap::ShutdownSignal::install();
   try {
     if (command == "record")
-      return record(output.value_or(default_bag_name()), topics, all, duration);
+      return record(output.value_or(mocap::bag::default_bag_directory()), topics, all, duration);
     if (command == "play") return play(*bag, playback, delay);
     return info(*bag);
   } catch (const std::exception& e) {

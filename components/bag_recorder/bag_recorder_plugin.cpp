@@ -2,7 +2,6 @@
 // launch file. Messages of this process arrive by pointer and are serialized only by the
 // writer thread; the others arrive over DDS. Storage and crash safety: mocap/bag/recorder.hpp.
 #include <chrono>
-#include <ctime>
 #include <memory>
 #include <set>
 #include <string>
@@ -13,15 +12,6 @@
 
 namespace mocap::bag {
 namespace {
-
-std::string default_directory() {
-  const std::time_t now = std::time(nullptr);
-  std::tm local{};
-  localtime_r(&now, &local);
-  char name[64];
-  std::strftime(name, sizeof name, "bag_%Y_%m_%d-%H_%M_%S", &local);
-  return name;
-}
 
 int64_t stamp_ns(Clock::time_point time) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count();
@@ -48,7 +38,7 @@ class BagRecorder final : public Component {
 
   explicit BagRecorder(Context& context) : Component(context) {
     std::string output = param<std::string>("output");
-    if (output.empty()) output = default_directory();
+    if (output.empty()) output = default_bag_directory();
     const std::vector<std::string> wanted = param<std::vector<std::string>>("topics");
     const std::vector<KnownTopic> known = context.known_topics();
 

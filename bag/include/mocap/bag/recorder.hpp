@@ -28,6 +28,9 @@ struct RecorderStats {
   size_t queued_bytes = 0;  // waiting now
 };
 
+// "bag_YYYY_MM_DD-HH_MM_SS" in local time: the directory a recording gets when none is named.
+std::string default_bag_directory();
+
 class Recorder {
  public:
   // Creates the bag (BagWriter's rules) and starts the writer thread. Throws BagError.
