@@ -111,12 +111,11 @@ class RawEndpoint : public dds::DataReaderListener, public dds::DataWriterListen
     matched = status.current_count;
   }
 
-  // Fast DDS 2.9 reports spurious timeouts on full keep-all histories; the runtime retries
-  // within the blocking time, and so does this reference, so both deliver everything.
+  // A full keep-all history makes a write wait (at most mocap::kWriteWaitSlice, then it
+  // times out, and also spuriously in Fast DDS 2.9); the runtime writes again until there is
+  // room, and so does this reference, so both deliver everything.
   void write(T& message) {
-    auto deadline = Steady::now() + std::chrono::milliseconds(mocap::kReliableBlockingMilliseconds);
-    while (writer_->write(&message, dds::HANDLE_NIL) == ReturnCode_t::RETCODE_TIMEOUT &&
-           Steady::now() < deadline) {
+    while (writer_->write(&message, dds::HANDLE_NIL) == ReturnCode_t::RETCODE_TIMEOUT) {
     }
   }
 

@@ -2,9 +2,11 @@
 // errors and shutdown, through the same ComponentHost that mocap_launch uses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <set>
+#include <thread>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -369,6 +371,121 @@ TEST_F(ComponentHostTest, OneComponentsCallbacksNeverOverlapAndErrorsAreCounted)
   EXPECT_GE(record.ticks, 300);
   EXPECT_EQ(record.max_active, 1);
   EXPECT_GE(host.callback_errors(), 150u);
+}
+
+// Back-pressure inside one process: publishes `count` messages in one callback, as fast as
+// its subscribers let it, and keeps what it saw.
+struct BurstRecord {
+  std::atomic<bool> done{false};
+  std::atomic<int> ticks_during{0};  // the ticker's ticks while the burst was publishing
+  PublisherStats stats;
+  std::vector<int> received;
+  std::mutex mutex;
+} burst;
+
+class Burst final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.parameter("count", 500, "messages in the burst").min(1);
+    spec.publishes<Array>("/burst", Qos::reliable(), "");
+  }
+  explicit Burst(Context& context) : Component(context) {
+    publisher_ = create_publisher<Array>("/burst");
+    create_timer(std::chrono::milliseconds(1), [this] {
+      if (sent_ || publisher_.matched_subscribers() == 0) return;
+      sent_ = true;
+      int ticks_before = record.ticks;
+      for (int i = 0; i < param<int>("count"); ++i) {
+        Array message;
+        message.header().stamp().sec(i);
+        publisher_.publish(std::move(message));
+      }
+      burst.ticks_during = record.ticks - ticks_before;
+      burst.stats = publisher_.stats();
+      burst.done = true;
+    });
+  }
+
+ private:
+  Publisher<Array> publisher_;
+  bool sent_ = false;
+};
+
+class SlowSink final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.parameter("expect", 500, "messages before shutdown").min(1);
+    spec.subscribes<Array>("/burst", Qos::reliable(), "");
+  }
+  explicit SlowSink(Context& context) : Component(context) {
+    create_subscription<Array>("/burst", [this](const Array& message) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      std::lock_guard lock(burst.mutex);
+      burst.received.push_back(message.header().stamp().sec());
+      if (static_cast<int>(burst.received.size()) == param<int>("expect")) request_shutdown(0);
+    });
+  }
+};
+
+class Counter final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit Counter(Context& context) : Component(context) {
+    create_timer(std::chrono::milliseconds(2), [] { ++record.ticks; });
+  }
+};
+
+Qos reliable_with_depth(int depth) {
+  Qos qos = Qos::reliable();
+  qos.depth = depth;
+  return qos;
+}
+
+TEST_F(ComponentHostTest, ASlowSubscriberHoldsItsPublisherBackWhileTheOthersRunOn) {
+  burst.received.clear();
+  burst.done = false;
+  // One executor thread: the publisher waiting inside its callback must lend it, or neither
+  // the subscriber it waits for nor anyone else would run.
+  ComponentHost host({.name = "test", .threads = 1, .dds = {.enabled = false}});
+  host.add(make_component_factory<Burst>("burst"),
+           {.name = "burst", .qos = {{"/burst", reliable_with_depth(10)}}});
+  host.add(make_component_factory<SlowSink>("slow_sink"),
+           {.name = "sink", .qos = {{"/burst", reliable_with_depth(10)}}});
+  host.add(make_component_factory<Counter>("counter"), {.name = "counter"});
+  EXPECT_EQ(host.run(std::chrono::seconds(60)), 0);
+  ASSERT_TRUE(burst.done);
+  ASSERT_EQ(burst.received.size(), 500u);
+  for (int i = 0; i < 500; ++i) ASSERT_EQ(burst.received[static_cast<size_t>(i)], i);
+  EXPECT_EQ(burst.stats.published, 500u);
+  EXPECT_EQ(burst.stats.dropped, 0u);
+  EXPECT_GT(burst.stats.waited, 0u);
+  EXPECT_GT(burst.stats.blocked, std::chrono::milliseconds(100));  // of about 500 ms of work
+  EXPECT_GT(burst.ticks_during, 0);  // the other component ran on meanwhile
+}
+
+TEST_F(ComponentHostTest, StoppingReleasesAPublisherWaitingForASubscriber) {
+  burst.received.clear();
+  burst.done = false;
+  ComponentHost host({.name = "test", .threads = 2, .dds = {.enabled = false}});
+  host.add(make_component_factory<Burst>("burst"), {.name = "burst",
+                                                    .parameters = {{"count", int64_t{100000}}},
+                                                    .qos = {{"/burst", reliable_with_depth(10)}}});
+  host.add(make_component_factory<SlowSink>("slow_sink"),
+           {.name = "sink",
+            .parameters = {{"expect", int64_t{100000}}},
+            .qos = {{"/burst", reliable_with_depth(10)}}});
+  // 100 s of work for the sink; the host must still stop when asked.
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(host.run(std::chrono::milliseconds(300)), 0);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+  ASSERT_TRUE(burst.done);
+  EXPECT_EQ(burst.stats.published, 100000u);
+  EXPECT_GT(burst.stats.dropped, 90000u);  // given up once stopping: nobody would take them
+  std::lock_guard lock(burst.mutex);
+  EXPECT_LE(burst.received.size() + burst.stats.dropped, 100000u);
+  EXPECT_TRUE(std::is_sorted(burst.received.begin(), burst.received.end()));
+  EXPECT_EQ(std::adjacent_find(burst.received.begin(), burst.received.end()),
+            burst.received.end());  // none twice
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
-// DDS between processes: rediscovery, reliability, zero-copy kept beside remote subscribers,
-// late joiners of latched topics, and the command-line tools.
+// DDS between processes: rediscovery, reliability (also with every core busy and with a slow
+// subscriber), zero-copy kept beside remote subscribers, late joiners of latched topics, and
+// the command-line tools.
 #include <gtest/gtest.h>
 
 #include <signal.h>
+
+#include <memory>
 
 #include <fmt/format.h>
 
@@ -41,52 +44,194 @@ std::string sink_yaml(const std::string& parameters, const std::string& qos = "r
   return one_component_yaml("sink", parameters, qos);
 }
 
-TEST(Dds, ARestartedSubscriberProcessReceivesAgain) {
-  test::TempDir dir;
-  auto env = environment(10);
-  test::write_file(dir / "source.yaml",
-                   source_yaml("count: 0, batch: 1, period_s: 0.01, subscribers: 0"));
-  test::write_file(dir / "sink.yaml", sink_yaml("expect: 0, log_every: 20, timeout_s: 120"));
-  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+// The machine a reliable stream must not lose samples on: quiet, with every core busy with
+// other processes, with a subscriber that takes 5 ms over each message (far slower than its
+// publisher, which must then wait for it), or one that stalls for a second now and then.
+enum class Load { Quiet, BusyCores, SlowSubscriber, StallingSubscriber };
 
-  test::ChildProcess first({launcher(), (dir / "sink.yaml").string()}, env, dir / "first.log");
-  ASSERT_TRUE(first.wait_for_output("received 20", std::chrono::seconds(60))) << first.output();
-  first.signal(SIGKILL);  // no goodbye to the publisher
-  ASSERT_EQ(first.wait(std::chrono::seconds(10)), 128 + SIGKILL);
-
-  test::ChildProcess second({launcher(), (dir / "sink.yaml").string()}, env, dir / "second.log");
-  EXPECT_TRUE(second.wait_for_output("received 20", std::chrono::seconds(60)))
-      << second.output() << source.output();
-  second.signal(SIGTERM);
-  EXPECT_EQ(second.wait(std::chrono::seconds(30)), 0) << second.output();
-  source.signal(SIGTERM);
-  EXPECT_EQ(source.wait(std::chrono::seconds(30)), 0) << source.output();
+std::string load_name(const ::testing::TestParamInfo<Load>& info) {
+  switch (info.param) {
+    case Load::Quiet:
+      return "Quiet";
+    case Load::BusyCores:
+      return "BusyCores";
+    case Load::SlowSubscriber:
+      return "SlowSubscriber";
+    case Load::StallingSubscriber:
+      return "StallingSubscriber";
+  }
+  return "?";
 }
 
-TEST(Dds, ReliableLosesNothingAcrossTenThousandMessages) {
+class ReliableUnderLoad : public ::testing::TestWithParam<Load> {
+ protected:
+  void SetUp() override {
+    if (GetParam() == Load::BusyCores) busy_ = std::make_unique<test::BusyCores>();
+  }
+  void TearDown() override { busy_.reset(); }
+
+  // The DDS domain of this test under this load: `slot` to `slot` + 3.
+  std::map<std::string, std::string> env(int slot) const {
+    return environment(slot + static_cast<int>(GetParam()));
+  }
+  // The sink's parameters under this load.
+  std::string sink(const std::string& parameters) const {
+    switch (GetParam()) {
+      case Load::SlowSubscriber:
+        return parameters + ", work_s: 0.005";
+      case Load::StallingSubscriber:
+        return parameters + ", stall_every: 2500, stall_s: 1.0";
+      default:
+        return parameters;
+    }
+  }
+
+ private:
+  std::unique_ptr<test::BusyCores> busy_;
+};
+
+INSTANTIATE_TEST_SUITE_P(Dds, ReliableUnderLoad,
+                         ::testing::Values(Load::Quiet, Load::BusyCores, Load::SlowSubscriber,
+                                           Load::StallingSubscriber),
+                         load_name);
+
+TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
   test::TempDir dir;
-  test::write_file(dir / "graph.yaml", fmt::format(R"(groups:
+  test::write_file(dir / "graph.yaml",
+                   fmt::format(R"(groups:
   - name: source
     components:
       - plugin: sequence_source
         name: source
-        parameters: {{count: 10000, batch: 200, period_s: 0.002}}
+        parameters: {{count: 10000, batch: 200, period_s: 0.002, summary_file: "{}"}}
   - name: sink
     components:
       - plugin: sequence_sink
         name: sink
-        parameters: {{expect: 10000, summary_file: "{}", timeout_s: 120}}
+        parameters: {{{}}}
 )",
-                                                   (dir / "summary.yaml").string()));
-  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()},
-                                          environment(11), std::chrono::seconds(180));
+                               (dir / "source.yaml").string(),
+                               sink(fmt::format("expect: 10000, summary_file: \"{}\", "
+                                                "timeout_s: 300",
+                                                (dir / "summary.yaml").string()))));
+  auto [code, output] = test::run_command({launcher(), (dir / "graph.yaml").string()}, env(21),
+                                          std::chrono::seconds(400));
   ASSERT_EQ(code, 0) << output;
   auto summary = test::read_summary(dir / "summary.yaml");
   EXPECT_EQ(summary.at("received"), 10000);
+  EXPECT_EQ(summary.at("first"), 0);
+  EXPECT_EQ(summary.at("last"), 9999);
   EXPECT_EQ(summary.at("missing"), 0);
   EXPECT_EQ(summary.at("out_of_order"), 0);
   EXPECT_EQ(summary.at("corrupt"), 0);
   EXPECT_EQ(output.find("dropped"), std::string::npos) << output;
+  auto source = test::read_summary(dir / "source.yaml");
+  EXPECT_EQ(source.at("published"), 10000);
+  EXPECT_EQ(source.at("dropped"), 0);
+  if (GetParam() == Load::SlowSubscriber) {
+    // 10,000 messages in about 0.2 s against 50 s of work: the publisher waited, and said so.
+    EXPECT_GT(source.at("waited"), 1000);
+    EXPECT_GT(source.at("blocked_ms"), 30000);
+    EXPECT_NE(output.find("publisher waits for DDS subscriber(s) in 'sink'"), std::string::npos)
+        << output;
+  }
+  if (GetParam() == Load::StallingSubscriber) {
+    EXPECT_GT(source.at("longest_wait_ms"), 500);  // through a whole stall
+  }
+}
+
+TEST_P(ReliableUnderLoad, ARestartedSubscriberProcessReceivesAgain) {
+  test::TempDir dir;
+  auto environment = env(25);
+  // 1000 messages a second: more than a slow subscriber takes, so the publisher waits for it
+  // when the first subscriber is killed.
+  test::write_file(dir / "source.yaml",
+                   source_yaml("count: 0, batch: 10, period_s: 0.01, subscribers: 0"));
+  test::write_file(dir / "sink.yaml",
+                   sink_yaml(sink(fmt::format("expect: 0, log_every: 20, timeout_s: 300, "
+                                              "summary_file: \"{}\"",
+                                              (dir / "summary.yaml").string()))));
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, environment,
+                            dir / "source.log");
+
+  test::ChildProcess first({launcher(), (dir / "sink.yaml").string()}, environment,
+                           dir / "first.log");
+  ASSERT_TRUE(first.wait_for_output("received 200", std::chrono::seconds(60))) << first.output();
+  first.signal(SIGKILL);  // no goodbye to the publisher
+  ASSERT_EQ(first.wait(std::chrono::seconds(10)), 128 + SIGKILL);
+
+  test::ChildProcess second({launcher(), (dir / "sink.yaml").string()}, environment,
+                            dir / "second.log");
+  EXPECT_TRUE(second.wait_for_output("received 200", std::chrono::seconds(60)))
+      << second.output() << source.output();
+  second.signal(SIGTERM);
+  EXPECT_EQ(second.wait(std::chrono::seconds(30)), 0) << second.output();
+  // From its first message on, the second subscriber got every one, once, in order.
+  auto summary = test::read_summary(dir / "summary.yaml");
+  EXPECT_GE(summary.at("received"), 200);
+  EXPECT_EQ(summary.at("last") - summary.at("first") + 1, summary.at("received"));
+  EXPECT_EQ(summary.at("missing"), 0);
+  EXPECT_EQ(summary.at("out_of_order"), 0);
+  EXPECT_EQ(summary.at("corrupt"), 0);
+  source.signal(SIGTERM);
+  EXPECT_EQ(source.wait(std::chrono::seconds(30)), 0) << source.output();
+  EXPECT_EQ(source.output().find("dropped"), std::string::npos) << source.output();
+}
+
+TEST_P(ReliableUnderLoad, ALatchedSampleReachesAProcessStartedLater) {
+  test::TempDir dir;
+  auto environment = env(50);
+  test::write_file(dir / "source.yaml", source_yaml("count: 1, subscribers: 0", "latched"));
+  test::write_file(
+      dir / "sink.yaml",
+      sink_yaml(sink(fmt::format("expect: 1, summary_file: \"{}\"", (dir / "summary").string())),
+                "latched"));
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, environment,
+                            dir / "source.log");
+  ASSERT_TRUE(source.wait_for_output("published 1 messages", std::chrono::seconds(30)));
+  auto [code, output] = test::run_command({launcher(), (dir / "sink.yaml").string()}, environment);
+  EXPECT_EQ(code, 0) << output;
+  auto summary = test::read_summary(dir / "summary");
+  EXPECT_EQ(summary.at("received"), 1);
+  EXPECT_EQ(summary.at("first"), 0);
+  source.signal(SIGTERM);
+}
+
+// A publisher waiting for a slow subscriber in another process resumes as soon as that
+// subscriber leaves, not after DDS's lease on it (5 s) runs out.
+TEST(Dds, ASubscriberThatLeavesReleasesAWaitingPublisherAtOnce) {
+  test::TempDir dir;
+  auto env = environment(19);
+  test::write_file(dir / "source.yaml",
+                   source_yaml(fmt::format("count: 20000, batch: 20, period_s: 0.002, "
+                                           "subscribers: 1, summary_file: \"{}\"",
+                                           (dir / "source.summary").string())));
+  test::write_file(dir / "slow.yaml",
+                   sink_yaml("expect: 0, work_s: 0.005, log_every: 100, timeout_s: 300"));
+  test::write_file(dir / "fast.yaml", sink_yaml(fmt::format("expect: 0, timeout_s: 300, "
+                                                            "summary_file: \"{}\"",
+                                                            (dir / "fast.summary").string())));
+  test::ChildProcess slow({launcher(), (dir / "slow.yaml").string()}, env, dir / "slow.log");
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+  ASSERT_TRUE(source.wait_for_output("publisher waits for DDS subscriber(s) in 'sink'",
+                                     std::chrono::seconds(60)))
+      << source.output() << slow.output();
+  test::ChildProcess fast({launcher(), (dir / "fast.yaml").string()}, env, dir / "fast.log");
+  ASSERT_TRUE(slow.wait_for_output("received 300", std::chrono::seconds(60))) << slow.output();
+  slow.signal(SIGTERM);  // a goodbye: its reader leaves the graph at once
+  ASSERT_EQ(slow.wait(std::chrono::seconds(30)), 0) << slow.output();
+  ASSERT_TRUE(source.wait_for_output("published 20000 messages", std::chrono::seconds(120)))
+      << source.output();
+  auto published = test::read_summary(dir / "source.summary");
+  EXPECT_EQ(published.at("dropped"), 0);
+  EXPECT_LT(published.at("longest_wait_ms"), 5000);
+  fast.signal(SIGTERM);
+  EXPECT_EQ(fast.wait(std::chrono::seconds(30)), 0) << fast.output();
+  auto summary = test::read_summary(dir / "fast.summary");
+  EXPECT_EQ(summary.at("last"), 19999);
+  EXPECT_EQ(summary.at("last") - summary.at("first") + 1, summary.at("received"));
+  EXPECT_EQ(summary.at("missing"), 0);
+  source.signal(SIGTERM);
 }
 
 // A topic with subscribers in the publisher's process and in another: the local one still
@@ -127,21 +272,6 @@ TEST(Dds, LocalDeliveryStaysZeroCopyAndSingleBesideARemoteSubscriber) {
   EXPECT_EQ(remote_summary.at("received"), 500);
   EXPECT_EQ(remote_summary.at("missing"), 0);
   EXPECT_EQ(remote_summary.at("same_object"), 0);
-}
-
-TEST(Dds, ALatchedSampleReachesAProcessStartedLater) {
-  test::TempDir dir;
-  auto env = environment(13);
-  test::write_file(dir / "source.yaml", source_yaml("count: 1, subscribers: 0", "latched"));
-  test::write_file(dir / "sink.yaml", sink_yaml(fmt::format("expect: 1, summary_file: \"{}\"",
-                                                            (dir / "summary").string()),
-                                                "latched"));
-  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
-  ASSERT_TRUE(source.wait_for_output("published 1 messages", std::chrono::seconds(30)));
-  auto [code, output] = test::run_command({launcher(), (dir / "sink.yaml").string()}, env);
-  EXPECT_EQ(code, 0) << output;
-  EXPECT_EQ(test::read_summary(dir / "summary").at("received"), 1);
-  source.signal(SIGTERM);
 }
 
 TEST(Dds, TopicToolListsEchoesAndMeasures) {

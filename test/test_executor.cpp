@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -50,6 +52,58 @@ TEST(Executor, AStrandWithEndlessWorkDoesNotStarveOthers) {
   EXPECT_TRUE(eventually([&] { return single->done == 1; }));
   executor.stop();
   EXPECT_GT(endless->done, 0);
+}
+
+// A waitable whose one callback runs `body`.
+class Once final : public Waitable {
+ public:
+  explicit Once(std::function<void()> body) : Waitable("once"), body_(std::move(body)) {}
+  bool execute_one() override {
+    if (done_.exchange(true)) return false;
+    run_callback(body_);
+    return true;
+  }
+
+ private:
+  std::function<void()> body_;
+  std::atomic<bool> done_{false};
+};
+
+TEST(Executor, ACallbackWaitingForAnothersWorkLendsItsThread) {
+  Executor executor(1);
+  Logger logger("test");
+  Strand waiter(executor, logger), worker(executor, logger);
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool work_done = false, waiter_done = false;
+  // The waiter needs the worker's callback, which can only run if the executor's one thread,
+  // held by the waiter, is lent to it.
+  waiter.add(std::make_shared<Once>([&] {
+    WaitingScope waiting;
+    std::unique_lock lock(mutex);
+    changed.wait_for(lock, std::chrono::seconds(30), [&] { return work_done; });
+    waiter_done = work_done;
+  }));
+  worker.add(std::make_shared<Once>([&] {
+    std::lock_guard lock(mutex);
+    work_done = true;
+    changed.notify_all();
+  }));
+  waiter.enable();
+  worker.enable();
+  executor.start();
+  waiter.notify();
+  // Usually the waiter waits by now and the worker gets a new thread; otherwise the waiter
+  // finds the worker ready when it begins to wait. Either way one more thread runs it.
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  worker.notify();
+  EXPECT_TRUE(eventually([&] {
+    std::lock_guard lock(mutex);
+    return waiter_done;
+  }));
+  EXPECT_EQ(executor.threads_started(), 2);
+  executor.stop();
+  EXPECT_EQ(executor.threads_started(), 0);  // all joined
 }
 
 TEST(Executor, NothingRunsBeforeEnable) {
@@ -158,6 +212,12 @@ TEST_F(DispatchTest, HandsSlowCallbacksToTheExecutor) {
   EXPECT_TRUE(recorder->dispatch_ran_here(strand));
   EXPECT_FALSE(recorder->dispatch_ran_here(strand));
   EXPECT_FALSE(recorder->dispatch_ran_here(strand));
+}
+
+TEST_F(DispatchTest, NeverRunsCallbacksThatMayWaitForASubscriberHere) {
+  warm_up();
+  strand.set_may_wait();
+  for (int i = 0; i < 5; ++i) EXPECT_FALSE(recorder->dispatch_ran_here(strand));
 }
 
 TEST_F(DispatchTest, StopWaitsForACallbackRunningOnAnotherThread) {

@@ -57,7 +57,7 @@ groups:
       - plugin: sequence_source
         name: source
         parameters: {count: 20, period_s: 1}
-        qos: {/test/sequence: {profile: reliable, depth: 50}}
+        qos: {/test/sequence: {profile: reliable, depth: 50, max_blocking_s: 0.25}}
   - name: sink
     components:
       - plugin: sequence_sink
@@ -78,6 +78,9 @@ TEST_F(LaunchFileTest, ReadsAValidFile) {
   EXPECT_EQ(source.plugin->name, "sequence_source");
   EXPECT_EQ(source.config.parameters.at("count"), ParameterValue(int64_t{20}));
   EXPECT_EQ(source.config.qos.at("/test/sequence").depth, 50);
+  EXPECT_EQ(source.config.qos.at("/test/sequence").max_blocking, std::chrono::milliseconds(250));
+  EXPECT_EQ(source.config.qos.at("/test/sequence").to_string(),
+            "reliable, volatile, keep_all 50, max_blocking 250 ms");
   EXPECT_EQ(source.line, 9);
   EXPECT_EQ(file.groups[1].components.at(0).config.remaps.at("/test/sequence"), "/other");
   EXPECT_EQ(file.component_count(), 2u);
@@ -192,7 +195,7 @@ TEST_F(LaunchFileTest, ParameterNamesTypesAndRanges) {
             "expects int >= 1, got double 2.5");
   EXPECT_EQ(list[3],
             "launch.yaml:10: component 'source' (sequence_source): unknown parameter "
-            "'colour' (parameters: count, batch, period_s, subscribers)");
+            "'colour' (parameters: count, batch, period_s, subscribers, summary_file)");
   EXPECT_EQ(list[4],
             "launch.yaml:11: component 'source' (sequence_source): parameter "
             "'subscribers' expects int >= 0, got string \"1\"");
@@ -281,6 +284,37 @@ TEST_F(LaunchFileTest, RemapsAndQos) {
   EXPECT_EQ(list[3],
             "launch.yaml:7: component 'sink' (sequence_sink): QoS for unknown topic "
             "'/nothing' (topics: /test/sequence)");
+}
+
+TEST_F(LaunchFileTest, MaxBlockingIsAReliablePublishersLimit) {
+  auto list = problems(R"(groups:
+  - name: g
+    components:
+      - plugin: sequence_source
+        name: source
+        qos: {/test/sequence: {profile: sensor_data, max_blocking_s: 0.1}}
+      - plugin: sequence_source
+        name: source2
+        qos: {/test/sequence: {profile: reliable, max_blocking_s: forever}}
+      - plugin: sequence_source
+        name: source3
+        qos: {/test/sequence: {profile: reliable, max_blocking_s: 0}}
+      - plugin: sequence_sink
+        name: sink
+        qos: {/test/sequence: {profile: reliable, max_blocking_s: 1}}
+)");
+  ASSERT_EQ(list.size(), 4u) << ::testing::PrintToString(list);
+  EXPECT_EQ(list[0],
+            "launch.yaml:6: QoS for '/test/sequence': max_blocking_s applies to the reliable "
+            "profile (keep_all), not to sensor_data");
+  EXPECT_EQ(list[1],
+            "launch.yaml:9: 'max_blocking_s' must be a number of seconds in [0.001, 3600]");
+  EXPECT_EQ(list[2],
+            "launch.yaml:12: 'max_blocking_s' must be a number of seconds in [0.001, 3600]");
+  EXPECT_EQ(list[3],
+            "launch.yaml:15: component 'sink' (sequence_sink): QoS for '/test/sequence': "
+            "max_blocking_s limits a publisher's wait, and the component subscribes to this "
+            "topic");
 }
 
 TEST_F(LaunchFileTest, DdsAndGroupSettings) {

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <fstream>
 #include <random>
@@ -104,6 +105,24 @@ std::optional<int> ChildProcess::wait(std::chrono::seconds timeout) {
 
 void ChildProcess::signal(int signal_number) {
   if (!exit_code_) kill(pid_, signal_number);
+}
+
+BusyCores::BusyCores() {
+  unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  for (unsigned i = 0; i < cores; ++i) {
+    int pid = fork();
+    if (pid == 0) {
+      // Only async-signal-safe work after fork() in a threaded process: a bare loop.
+      volatile uint64_t spin = 0;
+      for (;;) spin = spin + 1;
+    }
+    if (pid > 0) pids_.push_back(pid);
+  }
+}
+
+BusyCores::~BusyCores() {
+  for (int pid : pids_) kill(pid, SIGKILL);
+  for (int pid : pids_) waitpid(pid, nullptr, 0);
 }
 
 std::pair<int, std::string> run_command(const std::vector<std::string>& argv,

@@ -59,6 +59,20 @@ class ChildProcess {
   std::filesystem::path output_file_;
 };
 
+// Every core kept busy by other processes (one busy loop per core, at the tests' priority)
+// while the object lives: the machine a robot's computer often is.
+class BusyCores {
+ public:
+  BusyCores();
+  ~BusyCores();  // kills and reaps them
+  BusyCores(const BusyCores&) = delete;
+  BusyCores& operator=(const BusyCores&) = delete;
+  size_t processes() const { return pids_.size(); }
+
+ private:
+  std::vector<int> pids_;
+};
+
 // Runs a command to completion; returns its exit code and output.
 std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
                                         std::map<std::string, std::string> environment = {},

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <mocap/waiting_scope.hpp>
 
 namespace mocap::bag {
 
@@ -51,6 +52,7 @@ struct Recorder::State {
       Item item = std::move(queue.front());
       queue.pop_front();
       queued_bytes -= item.size;
+      room.notify_all();
       lock.unlock();
       write(item, buffer);
       lock.lock();
@@ -115,6 +117,7 @@ struct Recorder::State {
   BagWriter writer;
   mutable std::mutex mutex;  // the queue, the counts, the error
   std::condition_variable arrived;
+  std::condition_variable room;  // for record() while the queue holds max_queued_bytes
   std::deque<Item> queue;
   size_t queued_bytes = 0;
   bool closing = false, closed = false;
@@ -150,9 +153,17 @@ void Recorder::record(uint32_t topic_id, int64_t timestamp_ns, std::shared_ptr<c
                           ? static_cast<const std::vector<uint8_t>*>(message.get())->size()
                           : type->serialized_size(message.get());
   {
-    std::lock_guard guard(state_->mutex);
-    if (state_->closing || state_->first_error ||
-        state_->queued_bytes + size > state_->options.max_queued_bytes) {
+    std::unique_lock lock(state_->mutex);
+    // A message larger than the whole queue goes alone.
+    auto room = [&] {
+      return state_->closing || state_->first_error || state_->queued_bytes == 0 ||
+             state_->queued_bytes + size <= state_->options.max_queued_bytes;
+    };
+    if (!room()) {
+      WaitingScope waiting;  // the bag_recorder's callback: other components run meanwhile
+      state_->room.wait(lock, room);
+    }
+    if (state_->closing || state_->first_error) {
       ++state_->stats.dropped;
       return;
     }
@@ -169,6 +180,7 @@ std::optional<std::string> Recorder::close() {
     state_->closing = true;
   }
   state_->arrived.notify_one();
+  state_->room.notify_all();
   if (state_->thread.joinable()) state_->thread.join();
   try {
     state_->writer.close();

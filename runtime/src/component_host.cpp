@@ -36,6 +36,7 @@ class HostPublisher final : public PublisherPort {
   void publish(std::shared_ptr<const void> message) override {
     if (message == nullptr) throw std::invalid_argument("publish() of a null message on " + topic_);
     Clock::time_point now = Clock::now();
+    published_.fetch_add(1, std::memory_order_relaxed);
     for (auto& port : ports_) port->publish(message, now);
   }
 
@@ -47,10 +48,24 @@ class HostPublisher final : public PublisherPort {
 
   const std::string& topic() const override { return topic_; }
 
+  PublisherStats stats() const override {
+    PublisherStats total;
+    total.published = published_.load(std::memory_order_relaxed);
+    for (const auto& port : ports_) {
+      PublisherStats stats = port->stats();
+      total.waited += stats.waited;
+      total.blocked += stats.blocked;
+      total.longest_wait = std::max(total.longest_wait, stats.longest_wait);
+      total.dropped += stats.dropped;
+    }
+    return total;
+  }
+
   std::vector<std::unique_ptr<TransportPublisher>> ports_;
 
  private:
   std::string topic_;
+  std::atomic<uint64_t> published_{0};
 };
 
 // A subscription as the executor sees it: takes from every transport in turn.
@@ -125,6 +140,13 @@ std::vector<std::string> check_component_config(const ComponentSpec& spec,
     if (!declared(topic)) {
       problems.push_back(fmt::format("QoS for unknown topic '{}'{}", topic,
                                      did_you_mean(topic, topic_names, "topics")));
+    } else if (const TopicSpec* subscribed = spec.find_topic(topic);
+               qos.max_blocking && subscribed != nullptr &&
+               subscribed->direction == TopicDirection::Subscribe) {
+      problems.push_back(
+          fmt::format("QoS for '{}': max_blocking_s limits a publisher's wait, and the component "
+                      "subscribes to this topic",
+                      topic));
     }
   }
   return problems;
@@ -239,6 +261,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
   }
 
   std::shared_ptr<PublisherPort> advertise_endpoint(const Endpoint& endpoint) {
+    if (publisher_may_wait(endpoint.qos, Qos::reliable())) strand_.set_may_wait();
     auto publisher = std::make_shared<HostPublisher>(endpoint.topic);
     for (auto& transport : host_.transports) {
       publisher->ports_.push_back(transport->advertise(endpoint));
@@ -453,6 +476,9 @@ int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
 
 void ComponentHost::stop() {
   impl_->timers.stop();
+  // Callbacks waiting for a subscriber's room would hold the executor's stop up forever: the
+  // subscribers in this process no longer run, those in others may not catch up.
+  for (auto& transport : impl_->transports) transport->stop_waiting();
   impl_->executor.stop();
 }
 

@@ -4,6 +4,12 @@
 #include <exception>
 
 namespace mocap {
+namespace {
+
+// The executor whose thread this is, if any.
+thread_local Executor* current_executor = nullptr;
+
+}  // namespace
 
 Executor::Executor(int threads)
     : thread_count_(threads > 0
@@ -16,22 +22,58 @@ void Executor::start() {
   std::lock_guard lock(mutex_);
   if (started_ || stopping_) return;
   started_ = true;
-  for (int i = 0; i < thread_count_; ++i) threads_.emplace_back([this] { work(); });
+  for (int i = 0; i < thread_count_; ++i) start_thread();
+}
+
+void Executor::start_thread() {
+  threads_.emplace_back([this] {
+    current_executor = this;
+    work();
+  });
 }
 
 void Executor::stop() {
+  std::vector<std::thread> threads;
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
     ready_.clear();
+    threads.swap(threads_);  // no thread starts once stopping
   }
   ready_cv_.notify_all();
-  for (std::thread& thread : threads_) {
+  for (std::thread& thread : threads) {
     if (thread.joinable()) thread.join();
   }
-  threads_.clear();
   std::unique_lock lock(mutex_);
   foreign_runs_done_.wait(lock, [this] { return foreign_runs_ == 0; });
+}
+
+int Executor::threads_started() const {
+  std::lock_guard lock(mutex_);
+  return static_cast<int>(threads_.size());
+}
+
+WaitingScope::WaitingScope() : executor_(current_executor) {
+  if (executor_ == nullptr) return;
+  {
+    std::lock_guard lock(executor_->mutex_);
+    --executor_->running_;
+    ++executor_->waiting_;
+    // Every thread runs or waits: one more takes this one's place, if there is work for it.
+    int others_free =
+        static_cast<int>(executor_->threads_.size()) - executor_->running_ - executor_->waiting_;
+    if (others_free == 0 && executor_->may_take_work() && !executor_->stopping_) {
+      executor_->start_thread();
+    }
+  }
+  executor_->ready_cv_.notify_one();
+}
+
+WaitingScope::~WaitingScope() {
+  if (executor_ == nullptr) return;
+  std::lock_guard lock(executor_->mutex_);
+  --executor_->waiting_;
+  ++executor_->running_;
 }
 
 bool Executor::begin_foreign_run() {
@@ -54,21 +96,25 @@ void Executor::schedule(Strand* strand) {
     std::lock_guard lock(mutex_);
     if (stopping_) return;
     ready_.push_back(strand);
+    // Threads that wait inside callbacks hold no place; without an idle thread, one more.
+    int free = static_cast<int>(threads_.size()) - running_ - waiting_;
+    if (started_ && free == 0 && running_ < thread_count_) start_thread();
   }
   ready_cv_.notify_one();
 }
 
 void Executor::work() {
+  std::unique_lock lock(mutex_);
   for (;;) {
-    Strand* strand;
-    {
-      std::unique_lock lock(mutex_);
-      ready_cv_.wait(lock, [this] { return stopping_ || !ready_.empty(); });
-      if (stopping_) return;
-      strand = ready_.front();
-      ready_.pop_front();
-    }
+    ready_cv_.wait(lock, [this] { return stopping_ || may_take_work(); });
+    if (stopping_) return;
+    Strand* strand = ready_.front();
+    ready_.pop_front();
+    ++running_;
+    lock.unlock();
     strand->run();
+    lock.lock();
+    --running_;
   }
 }
 
@@ -80,7 +126,7 @@ void Strand::notify() {
 }
 
 void Strand::dispatch() {
-  if (mean_callback_ns_.load() > kQuickCallbackNanoseconds) {
+  if (may_wait_.load() || mean_callback_ns_.load() > kQuickCallbackNanoseconds) {
     notify();
     return;
   }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <mocap/logger.hpp>
+#include <mocap/waiting_scope.hpp>
 
 #include "throttle.hpp"
 
@@ -48,7 +49,10 @@ class Waitable {
   int64_t callback_ns_ = 0;  // of the last callback
 };
 
-// A fixed pool of threads that runs ready strands in FIFO order.
+// A pool of threads that runs ready strands in FIFO order, at most `threads` at once. A thread
+// that waits inside a callback (mocap/waiting_scope.hpp: a publisher waiting for a subscriber)
+// does not count: another takes its place, started if none is idle, so that the callbacks it waits
+// for can run however many threads wait.
 class Executor {
  public:
   explicit Executor(int threads);  // threads <= 0: one per CPU core
@@ -67,17 +71,26 @@ class Executor {
   bool begin_foreign_run();
   void end_foreign_run();
 
+  // Threads started so far, those standing in for waiting ones included.
+  int threads_started() const;
+
  private:
+  friend class WaitingScope;
   void work();
+  void start_thread();  // requires mutex_
+  bool may_take_work() const { return !ready_.empty() && running_ < thread_count_; }
 
   int thread_count_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable ready_cv_;
   std::condition_variable foreign_runs_done_;
   std::deque<Strand*> ready_;
   bool started_ = false;
   bool stopping_ = false;
   int foreign_runs_ = 0;
+  // Threads by state: running a strand, waiting inside one, or neither (idle or starting).
+  int running_ = 0;
+  int waiting_ = 0;
   std::vector<std::thread> threads_;
 };
 
@@ -99,6 +112,10 @@ class Strand {
   // delivery, so that publishing never runs a subscriber's code. Quick callbacks keep the
   // transport's thread free for its other work.
   void dispatch();
+  // The strand's callbacks publish where they may have to wait for a subscriber. dispatch()
+  // then always hands them to the executor: a transport's thread that waited inside a
+  // callback could not receive the acknowledgements it waits for.
+  void set_may_wait() { may_wait_.store(true); }
   // A strand runs nothing before it is enabled, so that a component's subscriptions cannot
   // call into it before its constructor has returned. Notifications are kept until then.
   void enable();
@@ -122,6 +139,7 @@ class Strand {
   std::atomic<bool> enabled_{false};
   std::atomic<bool> scheduled_{false};
   std::atomic<bool> pending_{false};
+  std::atomic<bool> may_wait_{false};
   std::atomic<uint64_t> callback_errors_{0};
   // Moving average over about 16 callbacks; starts slow, so that a component's callbacks
   // run on a transport's thread only once they have shown to be quick.

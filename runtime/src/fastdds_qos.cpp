@@ -135,7 +135,7 @@ void apply(const Qos& qos, EndpointQos& out) {
   out.reliability().kind = qos.reliability == Reliability::Reliable
                                ? dds::RELIABLE_RELIABILITY_QOS
                                : dds::BEST_EFFORT_RELIABILITY_QOS;
-  out.reliability().max_blocking_time = {0, kReliableBlockingMilliseconds * 1000000u};
+  out.reliability().max_blocking_time = {0, static_cast<uint32_t>(kWriteWaitSlice.count())};
   out.durability().kind = qos.durability == Durability::TransientLocal
                               ? dds::TRANSIENT_LOCAL_DURABILITY_QOS
                               : dds::VOLATILE_DURABILITY_QOS;
@@ -162,15 +162,29 @@ dds::DataWriterQos to_writer_qos(const Qos& qos) {
   dds::DataWriterQos out;
   apply(qos, out);
   // A sample lost in transit is repaired when the reader answers a heartbeat. Fast DDS's
-  // default period, 3 s, would outlast a reliable publisher's wait for room; heartbeats are
-  // only sent while samples are unacknowledged, so a short period costs nothing when idle.
+  // default period, 3 s, would hold a waiting publisher up that long after a loss; heartbeats
+  // are only sent while samples are unacknowledged, so a short period costs nothing when idle.
   out.reliable_writer_qos().times.heartbeatPeriod = {0, 25000000u};
+  if (qos.history == History::KeepAll && qos.durability == Durability::Volatile) {
+    // The samples a subscriber may fall behind wait in its reader's history (`depth`); the
+    // writer keeps only those in flight. A reader whose history is full rejects what arrives
+    // and asks for it again at every heartbeat, and the writer sends again all it holds: with
+    // the whole depth in the writer too, a subscriber slower than its publisher costs both
+    // processes about twice the CPU time in resends (bench/backpressure_bench).
+    int in_flight = std::min(qos.depth, kWriterSamplesInFlight);
+    out.history().depth = in_flight;
+    out.resource_limits().max_samples = in_flight;
+    out.resource_limits().max_samples_per_instance = in_flight;
+  }
   return out;
 }
 
 dds::DataReaderQos to_reader_qos(const Qos& qos) {
   dds::DataReaderQos out;
   apply(qos, out);
+  // Acknowledge at once: a writer with few samples in flight waits for each acknowledgement,
+  // and Fast DDS's default 5 ms delay would cap a stream at kWriterSamplesInFlight per 5 ms.
+  out.reliable_reader_qos().times.heartbeatResponseDelay = {0, 0u};
   return out;
 }
 

@@ -3,6 +3,7 @@
 // makes of its `dds:` settings.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -20,6 +21,15 @@ namespace mocap {
 
 // Shared memory of each participant for messages to processes on the same host.
 constexpr uint32_t kSharedMemorySegmentBytes = 8 * 1024 * 1024;
+
+// The longest one DDS write waits for room in a full keep-all history (the writer's
+// max_blocking_time). A publisher that must wait longer writes again (FastDdsTransport), so
+// that it sees the process stopping and Qos::max_blocking in time.
+constexpr std::chrono::nanoseconds kWriteWaitSlice = std::chrono::milliseconds(5);
+
+// Samples a reliable keep-all (volatile) writer keeps unacknowledged: its window. The depth of
+// such a topic is kept by the readers (to_writer_qos says why).
+constexpr int kWriterSamplesInFlight = 32;
 
 eprosima::fastdds::dds::DataWriterQos to_writer_qos(const Qos& qos);
 eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);

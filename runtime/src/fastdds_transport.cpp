@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include <fastdds/rtps/common/InstanceHandle.h>
@@ -23,6 +25,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "executor.hpp"
 #include "fastdds_qos.hpp"
 #include "fastdds_type_adapter.hpp"
 #include "shared_memory_cleanup.hpp"
@@ -101,6 +104,15 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
       std::erase_if(endpoints_,
                     [&](const auto& entry) { return entry.first.guidPrefix == prefix; });
     }
+  }
+
+  // The name a participant announced, or its GUID prefix while it is not known.
+  std::string participant_name(const rtps::GuidPrefix_t& prefix) const {
+    std::lock_guard lock(mutex_);
+    if (auto it = participants_.find(prefix); it != participants_.end()) return it->second;
+    std::ostringstream text;
+    text << prefix;
+    return text.str();
   }
 
   std::vector<DiscoveredEndpoint> endpoints() const {
@@ -186,7 +198,7 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
       : transport_(transport),
         endpoint_(endpoint),
         own_prefix_(transport.participant_->guid().guidPrefix),
-        drops_(endpoint, "publisher") {
+        report_(endpoint) {
     const TopicUse& use = transport.acquire_topic(endpoint);
     topic_ = use.topic;
     local_writers_ = use.local_writers;
@@ -212,13 +224,13 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   void publish(const std::shared_ptr<const void>& message, Clock::time_point) override {
     // Nobody in another process listens, and nobody who joins later may ask for it.
     if (remote_readers_.load() == 0 && endpoint_.qos.durability == Durability::Volatile) return;
-    auto result = write(message.get());
-    if (result == ReturnCode_t::RETCODE_TIMEOUT) {
-      drops_.count(1, fmt::format("a reliable DDS subscriber is {} samples behind and did not "
-                                  "catch up within {} ms",
-                                  endpoint_.qos.depth, kReliableBlockingMilliseconds));
-    } else if (result != ReturnCode_t::RETCODE_OK) {
-      drops_.count(1, fmt::format("DDS write failed (code {})", result()));
+    auto start = std::chrono::steady_clock::now();
+    writing = true;
+    ReturnCode_t result = writer_->write(const_cast<void*>(message.get()), dds::HANDLE_NIL);
+    if (result == ReturnCode_t::RETCODE_TIMEOUT) result = wait_and_write(message.get(), start);
+    writing = false;
+    if (result != ReturnCode_t::RETCODE_OK && result != ReturnCode_t::RETCODE_TIMEOUT) {
+      report_.count_drop(1, fmt::format("DDS write failed (code {})", result()));
     }
   }
 
@@ -226,27 +238,18 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
     return static_cast<size_t>(remote_readers_.load());
   }
 
-  // Fast DDS 2.9 can report a timeout long before the blocking time has passed: when acks
-  // free a full keep-all history, a volatile writer removes the acknowledged samples itself,
-  // and the waiting write, finding no sample left to remove, gives up although there is room
-  // now. Writing again within the blocking time succeeds at once.
-  ReturnCode_t write(const void* message) {
-    auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::milliseconds(kReliableBlockingMilliseconds);
-    writing = true;
-    ReturnCode_t result;
-    do {
-      result = writer_->write(const_cast<void*>(message), dds::HANDLE_NIL);
-    } while (result == ReturnCode_t::RETCODE_TIMEOUT &&
-             std::chrono::steady_clock::now() < deadline);
-    writing = false;
-    return result;
-  }
+  PublisherStats stats() const override { return report_.stats(); }
 
   void on_publication_matched(dds::DataWriter*,
                               const dds::PublicationMatchedStatus& status) override {
-    if (prefix_of(status.last_subscription_handle) != own_prefix_) {
-      remote_readers_.fetch_add(status.current_count_change);
+    rtps::GuidPrefix_t prefix = prefix_of(status.last_subscription_handle);
+    if (prefix == own_prefix_) return;
+    remote_readers_.fetch_add(status.current_count_change);
+    std::lock_guard lock(matched_mutex_);
+    if (status.current_count_change > 0) {
+      matched_prefixes_.insert(prefix);
+    } else if (auto it = matched_prefixes_.find(prefix); it != matched_prefixes_.end()) {
+      matched_prefixes_.erase(it);
     }
   }
 
@@ -260,14 +263,62 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   }
 
  private:
+  // The history is full of samples a reliable reader has not acknowledged: write again until
+  // there is room. Fast DDS wakes a waiting write as soon as acknowledgements free a sample, or
+  // the reader goes away (unmatched: its acknowledgements no longer count); each write waits at
+  // most kWriteWaitSlice, so that stop_waiting() and Qos::max_blocking are seen in time. Fast
+  // DDS 2.9 also reports timeouts before that when acks free a full keep-all history (a
+  // volatile writer removes the acknowledged samples itself, and the waiting write, finding none
+  // left to remove, gives up although there is room); writing again succeeds at once.
+  ReturnCode_t wait_and_write(const void* message, std::chrono::steady_clock::time_point start) {
+    ReturnCode_t result = ReturnCode_t::RETCODE_TIMEOUT;
+    std::optional<std::string> given_up;
+    {
+      WaitingScope waiting;
+      while (result == ReturnCode_t::RETCODE_TIMEOUT) {
+        if (transport_.stopped_waiting_.load()) {
+          given_up = "the process is stopping and a DDS subscriber has not acknowledged " +
+                     std::to_string(endpoint_.qos.depth) + " samples";
+          break;
+        }
+        if (endpoint_.qos.max_blocking &&
+            std::chrono::steady_clock::now() - start >= *endpoint_.qos.max_blocking) {
+          given_up = fmt::format("{} had no room for max_blocking {} ms", subscribers(),
+                                 endpoint_.qos.max_blocking->count());
+          break;
+        }
+        result = writer_->write(const_cast<void*>(message), dds::HANDLE_NIL);
+      }
+    }
+    report_.count_wait(std::chrono::steady_clock::now() - start, subscribers());
+    if (given_up) report_.count_drop(1, *given_up);
+    return result;
+  }
+
+  // "DDS subscriber(s) in 'sink', 'recorder'": the participants of the matched readers.
+  // (Fast DDS 2.9 does not implement DataWriter::get_matched_subscriptions().)
+  std::string subscribers() const {
+    std::set<std::string> names;
+    {
+      std::lock_guard lock(matched_mutex_);
+      for (const auto& prefix : matched_prefixes_) {
+        names.insert(transport_.listener_->participant_name(prefix));
+      }
+    }
+    if (names.empty()) return "a DDS subscriber";
+    return fmt::format("DDS subscriber(s) in '{}'", fmt::join(names, "', '"));
+  }
+
   FastDdsTransport& transport_;
   Endpoint endpoint_;
   rtps::GuidPrefix_t own_prefix_;
-  DropReport drops_;
+  PublisherReport report_;
   dds::Topic* topic_ = nullptr;
   std::shared_ptr<std::atomic<int>> local_writers_;
   dds::DataWriter* writer_ = nullptr;
   std::atomic<int> remote_readers_{0};
+  mutable std::mutex matched_mutex_;
+  std::multiset<rtps::GuidPrefix_t> matched_prefixes_;  // of remote readers
 };
 
 // ---------------------------------------------------------------------------------------
@@ -338,11 +389,18 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     drops_.count(static_cast<uint64_t>(status.total_count_change), "lost in transit (best effort)");
   }
 
-  // A reliable reader's rejected samples are sent again; only a best-effort reader's are lost.
+  // A reliable reader's rejected samples are sent again: its publishers wait for it. Only a
+  // best-effort reader's are lost.
   void on_sample_rejected(dds::DataReader*, const dds::SampleRejectedStatus& status) override {
+    auto count = static_cast<uint64_t>(status.total_count_change);
     if (endpoint_.qos.reliability == Reliability::BestEffort) {
-      drops_.count(static_cast<uint64_t>(status.total_count_change),
-                   "rejected: the subscriber's queue is full");
+      drops_.count(count, "rejected: the subscriber's queue is full");
+    } else if (holding_back_.count(count)) {
+      Logger(endpoint_.owner)
+          .info(
+              "{}: subscriber '{}' has {} samples waiting to be taken; its DDS publishers wait "
+              "for it (reliable, keep_all)",
+              endpoint_.topic, endpoint_.owner, endpoint_.qos.depth);
     }
   }
 
@@ -366,6 +424,7 @@ class FastDdsTransport::Reader final : public TransportSubscription,
   std::shared_ptr<MessagePool> pool_;
   rtps::GuidPrefix_t own_prefix_;
   DropReport drops_;
+  Throttle holding_back_{std::chrono::seconds(10)};
   dds::Topic* topic_ = nullptr;
   std::shared_ptr<std::atomic<int>> local_writers_;
   dds::DataReader* reader_ = nullptr;
@@ -411,6 +470,8 @@ std::unique_ptr<TransportSubscription> FastDdsTransport::subscribe(const Endpoin
                                                                    DataNotification on_data) {
   return std::make_unique<Reader>(*this, endpoint, std::move(on_data));
 }
+
+void FastDdsTransport::stop_waiting() { stopped_waiting_.store(true); }
 
 std::vector<DiscoveredEndpoint> FastDdsTransport::discovered_endpoints() const {
   return listener_->endpoints();

@@ -45,6 +45,7 @@ class FastDdsTransport final : public Transport {
   std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) override;
   std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
                                                    DataNotification on_data) override;
+  void stop_waiting() override;
 
   int domain_id() const { return domain_id_; }
   // Endpoints of other participants seen so far (alive ones only).
@@ -74,6 +75,7 @@ class FastDdsTransport final : public Transport {
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::mutex mutex_;
   std::map<std::string, TopicUse> topics_;
+  std::atomic<bool> stopped_waiting_{false};
 };
 
 // MOCAP_DOMAIN_ID if set (validated), otherwise `configured`.

@@ -1,7 +1,9 @@
 // Delivery between components of one process: the publisher's shared pointer itself, no copy
-// and no serialization, with the same QoS rules as DDS (including transient local).
+// and no serialization, with the same QoS rules as DDS (including transient local and the
+// wait of a reliable keep-all publisher for a subscriber without room).
 #pragma once
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -26,6 +28,7 @@ class IntraProcessTransport final : public Transport {
   std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) override;
   std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
                                                    DataNotification on_data) override;
+  void stop_waiting() override;
 
  private:
   struct Topic {
@@ -40,9 +43,18 @@ class IntraProcessTransport final : public Transport {
   void remove(Publisher* publisher);
   void remove(const std::shared_ptr<Queue>& subscription);
 
+  // Components that wait for one another's room, to see a wait that could never end coming:
+  // `publisher` waiting for `subscriber` when `subscriber` already waits, directly or through
+  // others, for `publisher`. Returns false (and records nothing) for such a cycle.
+  bool begin_wait(const std::string& publisher, const std::string& subscriber);
+  void end_wait(const std::string& publisher, const std::string& subscriber);
+
   // Guards the topics and who is connected to whom; never held while a publisher waits.
   std::shared_mutex mutex_;
   std::map<std::string, Topic, std::less<>> topics_;
+  std::atomic<bool> stopped_waiting_{false};
+  std::mutex waits_mutex_;
+  std::multimap<std::string, std::string> waiting_for_;  // publisher -> subscriber
 };
 
 }  // namespace mocap

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -112,11 +113,12 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
     return std::nullopt;
   }
   if (!node.IsMap()) {
-    problems.add(node,
-                 fmt::format("QoS for '{}' must be a profile name or {{profile, depth}}", topic));
+    problems.add(node, fmt::format("QoS for '{}' must be a profile name or {{profile, depth, "
+                                   "max_blocking_s}}",
+                                   topic));
     return std::nullopt;
   }
-  check_keys(node, std::vector<std::string>{"profile", "depth"},
+  check_keys(node, std::vector<std::string>{"profile", "depth", "max_blocking_s"},
              fmt::format("the QoS of '{}'", topic), problems);
   std::optional<Qos> qos;
   if (YAML::Node profile = node["profile"]) {
@@ -132,6 +134,26 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
     auto value = int_value(depth, "depth", 1, 1000000, problems);
     if (!value) return std::nullopt;
     qos->depth = static_cast<int>(*value);
+  }
+  if (YAML::Node limit = node["max_blocking_s"]) {
+    if (!publisher_may_wait(*qos, *qos)) {
+      problems.add(limit, fmt::format("QoS for '{}': max_blocking_s applies to the reliable "
+                                      "profile (keep_all), not to {}",
+                                      topic, node["profile"].Scalar()));
+      return std::nullopt;
+    }
+    std::optional<double> seconds;
+    try {
+      ParameterValue value = parameter_value_from_yaml(limit);
+      if (const double* number = std::get_if<double>(&value)) seconds = *number;
+      if (const int64_t* number = std::get_if<int64_t>(&value)) seconds = *number;
+    } catch (const std::invalid_argument&) {
+    }
+    if (!seconds || !(*seconds >= 0.001 && *seconds <= 3600)) {
+      problems.add(limit, "'max_blocking_s' must be a number of seconds in [0.001, 3600]");
+      return std::nullopt;
+    }
+    qos->max_blocking = std::chrono::milliseconds(std::llround(*seconds * 1000));
   }
   return qos;
 }

@@ -6,8 +6,11 @@
 // never reaches a subscriber twice.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include <mocap/component.hpp>
@@ -33,8 +36,11 @@ struct ReceivedMessage {
 class TransportPublisher {
  public:
   virtual ~TransportPublisher() = default;
+  // Waits while a reliable keep-all subscriber has no room (Qos::max_blocking).
   virtual void publish(const std::shared_ptr<const void>& message, Clock::time_point now) = 0;
   virtual size_t matched_subscribers() const = 0;
+  // Waits and drops; `published` stays 0 (the host counts publish() calls).
+  virtual PublisherStats stats() const = 0;
 };
 
 class TransportSubscription {
@@ -55,6 +61,9 @@ class Transport {
   virtual std::unique_ptr<TransportPublisher> advertise(const Endpoint& endpoint) = 0;
   virtual std::unique_ptr<TransportSubscription> subscribe(const Endpoint& endpoint,
                                                            DataNotification on_data) = 0;
+  // The process is stopping and subscribers will not catch up: publishers waiting for room
+  // give up now, and later ones do not wait (what does not fit is dropped and counted).
+  virtual void stop_waiting() = 0;
 };
 
 // Counts dropped samples of one endpoint and logs them at most every two seconds.
@@ -82,6 +91,62 @@ class DropReport {
   std::string topic_;
   std::string what_;
   Throttle throttle_;
+};
+
+}  // namespace mocap
+
+namespace mocap {
+
+// A publisher's waits for subscribers without room and the samples it gave up: counted for
+// stats(), logged with whom it waits for (at once, then at most every ten seconds), and
+// summed up when the publisher goes.
+class PublisherReport {
+ public:
+  explicit PublisherReport(const Endpoint& endpoint)
+      : logger_(endpoint.owner), topic_(endpoint.topic), drops_(endpoint, "publisher") {}
+  ~PublisherReport() {
+    std::lock_guard lock(mutex_);
+    if (stats_.waited > 0) {
+      logger_.info(
+          "{}: publisher waited {:.3f} s in all for subscribers without room ({} "
+          "sample(s) waited, the longest {:.1f} ms)",
+          topic_, seconds(stats_.blocked), stats_.waited, seconds(stats_.longest_wait) * 1e3);
+    }
+  }
+
+  // One sample waited `waited` for `whom` ("subscriber 'sink' in this process").
+  void count_wait(std::chrono::nanoseconds waited, std::string_view whom) {
+    std::lock_guard lock(mutex_);
+    ++stats_.waited;
+    stats_.blocked += waited;
+    stats_.longest_wait = std::max(stats_.longest_wait, waited);
+    if (auto since_last = waits_.count()) {
+      logger_.info(
+          "{}: publisher waits for {} ({} sample(s) waited, {:.3f} s in all): a "
+          "reliable keep_all subscriber sets the pace",
+          topic_, whom, stats_.waited, seconds(stats_.blocked));
+    }
+  }
+  void count_drop(uint64_t n, std::string_view reason) { drops_.count(n, reason); }
+
+  PublisherStats stats() const {
+    std::lock_guard lock(mutex_);
+    PublisherStats stats = stats_;
+    stats.dropped = drops_.total();
+    return stats;
+  }
+
+ private:
+  static double seconds(std::chrono::nanoseconds duration) {
+    return std::chrono::duration<double>(duration).count();
+  }
+
+  Logger logger_;
+  std::string topic_;
+  DropReport drops_;
+  mutable std::mutex mutex_;
+  PublisherStats stats_;
+  Throttle waits_{std::chrono::seconds(10)};
 };
 
 }  // namespace mocap

@@ -1,4 +1,6 @@
 // sequence_source (test plugin): publishes the test stream of sequence_message.hpp.
+#include <fstream>
+
 #include <fmt/format.h>
 
 #include <mocap/component.hpp>
@@ -16,6 +18,8 @@ class SequenceSource final : public Component {
     spec.parameter("batch", 10, "messages per tick").min(1);
     spec.parameter("period_s", 0.01, "seconds between ticks").range(1e-5, 60);
     spec.parameter("subscribers", 1, "matched subscribers to wait for before publishing").min(0);
+    spec.parameter("summary_file", std::string(),
+                   "where the publisher's figures go (YAML) once `count` are published");
     spec.publishes<mocap_msgs::msg::FiducialArray>(kSequenceTopic, Qos::reliable(),
                                                    "the numbered stream");
   }
@@ -24,6 +28,7 @@ class SequenceSource final : public Component {
     count_ = param<int>("count");
     batch_ = param<int>("batch");
     subscribers_ = param<size_t>("subscribers");
+    summary_file_ = param<std::string>("summary_file");
     publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kSequenceTopic);
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(param<double>("period_s"))),
@@ -35,6 +40,7 @@ class SequenceSource final : public Component {
     if (!started_) {
       if (publisher_.matched_subscribers() < subscribers_) return;
       started_ = true;
+      started_at_ = std::chrono::steady_clock::now();
       log().info("{} subscriber(s) matched; publishing", publisher_.matched_subscribers());
     }
     for (int i = 0; i < batch_ && (count_ == 0 || next_ < count_); ++i) {
@@ -46,13 +52,27 @@ class SequenceSource final : public Component {
     }
     if (count_ != 0 && next_ == count_ && !reported_) {
       reported_ = true;
-      log().info("published {} messages", count_);
+      PublisherStats stats = publisher_.stats();
+      auto ms = [](std::chrono::nanoseconds d) { return d.count() / 1000000; };
+      log().info(
+          "published {} messages in {:.3f} s; {} waited for subscribers, {} ms in all", count_,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count(),
+          stats.waited, ms(stats.blocked));
+      if (!summary_file_.empty()) {
+        std::ofstream(summary_file_) << fmt::format(
+            "published: {}\nwaited: {}\nblocked_ms: {}\nlongest_wait_ms: {}\ndropped: {}\n"
+            "elapsed_ms: {}\n",
+            stats.published, stats.waited, ms(stats.blocked), ms(stats.longest_wait), stats.dropped,
+            ms(std::chrono::steady_clock::now() - started_at_));
+      }
     }
   }
 
   int count_;
   int batch_;
   size_t subscribers_;
+  std::string summary_file_;
+  std::chrono::steady_clock::time_point started_at_;
   int next_ = 0;
   bool started_ = false;
   bool reported_ = false;

@@ -38,6 +38,20 @@ namespace mocap {
 
 using Clock = std::chrono::system_clock;
 
+// What a publisher has been through. A reliable keep-all publisher waits for a subscriber
+// that is `depth` samples behind (Qos::max_blocking), inside publish(): that is how a slow
+// subscriber holds its producer back without losing samples.
+struct PublisherStats {
+  uint64_t published = 0;  // publish() calls
+  // Samples that had to wait for room at some subscriber, and the time publish() spent so.
+  uint64_t waited = 0;
+  std::chrono::nanoseconds blocked{0};
+  std::chrono::nanoseconds longest_wait{0};
+  // Samples given up for some subscriber: Qos::max_blocking passed, a DDS write failed, or
+  // the process was stopping. Keep-last overflow is counted by the subscriber, not here.
+  uint64_t dropped = 0;
+};
+
 // The runtime side of a publisher.
 class PublisherPort {
  public:
@@ -47,6 +61,7 @@ class PublisherPort {
   virtual size_t matched_subscribers() const = 0;
   // The topic after remapping.
   virtual const std::string& topic() const = 0;
+  virtual PublisherStats stats() const = 0;
 };
 
 template <class Message>
@@ -61,6 +76,7 @@ class Publisher {
   }
   size_t matched_subscribers() const { return port_->matched_subscribers(); }
   const std::string& topic() const { return port_->topic(); }
+  PublisherStats stats() const { return port_->stats(); }
   explicit operator bool() const { return port_ != nullptr; }
 
  private:
@@ -160,7 +176,7 @@ class Component {
 // What a plugin library exports, through MOCAP_REGISTER_COMPONENT.
 struct ComponentFactory {
   // Raised whenever Component, Context or this struct change layout.
-  static constexpr uint32_t kAbiVersion = 2;
+  static constexpr uint32_t kAbiVersion = 3;
   static constexpr const char* kSymbol = "mocap_component_factory";
 
   uint32_t abi_version;

@@ -1,7 +1,7 @@
-// Records messages into a bag from any thread without holding the caller up: messages are
-// queued as they arrive (typed messages by pointer, serialized only when written) and a
-// writer thread serializes them and commits them to a BagWriter. Shared by `mocap_bag record`
-// (raw CDR from DDS) and the bag_recorder component (typed messages in-process).
+// Records messages into a bag from any thread without holding the caller up while the disk
+// keeps pace: messages are queued as they arrive (typed messages by pointer, serialized only
+// when written) and a writer thread serializes them and commits them to a BagWriter. Shared by
+// `mocap_bag record` (raw CDR from DDS) and the bag_recorder component (typed messages in-process).
 #pragma once
 
 #include <cstdint>
@@ -16,14 +16,15 @@ namespace mocap::bag {
 
 struct RecorderOptions {
   BagWriterOptions writer;
-  // Messages waiting to be written may hold this many bytes (as serialized); beyond it new
-  // ones are dropped and counted, so that a slow disk cannot eat the memory.
-  size_t max_queued_bytes = size_t{1} << 30;
+  // Messages waiting to be written may hold this many bytes (as serialized); beyond it
+  // record() waits for the writer thread, so that a slow disk cannot eat the memory and, as
+  // any reliable subscriber, the recording holds its publishers back rather than lose data.
+  size_t max_queued_bytes = size_t{256} << 20;
 };
 
 struct RecorderStats {
   uint64_t written = 0;     // messages in the bag
-  uint64_t dropped = 0;     // not written: the queue was full, or after a write error
+  uint64_t dropped = 0;     // not written: a write error, or recorded after close()
   uint64_t bytes = 0;       // payload bytes written
   size_t queued_bytes = 0;  // waiting now
 };
@@ -41,8 +42,9 @@ class Recorder {
 
   // Thread-safe. Returns the id for record().
   uint32_t add_topic(const BagTopic& topic);
-  // Thread-safe and quick: queues `message` of `type` (serialized by the writer thread) or,
-  // with `type` null, `message` is a std::vector<uint8_t> of encapsulated CDR, written as it is.
+  // Thread-safe; quick unless max_queued_bytes wait to be written, then it waits for room.
+  // Queues `message` of `type` (serialized by the writer thread) or, with `type` null,
+  // `message` is a std::vector<uint8_t> of encapsulated CDR, written as it is.
   void record(uint32_t topic_id, int64_t timestamp_ns, std::shared_ptr<const void> message,
               const MessageType* type);
   // Writes what is queued, closes the bag and stops the thread. Idempotent. Returns the first
