@@ -288,6 +288,22 @@ TEST(IntraProcess, LatchedSamplesReachLateSubscribersByPointer) {
   EXPECT_EQ(volatile_publisher->matched_subscribers(), 0u);
 }
 
+TEST(IntraProcess, ALateJoinerTakesTheWholeHistoryWithoutAnyoneWaiting) {
+  IntraProcessTransport transport;
+  Qos history = reliable_with_depth(3);
+  history.durability = Durability::TransientLocal;
+  auto publisher = transport.advertise(endpoint_of("map", "/map", history));
+  for (int i = 0; i < 5; ++i) publisher->publish(numbered(i), Clock::now());
+  Qos small = reliable_with_depth(1);
+  small.durability = Durability::TransientLocal;
+  // Connecting happens under the transport's lock: the queue takes the publisher's history
+  // beyond its own depth rather than making anyone wait there.
+  auto late = transport.subscribe(endpoint_of("late", "/map", small), [](bool) {});
+  for (int i = 2; i < 5; ++i) EXPECT_EQ(number(take(*late)), i);
+  EXPECT_EQ(take(*late), nullptr);
+  EXPECT_EQ(publisher->stats().waited, 0u);
+}
+
 TEST(IntraProcess, EndpointsLeaveCleanly) {
   IntraProcessTransport transport;
   auto publisher = transport.advertise(endpoint("/a", Qos::reliable()));

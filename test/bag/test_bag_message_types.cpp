@@ -1,7 +1,8 @@
 // Every message type through a bag both ways a deployment uses one: typed messages recorded by
 // the Recorder (serialized by its writer thread) and read back as the bytes of the original,
-// which the player deserializes into equal messages. Also the Recorder's own failure: a full
-// bag ends the recording with the writer's error, counted drops, and a readable bag.
+// which the player deserializes into equal messages. Also the Recorder's own limits: a full
+// bag ends the recording with the writer's error, counted drops, and a readable bag; a disk
+// slower than the messages makes record() wait rather than drop.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -105,6 +106,29 @@ TEST(BagMessageTypes, AFullBagEndsTheRecordingAndKeepsWhatWasCommitted) {
     ASSERT_EQ(message.data.size(), 10u * 1024);
     EXPECT_EQ(message.data.front(), expected++);  // the first ones, in order
   }
+}
+
+TEST(BagMessageTypes, ARecorderBehindItsDiskWaitsForItInsteadOfDropping) {
+  test::TempDir dir;
+  RecorderOptions options;
+  options.max_queued_bytes = 4 * 1024;  // four messages
+  Recorder recorder((dir / "slow").string(), options);
+  const uint32_t id = recorder.add_topic({"/blob", "std_msgs/msg/Empty", "cdr", {}, 0});
+  size_t most_queued = 0;
+  for (int i = 0; i < 2000; ++i) {
+    auto blob = std::make_shared<std::vector<uint8_t>>(1024, static_cast<uint8_t>(i));
+    recorder.record(id, 1'000'000'000 + i, std::move(blob), nullptr);
+    most_queued = std::max(most_queued, recorder.stats().queued_bytes);
+  }
+  EXPECT_LE(most_queued, options.max_queued_bytes);
+  ASSERT_FALSE(recorder.close().has_value());
+  EXPECT_EQ(recorder.stats().written, 2000u);
+  EXPECT_EQ(recorder.stats().dropped, 0u);
+  BagReader reader((dir / "slow").string());
+  BagMessage message;
+  int n = 0;
+  while (reader.next(message)) ASSERT_EQ(message.data.front(), static_cast<uint8_t>(n++));
+  EXPECT_EQ(n, 2000);
 }
 
 }  // namespace
