@@ -195,6 +195,7 @@ int play(const std::string& path, const mocap::bag::PlaybackOptions& options, do
     while (!stop.load() && !mocap::ShutdownSignal::wait(std::chrono::milliseconds(100))) {
     }
     stop.store(true);
+    transport.stop_waiting();  // a publish waiting for a slow subscriber gives up too
   });
   // Subscribers must be discovered first, or the first messages go to nobody.
   mocap::ShutdownSignal::wait(std::chrono::duration_cast<std::chrono::steady_clock::duration>(

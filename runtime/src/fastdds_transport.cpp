@@ -277,8 +277,7 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
       WaitingScope waiting;
       while (result == ReturnCode_t::RETCODE_TIMEOUT) {
         if (transport_.stopped_waiting_.load()) {
-          given_up = "the process is stopping and a DDS subscriber has not acknowledged " +
-                     std::to_string(endpoint_.qos.depth) + " samples";
+          given_up = fmt::format("the process is stopping and {} had no room", subscribers());
           break;
         }
         if (endpoint_.qos.max_blocking &&

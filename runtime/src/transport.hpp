@@ -1,4 +1,5 @@
-// The interface every transport implements: in-process (intra) and DDS (fastdds).
+// The interface every transport implements: in-process (intra) and DDS (fastdds), and the
+// reports of drops and waits they share.
 //
 // A process composes them: a publisher publishes through every transport, a subscription
 // takes from every transport. Each transport delivers only what the others do not: intra
@@ -93,10 +94,6 @@ class DropReport {
   Throttle throttle_;
 };
 
-}  // namespace mocap
-
-namespace mocap {
-
 // A publisher's waits for subscribers without room and the samples it gave up: counted for
 // stats(), logged with whom it waits for (at once, then at most every ten seconds), and
 // summed up when the publisher goes.
@@ -120,7 +117,7 @@ class PublisherReport {
     ++stats_.waited;
     stats_.blocked += waited;
     stats_.longest_wait = std::max(stats_.longest_wait, waited);
-    if (auto since_last = waits_.count()) {
+    if (waits_.count()) {
       logger_.info(
           "{}: publisher waits for {} ({} sample(s) waited, {:.3f} s in all): a "
           "reliable keep_all subscriber sets the pace",
