@@ -4,7 +4,7 @@
 # with the same type and QoS. Counted by callgrind, so the figure is the same on every run
 # and under any load, unlike the timings of transport_bench.
 #
-#   bench/receive_path_instructions.sh [BUILD_DIR]      (about two minutes)
+#   bench/receive_path_instructions.sh [BUILD_DIR]      (about half a minute)
 #
 # Each subscriber (transport_bench --subscriber) runs under callgrind against a paced
 # publisher (the sequence_source test plugin), once for 200 and once for 1200 messages; the
@@ -26,10 +26,13 @@ groups:
         parameters: {count: $2, batch: 1, period_s: 0.005, subscribers: 1}
         remap: {/test/sequence: /bench/hop}
 YAML
-  (sleep 3; timeout 120 "$build/bin/mocap_launch" "$work/publisher.yaml" > /dev/null 2>&1) &
+  (sleep 3; exec timeout 120 "$build/bin/mocap_launch" "$work/publisher.yaml" > /dev/null 2>&1) &
+  local publisher=$!
   valgrind --tool=callgrind --callgrind-out-file="$work/$1_$2.out" \
     "$build/bin/transport_bench" --subscriber "$1" fiducials "$2" "$work/received" \
     > /dev/null 2>&1
+  # The source publishes its count, then idles: stop it rather than wait for the timeout.
+  kill -TERM "$publisher" 2>/dev/null || true
   wait
   local received
   received=$(awk 'NR == 1 {print $1}' "$work/received")
