@@ -46,8 +46,15 @@ std::string sink_yaml(const std::string& parameters, const std::string& qos = "r
 
 // The machine a reliable stream must not lose samples on: quiet, with every core busy with
 // other processes, with a subscriber that takes 5 ms over each message (far slower than its
-// publisher, which must then wait for it), or one that stalls for a second now and then.
-enum class Load { Quiet, BusyCores, SlowSubscriber, StallingSubscriber };
+// publisher, which must then wait for it), both at once, or with a subscriber that stalls for
+// a second now and then.
+enum class Load {
+  Quiet,
+  BusyCores,
+  SlowSubscriber,
+  BusyCoresAndSlowSubscriber,
+  StallingSubscriber
+};
 
 std::string load_name(const ::testing::TestParamInfo<Load>& info) {
   switch (info.param) {
@@ -57,6 +64,8 @@ std::string load_name(const ::testing::TestParamInfo<Load>& info) {
       return "BusyCores";
     case Load::SlowSubscriber:
       return "SlowSubscriber";
+    case Load::BusyCoresAndSlowSubscriber:
+      return "BusyCoresAndSlowSubscriber";
     case Load::StallingSubscriber:
       return "StallingSubscriber";
   }
@@ -66,24 +75,27 @@ std::string load_name(const ::testing::TestParamInfo<Load>& info) {
 class ReliableUnderLoad : public ::testing::TestWithParam<Load> {
  protected:
   void SetUp() override {
-    if (GetParam() == Load::BusyCores) busy_ = std::make_unique<test::BusyCores>();
+    if (GetParam() == Load::BusyCores || GetParam() == Load::BusyCoresAndSlowSubscriber) {
+      busy_ = std::make_unique<test::BusyCores>();
+    }
   }
   void TearDown() override { busy_.reset(); }
 
-  // The DDS domain of this test under this load: `slot` to `slot` + 3.
+  bool slow() const {
+    return GetParam() == Load::SlowSubscriber || GetParam() == Load::BusyCoresAndSlowSubscriber;
+  }
+
+  // The DDS domain of this test under this load: `slot` to `slot` + 4.
   std::map<std::string, std::string> env(int slot) const {
     return environment(slot + static_cast<int>(GetParam()));
   }
   // The sink's parameters under this load.
   std::string sink(const std::string& parameters) const {
-    switch (GetParam()) {
-      case Load::SlowSubscriber:
-        return parameters + ", work_s: 0.005";
-      case Load::StallingSubscriber:
-        return parameters + ", stall_every: 2500, stall_s: 1.0";
-      default:
-        return parameters;
+    if (slow()) return parameters + ", work_s: 0.005";
+    if (GetParam() == Load::StallingSubscriber) {
+      return parameters + ", stall_every: 2500, stall_s: 1.0";
     }
+    return parameters;
   }
 
  private:
@@ -92,6 +104,7 @@ class ReliableUnderLoad : public ::testing::TestWithParam<Load> {
 
 INSTANTIATE_TEST_SUITE_P(Dds, ReliableUnderLoad,
                          ::testing::Values(Load::Quiet, Load::BusyCores, Load::SlowSubscriber,
+                                           Load::BusyCoresAndSlowSubscriber,
                                            Load::StallingSubscriber),
                          load_name);
 
@@ -128,7 +141,7 @@ TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
   auto source = test::read_summary(dir / "source.yaml");
   EXPECT_EQ(source.at("published"), 10000);
   EXPECT_EQ(source.at("dropped"), 0);
-  if (GetParam() == Load::SlowSubscriber) {
+  if (slow()) {
     // 10,000 messages in about 0.2 s against 50 s of work: the publisher waited, and said so.
     EXPECT_GT(source.at("waited"), 1000);
     EXPECT_GT(source.at("blocked_ms"), 30000);
@@ -142,7 +155,7 @@ TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
 
 TEST_P(ReliableUnderLoad, ARestartedSubscriberProcessReceivesAgain) {
   test::TempDir dir;
-  auto environment = env(25);
+  auto environment = env(31);
   // 1000 messages a second: more than a slow subscriber takes, so the publisher waits for it
   // when the first subscriber is killed.
   test::write_file(dir / "source.yaml",
