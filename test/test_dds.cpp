@@ -5,7 +5,9 @@
 
 #include <signal.h>
 
+#include <filesystem>
 #include <memory>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -17,6 +19,21 @@ namespace {
 std::map<std::string, std::string> environment(int slot) {
   return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))},
           {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}};
+}
+
+// The Fast DDS shared-memory ports process `pid` reads from: the lock files it holds open.
+std::set<std::string> shared_memory_ports(int pid) {
+  std::set<std::string> ports;
+  std::error_code error;
+  for (const auto& fd :
+       std::filesystem::directory_iterator(fmt::format("/proc/{}/fd", pid), error)) {
+    std::string target = std::filesystem::read_symlink(fd.path(), error).filename().string();
+    if (target.rfind("fastrtps_port", 0) == 0 && target.size() > 3 &&
+        target.compare(target.size() - 3, 3, "_el") == 0) {
+      ports.insert(target);
+    }
+  }
+  return ports;
 }
 
 std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
@@ -170,11 +187,19 @@ TEST_P(ReliableUnderLoad, ARestartedSubscriberProcessReceivesAgain) {
   test::ChildProcess first({launcher(), (dir / "sink.yaml").string()}, environment,
                            dir / "first.log");
   ASSERT_TRUE(first.wait_for_output("received 200", std::chrono::seconds(60))) << first.output();
+  std::set<std::string> first_ports = shared_memory_ports(first.pid());
+  EXPECT_EQ(first_ports.size(), 2u);
   first.signal(SIGKILL);  // no goodbye to the publisher
   ASSERT_EQ(first.wait(std::chrono::seconds(10)), 128 + SIGKILL);
 
   test::ChildProcess second({launcher(), (dir / "sink.yaml").string()}, environment,
                             dir / "second.log");
+  // The publisher may still write to the shared memory of the killed process's ports, and
+  // would never reach a process that took them (fastdds_shared_memory.hpp).
+  ASSERT_TRUE(second.wait_for_output("running sink", std::chrono::seconds(60))) << second.output();
+  for (const std::string& port : shared_memory_ports(second.pid())) {
+    EXPECT_EQ(first_ports.count(port), 0u) << port << " again";
+  }
   EXPECT_TRUE(second.wait_for_output("received 200", std::chrono::seconds(60)))
       << second.output() << source.output();
   second.signal(SIGTERM);
@@ -208,6 +233,44 @@ TEST_P(ReliableUnderLoad, ALatchedSampleReachesAProcessStartedLater) {
   EXPECT_EQ(summary.at("received"), 1);
   EXPECT_EQ(summary.at("first"), 0);
   source.signal(SIGTERM);
+}
+
+// A reliable publisher is transient_local on the wire (to_writer_qos says why) and so keeps a
+// history; a latched subscriber in another process still takes nothing from it, as in one
+// process, and says why.
+TEST(Dds, ALatchedSubscriberTakesNothingFromAReliablePublisher) {
+  test::TempDir dir;
+  auto env = environment(13);
+  test::write_file(dir / "source.yaml",
+                   source_yaml("count: 0, batch: 10, period_s: 0.01, subscribers: 1"));
+  test::write_file(dir / "volatile.yaml", sink_yaml("expect: 0, log_every: 100, timeout_s: 300"));
+  test::write_file(dir / "latched.yaml",
+                   sink_yaml(fmt::format("expect: 0, timeout_s: 300, summary_file: \"{}\"",
+                                         (dir / "latched.summary").string()),
+                             "latched"));
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+  test::ChildProcess reader({launcher(), (dir / "volatile.yaml").string()}, env,
+                            dir / "volatile.log");
+  ASSERT_TRUE(reader.wait_for_output("received 100", std::chrono::seconds(60)))
+      << reader.output() << source.output();
+  test::ChildProcess latched({launcher(), (dir / "latched.yaml").string()}, env,
+                             dir / "latched.log");
+  EXPECT_TRUE(latched.wait_for_output(
+      "/test/sequence: not connected to the publisher in 'source': the subscriber requests "
+      "transient_local durability but the publisher is volatile",
+      std::chrono::seconds(60)))
+      << latched.output();
+  // Live samples keep arriving at the volatile subscriber, and not at the latched one.
+  int logged = 0;
+  while (reader.output().find(fmt::format("received {}\n", logged + 100)) != std::string::npos) {
+    logged += 100;
+  }
+  EXPECT_TRUE(
+      reader.wait_for_output(fmt::format("received {}\n", logged + 300), std::chrono::seconds(60)))
+      << reader.output();
+  latched.signal(SIGTERM);
+  ASSERT_EQ(latched.wait(std::chrono::seconds(30)), 0) << latched.output();
+  EXPECT_EQ(test::read_summary(dir / "latched.summary").at("received"), 0) << latched.output();
 }
 
 // A publisher waiting for a slow subscriber in another process resumes as soon as that

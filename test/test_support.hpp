@@ -52,6 +52,7 @@ class ChildProcess {
   std::optional<int> wait(std::chrono::seconds timeout);
   void signal(int signal_number);
   std::string output() const;
+  int pid() const { return pid_; }
 
  private:
   int pid_ = -1;

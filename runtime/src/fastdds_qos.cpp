@@ -176,7 +176,28 @@ dds::DataWriterQos to_writer_qos(const Qos& qos) {
     out.resource_limits().max_samples = in_flight;
     out.resource_limits().max_samples_per_instance = in_flight;
   }
+  if (qos.reliability == Reliability::Reliable && qos.durability == Durability::Volatile) {
+    // Fast DDS 2.9.1 can deadlock a volatile reliable writer when a reader leaves while samples
+    // wait to be sent to it again (as a slow subscriber's always do): the writer then removes
+    // the samples every remaining reader has, holding its locator-selector locks while it takes
+    // the flow controller's, whose thread holds the flow controller's lock while it takes a
+    // locator selector's (eProsima/Fast-DDS#5432, fixed in later releases). Only a volatile
+    // writer removes samples there; a transient-local one keeps them until its history needs
+    // the room, and then removes one while it writes, without those locks. So the writer is
+    // transient-local on the wire: a volatile reader still gets only what is written after it
+    // joins (Fast DDS sends it a gap for the history), and the mark tells our transient-local
+    // readers and tools that the publisher is volatile.
+    out.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    out.user_data().setValue(
+        std::vector<uint8_t>(kVolatileWriterMark.begin(), kVolatileWriterMark.end()));
+  }
   return out;
+}
+
+Durability offered_durability(Durability announced, const std::vector<uint8_t>& user_data) {
+  bool marked = std::equal(user_data.begin(), user_data.end(), kVolatileWriterMark.begin(),
+                           kVolatileWriterMark.end());
+  return marked ? Durability::Volatile : announced;
 }
 
 dds::DataReaderQos to_reader_qos(const Qos& qos) {

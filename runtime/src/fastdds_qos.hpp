@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
@@ -31,8 +32,14 @@ constexpr std::chrono::nanoseconds kWriteWaitSlice = std::chrono::milliseconds(5
 // such a topic is kept by the readers (to_writer_qos says why).
 constexpr int kWriterSamplesInFlight = 32;
 
+// The user data of a reliable writer that is volatile although it announces transient_local
+// durability (to_writer_qos says why). Our readers and tools take it for volatile.
+constexpr std::string_view kVolatileWriterMark = "mocap:durability=volatile";
+
 eprosima::fastdds::dds::DataWriterQos to_writer_qos(const Qos& qos);
 eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);
+// The durability a discovered writer offers, `announced` on the wire, with its `user_data`.
+Durability offered_durability(Durability announced, const std::vector<uint8_t>& user_data);
 // With `options` as with_environment() amends them. Throws std::runtime_error for a bad
 // environment variable, security files that are missing, or a server host that does not resolve.
 eprosima::fastdds::dds::DomainParticipantQos to_participant_qos(const DdsOptions& options,

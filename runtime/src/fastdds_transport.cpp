@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -27,8 +28,8 @@
 
 #include "executor.hpp"
 #include "fastdds_qos.hpp"
+#include "fastdds_shared_memory.hpp"
 #include "fastdds_type_adapter.hpp"
-#include "shared_memory_cleanup.hpp"
 
 namespace mocap {
 namespace dds = eprosima::fastdds::dds;
@@ -115,6 +116,18 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
     return text.str();
   }
 
+  // The discovered publisher `writer`, if it is known.
+  std::optional<DiscoveredEndpoint> publisher(const rtps::GUID_t& writer) const {
+    std::lock_guard lock(mutex_);
+    auto it = endpoints_.find(writer);
+    if (it == endpoints_.end() || !it->second.is_publisher) return std::nullopt;
+    DiscoveredEndpoint copy = it->second;
+    if (auto name = participants_.find(writer.guidPrefix); name != participants_.end()) {
+      copy.participant = name->second;
+    }
+    return copy;
+  }
+
   std::vector<DiscoveredEndpoint> endpoints() const {
     std::lock_guard lock(mutex_);
     std::vector<DiscoveredEndpoint> out;
@@ -144,9 +157,10 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
     endpoint.qos.reliability = data.m_qos.m_reliability.kind == dds::RELIABLE_RELIABILITY_QOS
                                    ? Reliability::Reliable
                                    : Reliability::BestEffort;
-    endpoint.qos.durability = data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS
-                                  ? Durability::TransientLocal
-                                  : Durability::Volatile;
+    Durability announced = data.m_qos.m_durability.kind == dds::TRANSIENT_LOCAL_DURABILITY_QOS
+                               ? Durability::TransientLocal
+                               : Durability::Volatile;
+    endpoint.qos.durability = offered_durability(announced, data.m_qos.m_userData.data_vec());
   }
 
   mutable std::mutex mutex_;
@@ -368,6 +382,7 @@ class FastDdsTransport::Reader final : public TransportSubscription,
       if (reader_->take_next_sample(&sample, &info) != ReturnCode_t::RETCODE_OK) return false;
       // A sample can arrive between peeking and taking; judge what was actually taken.
       if (!info.valid_data || is_own(info)) continue;
+      if (from_volatile_publisher(info)) continue;
       if (sample.skip) {
         drops_.count(1, "replaced in the reader queue while being taken");
         continue;
@@ -417,6 +432,22 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     return info.sample_identity.writer_guid().guidPrefix == own_prefix_;
   }
 
+  // A transient-local subscriber matches our volatile reliable publishers, which are
+  // transient-local on the wire (to_writer_qos says why), but must not take from them, as in
+  // one process it is not connected to them.
+  bool from_volatile_publisher(const dds::SampleInfo& info) {
+    if (endpoint_.qos.durability != Durability::TransientLocal) return false;
+    const rtps::GUID_t& writer = info.sample_identity.writer_guid();
+    std::optional<DiscoveredEndpoint> publisher = transport_.listener_->publisher(writer);
+    if (!publisher || publisher->qos.durability != Durability::Volatile) return false;
+    if (ignored_writers_.insert(writer).second) {
+      Logger(endpoint_.owner)
+          .warn("{}: not connected to the publisher in '{}': {}", endpoint_.topic,
+                publisher->participant, *qos_mismatch(publisher->qos, endpoint_.qos));
+    }
+    return true;
+  }
+
   FastDdsTransport& transport_;
   Endpoint endpoint_;
   DataNotification on_data_;
@@ -424,6 +455,7 @@ class FastDdsTransport::Reader final : public TransportSubscription,
   rtps::GuidPrefix_t own_prefix_;
   DropReport drops_;
   Throttle holding_back_{std::chrono::seconds(10)};
+  std::set<rtps::GUID_t> ignored_writers_;  // used by take(), on the subscriber's strand
   dds::Topic* topic_ = nullptr;
   std::shared_ptr<std::atomic<int>> local_writers_;
   dds::DataReader* reader_ = nullptr;
@@ -434,9 +466,18 @@ class FastDdsTransport::Reader final : public TransportSubscription,
 FastDdsTransport::FastDdsTransport(const DdsOptions& options, const std::string& participant_name)
     : domain_id_(resolve_domain_id(options.domain_id)), listener_(std::make_unique<Listener>()) {
   auto* factory = dds::DomainParticipantFactory::get_instance();
-  participant_ =
-      factory->create_participant(domain_id_, to_participant_qos(options, participant_name),
-                                  listener_.get(), dds::StatusMask::none());
+  dds::DomainParticipantQos qos = to_participant_qos(options, participant_name);
+  {
+    // Until the participant holds its ports, another one in this process would choose them too.
+    static std::mutex choosing_ports;
+    std::lock_guard lock(choosing_ports);
+    if (options.shared_memory) {
+      remove_orphaned_shared_memory();
+      if (auto id = unused_participant_id(domain_id_)) qos.wire_protocol().participant_id = *id;
+    }
+    participant_ =
+        factory->create_participant(domain_id_, qos, listener_.get(), dds::StatusMask::none());
+  }
   if (participant_ == nullptr) {
     DdsOptions used = with_environment(options);
     throw std::runtime_error(

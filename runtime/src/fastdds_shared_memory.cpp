@@ -1,9 +1,10 @@
-#include "shared_memory_cleanup.hpp"
+#include "fastdds_shared_memory.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <regex>
 #include <string>
 #include <vector>
@@ -35,9 +36,7 @@ void remove_counting(const fs::path& file, SharedMemoryCleanup& done) {
 
 SharedMemoryCleanup remove_orphaned_shared_memory(const fs::path& directory,
                                                   std::chrono::seconds min_age) {
-  // Segments: fastrtps_<16 hex>, ports: fastrtps_port<number> with a semaphore
-  // sem.fastrtps_port<number>_mutex; each with a lock file named <file>_el.
-  static const std::regex lock_name(R"(fastrtps_([0-9a-f]{16}|port[0-9]{1,5})_el)");
+  static const std::regex lock_name(R"(fastrtps_[0-9a-f]{16}_el)");
   SharedMemoryCleanup done;
   std::error_code error;
   auto now = fs::file_time_type::clock::now();
@@ -53,10 +52,39 @@ SharedMemoryCleanup remove_orphaned_shared_memory(const fs::path& directory,
     std::string guarded = lock.filename().string();
     guarded.resize(guarded.size() - 3);  // without "_el"
     remove_counting(directory / guarded, done);
-    remove_counting(directory / ("sem." + guarded + "_mutex"), done);
     remove_counting(lock, done);
   }
   return done;
+}
+
+std::optional<int> unused_participant_id(int domain_id, const fs::path& directory) {
+  // Fast DDS's default port parameters (RTPS 2.2, 9.6.1.1): a participant reads metatraffic on
+  // port 7400 + 250 * domain + 10 + 2 * id and user data on the next one; from id 120 on they
+  // would be the next domain's.
+  constexpr int kParticipantIds = 120;
+  auto first_port = [domain_id](int id) { return 7400 + 250 * domain_id + 10 + 2 * id; };
+  std::optional<int> oldest_dead;
+  fs::file_time_type oldest_dead_time = fs::file_time_type::max();
+  for (int id = 0; id < kParticipantIds && first_port(id) + 1 <= 65535; ++id) {
+    bool used = false;
+    bool live = false;
+    fs::file_time_type opened = fs::file_time_type::max();
+    for (int port : {first_port(id), first_port(id) + 1}) {
+      fs::path lock = directory / ("fastrtps_port" + std::to_string(port) + "_el");
+      std::error_code error;
+      auto written = fs::last_write_time(lock, error);
+      if (error) continue;  // no lock file
+      used = true;
+      live = live || !unlocked(lock);
+      opened = std::min(opened, written);
+    }
+    if (!used) return id;
+    if (!live && opened < oldest_dead_time) {
+      oldest_dead = id;
+      oldest_dead_time = opened;
+    }
+  }
+  return oldest_dead;
 }
 
 }  // namespace mocap
