@@ -273,6 +273,29 @@ TEST(Dds, ALatchedSubscriberTakesNothingFromAReliablePublisher) {
   EXPECT_EQ(test::read_summary(dir / "latched.summary").at("received"), 0) << latched.output();
 }
 
+// A publisher whose process ends right after its last sample still delivers every one: the
+// writer waits for its subscribers' acknowledgements before it goes. Here the subscriber is
+// 1000 samples behind when the publisher is done.
+TEST(Dds, APublisherThatStopsDeliversItsLastSamples) {
+  test::TempDir dir;
+  auto env = environment(11);
+  test::write_file(dir / "source.yaml", source_yaml("count: 2000, batch: 100, period_s: 0.001, "
+                                                    "subscribers: 1, stop_when_done: true"));
+  test::write_file(dir / "sink.yaml",
+                   sink_yaml(fmt::format("expect: 2000, work_s: 0.001, timeout_s: 60, "
+                                         "summary_file: \"{}\"",
+                                         (dir / "summary.yaml").string())));
+  test::ChildProcess sink({launcher(), (dir / "sink.yaml").string()}, env, dir / "sink.log");
+  test::ChildProcess source({launcher(), (dir / "source.yaml").string()}, env, dir / "source.log");
+  ASSERT_EQ(source.wait(std::chrono::seconds(60)), 0) << source.output();
+  EXPECT_EQ(source.output().find("publisher closed before"), std::string::npos) << source.output();
+  ASSERT_EQ(sink.wait(std::chrono::seconds(90)), 0) << sink.output();
+  auto summary = test::read_summary(dir / "summary.yaml");
+  EXPECT_EQ(summary.at("received"), 2000);
+  EXPECT_EQ(summary.at("missing"), 0);
+  EXPECT_EQ(summary.at("out_of_order"), 0);
+}
+
 // A publisher waiting for a slow subscriber in another process resumes as soon as that
 // subscriber leaves, not after DDS's lease on it (5 s) runs out.
 TEST(Dds, ASubscriberThatLeavesReleasesAWaitingPublisherAtOnce) {

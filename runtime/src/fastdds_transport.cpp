@@ -30,6 +30,7 @@
 #include "fastdds_qos.hpp"
 #include "fastdds_shared_memory.hpp"
 #include "fastdds_type_adapter.hpp"
+#include "shutdown_signal.hpp"
 
 namespace mocap {
 namespace dds = eprosima::fastdds::dds;
@@ -229,6 +230,7 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   }
 
   ~Writer() override {
+    deliver_what_was_written();
     writer_->set_listener(nullptr);
     transport_.publisher_->delete_datawriter(writer_);
     local_writers_->fetch_sub(1);
@@ -277,6 +279,33 @@ class FastDdsTransport::Writer final : public TransportPublisher, public dds::Da
   }
 
  private:
+  // Deleting a reliable writer drops the samples its subscribers have not acknowledged yet (at
+  // most kWriterSamplesInFlight), such as the last ones `mocap_bag play` publishes before it
+  // exits. So it waits for them first, as publish() waits for room, unless the process is
+  // stopping on a signal; a subscriber that cannot take kWriterSamplesInFlight more samples in
+  // kCloseWait counts as stalled.
+  void deliver_what_was_written() {
+    if (endpoint_.qos.reliability != Reliability::Reliable || remote_readers_.load() == 0) return;
+    static constexpr auto kCloseWait = std::chrono::seconds(5);
+    auto start = std::chrono::steady_clock::now();
+    auto slice = std::chrono::duration_cast<std::chrono::microseconds>(kWriteWaitSlice);
+    eprosima::fastrtps::Duration_t wait(0, static_cast<uint32_t>(slice.count() * 1000));
+    // Fast DDS 2.9 reports a timeout here as RETCODE_ERROR.
+    while (writer_->wait_for_acknowledgments(wait) != ReturnCode_t::RETCODE_OK) {
+      std::optional<std::string> why;
+      if (ShutdownSignal::received()) why = "the process is stopping";
+      if (std::chrono::steady_clock::now() - start >= kCloseWait) {
+        why = fmt::format("waited {} s", kCloseWait.count());
+      }
+      if (why) {
+        Logger(endpoint_.owner)
+            .warn("{}: publisher closed before {} acknowledged all it published ({})",
+                  endpoint_.topic, subscribers(), *why);
+        return;
+      }
+    }
+  }
+
   // The history is full of samples a reliable reader has not acknowledged: write again until
   // there is room. Fast DDS wakes a waiting write as soon as acknowledgements free a sample, or
   // the reader goes away (unmatched: its acknowledgements no longer count); each write waits at

@@ -20,6 +20,7 @@ class SequenceSource final : public Component {
     spec.parameter("subscribers", 1, "matched subscribers to wait for before publishing").min(0);
     spec.parameter("summary_file", std::string(),
                    "where the publisher's figures go (YAML) once `count` are published");
+    spec.parameter("stop_when_done", false, "stop the process once `count` are published");
     spec.publishes<mocap_msgs::msg::FiducialArray>(kSequenceTopic, Qos::reliable(),
                                                    "the numbered stream");
   }
@@ -29,6 +30,7 @@ class SequenceSource final : public Component {
     batch_ = param<int>("batch");
     subscribers_ = param<size_t>("subscribers");
     summary_file_ = param<std::string>("summary_file");
+    stop_when_done_ = param<bool>("stop_when_done");
     publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kSequenceTopic);
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(param<double>("period_s"))),
@@ -65,6 +67,7 @@ class SequenceSource final : public Component {
             stats.published, stats.waited, ms(stats.blocked), ms(stats.longest_wait), stats.dropped,
             ms(std::chrono::steady_clock::now() - started_at_));
       }
+      if (stop_when_done_) request_shutdown();
     }
   }
 
@@ -72,6 +75,7 @@ class SequenceSource final : public Component {
   int batch_;
   size_t subscribers_;
   std::string summary_file_;
+  bool stop_when_done_;
   std::chrono::steady_clock::time_point started_at_;
   int next_ = 0;
   bool started_ = false;
