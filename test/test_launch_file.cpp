@@ -195,7 +195,8 @@ TEST_F(LaunchFileTest, ParameterNamesTypesAndRanges) {
             "expects int >= 1, got double 2.5");
   EXPECT_EQ(list[3],
             "launch.yaml:10: component 'source' (sequence_source): unknown parameter "
-            "'colour' (parameters: count, batch, period_s, subscribers, summary_file)");
+            "'colour' (parameters: count, batch, period_s, subscribers, summary_file, "
+            "stop_when_done)");
   EXPECT_EQ(list[4],
             "launch.yaml:11: component 'source' (sequence_source): parameter "
             "'subscribers' expects int >= 0, got string \"1\"");
