@@ -7,10 +7,10 @@
 # OUT_DIR then holds
 #   ca.cert.pem, ca.key.pem      a certificate authority (EC prime256v1, self-signed); keep
 #                                ca.key.pem away from the machines that only run participants
-#   governance.xml, .smime       the domain rules, signed by the CA: every domain (0..232) needs
-#                                authentication; discovery, liveliness and all messages (data
-#                                and metadata) are encrypted; every topic needs read and write
-#                                permission
+#   governance.xml, .smime       the domain rules, signed by the CA: every domain (0..230, the
+#                                most Cyclone DDS reads) needs authentication; discovery,
+#                                liveliness and all messages (data and metadata) are encrypted;
+#                                every topic needs read and write permission
 #   NAME.key.pem, NAME.cert.pem  one identity per NAME: its key and its certificate (subject
 #                                CN=NAME, signed by the CA)
 #   NAME.permissions.xml, .smime what NAME may do, signed by the CA: publish and subscribe to
@@ -118,7 +118,7 @@ cat > governance.xml << 'EOF'
   <domain_access_rules>
     <domain_rule>
       <domains>
-        <id_range><min>0</min><max>232</max></id_range>
+        <id_range><min>0</min><max>230</max></id_range>
       </domains>
       <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
       <enable_join_access_control>true</enable_join_access_control>
@@ -158,7 +158,7 @@ permissions() {  # NAME RULES
       </validity>
       <allow_rule>
         <domains>
-          <id_range><min>0</min><max>232</max></id_range>
+          <id_range><min>0</min><max>230</max></id_range>
         </domains>
 $2
       </allow_rule>

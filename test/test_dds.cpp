@@ -160,7 +160,10 @@ TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
   EXPECT_EQ(source.at("dropped"), 0);
   if (slow()) {
     // 10,000 messages in about 0.2 s against 50 s of work: the publisher waited, and said so.
-    EXPECT_GT(source.at("waited"), 1000);
+    // (How many samples wait depends on the implementation's window: Fast DDS lets 32 be
+    // unacknowledged, Cyclone DDS 500 kB, and wakes a waiting writer only when most are
+    // acknowledged.)
+    EXPECT_GT(source.at("waited"), 100);
     EXPECT_GT(source.at("blocked_ms"), 30000);
     EXPECT_NE(output.find("publisher waits for DDS subscriber(s) in 'sink'"), std::string::npos)
         << output;
@@ -188,7 +191,7 @@ TEST_P(ReliableUnderLoad, ARestartedSubscriberProcessReceivesAgain) {
                            dir / "first.log");
   ASSERT_TRUE(first.wait_for_output("received 200", std::chrono::seconds(60))) << first.output();
   std::set<std::string> first_ports = shared_memory_ports(first.pid());
-  EXPECT_EQ(first_ports.size(), 2u);
+  EXPECT_EQ(first_ports.size(), test::dds_implementation() == "fastdds" ? 2u : 0u);
   first.signal(SIGKILL);  // no goodbye to the publisher
   ASSERT_EQ(first.wait(std::chrono::seconds(10)), 128 + SIGKILL);
 

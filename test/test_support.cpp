@@ -44,7 +44,12 @@ std::string read_file(const fs::path& path) {
   return text.str();
 }
 
-int test_domain(int slot) { return 100 + slot; }
+std::string dds_implementation() {
+  const char* implementation = std::getenv("MOCAP_DDS_IMPLEMENTATION");
+  return implementation != nullptr && *implementation != '\0' ? implementation : "fastdds";
+}
+
+int test_domain(int slot) { return (dds_implementation() == "cyclonedds" ? 0 : 100) + slot; }
 
 ChildProcess::ChildProcess(std::vector<std::string> argv,
                            std::map<std::string, std::string> environment, fs::path output_file)

@@ -32,8 +32,12 @@ class TempDir {
 void write_file(const std::filesystem::path& path, std::string_view text);
 std::string read_file(const std::filesystem::path& path);
 
+// The DDS implementation the tests run on: MOCAP_DDS_IMPLEMENTATION, else "fastdds".
+std::string dds_implementation();
+
 // The DDS domain of a test: each test that talks DDS passes its own `slot` (0..99), so tests
-// running at the same time never see each other's topics.
+// running at the same time never see each other's topics. Domains 100..199 under Fast DDS,
+// 0..99 under Cyclone DDS (MOCAP_DDS_IMPLEMENTATION), so the two runs of a test do not meet.
 int test_domain(int slot);
 
 // A child process whose stdout and stderr go to a file. Stopped (SIGTERM, then SIGKILL after

@@ -17,7 +17,7 @@
 #include <mocap/generated_message_types.hpp>
 #include <mocap/raw_message_type.hpp>
 
-#include "fastdds_transport.hpp"
+#include "dds_transport.hpp"
 #include "shutdown_signal.hpp"
 
 namespace {
@@ -81,7 +81,8 @@ struct RecordedTopic {
 
 int record(const std::string& directory, const std::set<std::string>& wanted, bool all,
            std::optional<double> duration) {
-  mocap::FastDdsTransport transport(mocap::DdsOptions{}, "mocap_bag");
+  auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_bag");
+  mocap::DdsTransport& transport = *dds;
   mocap::bag::Recorder recorder(directory);
   fmt::print("recording to {}\n", recorder.directory());
   std::fflush(stdout);
@@ -166,7 +167,8 @@ int play(const std::string& path, const mocap::bag::PlaybackOptions& options, do
   for (const std::string& problem : reader.problems()) {
     fmt::print(stderr, "mocap_bag: {}\n", problem);
   }
-  mocap::FastDdsTransport transport(mocap::DdsOptions{}, "mocap_bag");
+  auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_bag");
+  mocap::DdsTransport& transport = *dds;
   std::vector<std::unique_ptr<mocap::RawMessageType>> types;
   std::map<std::string, std::unique_ptr<mocap::TransportPublisher>> publishers;
   const std::set<std::string> only(options.topics.begin(), options.topics.end());

@@ -5,8 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "dds_transport.hpp"
 #include "executor.hpp"
-#include "fastdds_transport.hpp"
 #include "intra_process_transport.hpp"
 #include "names.hpp"
 #include "shutdown_signal.hpp"
@@ -161,8 +161,9 @@ struct ComponentHost::Impl {
       : options(std::move(host_options)), executor(options.threads), logger(options.name) {
     transports.push_back(std::make_unique<IntraProcessTransport>());
     if (options.dds.enabled) {
-      auto dds = std::make_unique<FastDdsTransport>(options.dds, options.name);
+      auto dds = make_dds_transport(options.dds, options.name);
       dds_domain = dds->domain_id();
+      dds_implementation = std::string(dds->implementation());
       transports.push_back(std::move(dds));
     }
   }
@@ -181,6 +182,7 @@ struct ComponentHost::Impl {
   Logger logger;
   std::vector<std::unique_ptr<Transport>> transports;
   int dds_domain = -1;
+  std::string dds_implementation;
   // Declared after the transports: destroyed before them.
   std::vector<std::unique_ptr<ComponentContext>> contexts;
   std::vector<std::unique_ptr<Component>> components;
@@ -453,7 +455,9 @@ int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
   impl_->logger.info(
       "running {} on {} thread(s); {}", fmt::join(names, ", "), impl_->executor.threads(),
       dds.enabled
-          ? fmt::format("DDS domain {}{}", impl_->dds_domain, dds.shared_memory ? "" : ", UDP only")
+          ? fmt::format(
+                "{} DDS domain {}{}", impl_->dds_implementation, impl_->dds_domain,
+                dds.shared_memory && impl_->dds_implementation == "fastdds" ? "" : ", UDP only")
           : std::string("DDS off"));
   auto deadline =
       duration ? std::chrono::steady_clock::now() +

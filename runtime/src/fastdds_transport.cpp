@@ -1,7 +1,6 @@
 #include "fastdds_transport.hpp"
 
 #include <atomic>
-#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -30,6 +29,7 @@
 #include "fastdds_qos.hpp"
 #include "fastdds_shared_memory.hpp"
 #include "fastdds_type_adapter.hpp"
+#include "message_pool.hpp"
 #include "shutdown_signal.hpp"
 
 namespace mocap {
@@ -66,18 +66,6 @@ std::string access_control_hint(dds::DomainParticipant* participant, std::string
 }
 
 }  // namespace
-
-int resolve_domain_id(int configured) {
-  const char* text = std::getenv("MOCAP_DOMAIN_ID");
-  if (text == nullptr || *text == '\0') return configured;
-  int value = -1;
-  auto [end, error] = std::from_chars(text, text + std::strlen(text), value);
-  if (error != std::errc() || *end != '\0' || value < 0 || value > 232) {
-    throw std::runtime_error(
-        fmt::format("MOCAP_DOMAIN_ID='{}' is not a DDS domain id (an integer 0..232)", text));
-  }
-  return value;
-}
 
 // ---------------------------------------------------------------------------------------
 // Discovery: what other participants read and write, for tools such as `mocap_topic list`.
@@ -167,42 +155,6 @@ class FastDdsTransport::Listener final : public dds::DomainParticipantListener {
   mutable std::mutex mutex_;
   std::map<rtps::GUID_t, DiscoveredEndpoint> endpoints_;
   std::map<rtps::GuidPrefix_t, std::string> participants_;
-};
-
-// ---------------------------------------------------------------------------------------
-
-// Message objects for a reader to deserialize into. An object comes back when its last user
-// lets go of it: deserializing into a used object keeps its buffers, so large messages cost
-// no allocation and no page faults each.
-class FastDdsTransport::MessagePool : public std::enable_shared_from_this<MessagePool> {
- public:
-  explicit MessagePool(const MessageType& type) : type_(type) {}
-
-  std::shared_ptr<void> get() {
-    std::shared_ptr<void> object;
-    {
-      std::lock_guard lock(mutex_);
-      if (!free_.empty()) {
-        object = std::move(free_.back());
-        free_.pop_back();
-      }
-    }
-    if (object == nullptr) object = type_.create();
-    void* raw = object.get();
-    return std::shared_ptr<void>(
-        raw, [pool = shared_from_this(), object](void*) mutable { pool->put(std::move(object)); });
-  }
-
- private:
-  void put(std::shared_ptr<void> object) {
-    std::lock_guard lock(mutex_);
-    if (free_.size() < kKept) free_.push_back(std::move(object));
-  }
-
-  static constexpr size_t kKept = 4;
-  const MessageType& type_;
-  std::mutex mutex_;
-  std::vector<std::shared_ptr<void>> free_;
 };
 
 // ---------------------------------------------------------------------------------------

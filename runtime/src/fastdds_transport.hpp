@@ -16,7 +16,7 @@
 
 #include <mocap/component_host.hpp>
 
-#include "transport.hpp"
+#include "dds_transport.hpp"
 
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
@@ -27,16 +27,7 @@ class Topic;
 
 namespace mocap {
 
-// A reader or writer of another participant, as discovery reports it.
-struct DiscoveredEndpoint {
-  std::string topic;  // ROS name when the DDS name is a ROS one ("rt/a" -> "/a")
-  std::string type;   // DDS type name
-  bool is_publisher = false;
-  Qos qos;  // reliability and durability as announced; history is not announced
-  std::string participant;
-};
-
-class FastDdsTransport final : public Transport {
+class FastDdsTransport final : public DdsTransport {
  public:
   // Throws std::runtime_error when the participant cannot be created.
   FastDdsTransport(const DdsOptions& options, const std::string& participant_name);
@@ -47,12 +38,11 @@ class FastDdsTransport final : public Transport {
                                                    DataNotification on_data) override;
   void stop_waiting() override;
 
-  int domain_id() const { return domain_id_; }
-  // Endpoints of other participants seen so far (alive ones only).
-  std::vector<DiscoveredEndpoint> discovered_endpoints() const;
+  std::string_view implementation() const override { return "fastdds"; }
+  int domain_id() const override { return domain_id_; }
+  std::vector<DiscoveredEndpoint> discovered_endpoints() const override;
 
   class Listener;  // discovery
-  class MessagePool;
   class Writer;
   class Reader;
 
@@ -77,8 +67,5 @@ class FastDdsTransport final : public Transport {
   std::map<std::string, TopicUse> topics_;
   std::atomic<bool> stopped_waiting_{false};
 };
-
-// MOCAP_DOMAIN_ID if set (validated), otherwise `configured`.
-int resolve_domain_id(int configured);
 
 }  // namespace mocap

@@ -13,7 +13,8 @@
 
 #include <fmt/format.h>
 
-#include "fastdds_qos.hpp"
+#include "dds_options.hpp"
+#include "dds_transport.hpp"
 #include "names.hpp"
 #include "yaml_value.hpp"
 
@@ -252,6 +253,7 @@ class Reader {
       }
     }
     check_topics(loaded, problems_);
+    check_implementations();
     if (!problems_.empty()) throw LaunchError(problems_.take());
     return std::move(result_);
   }
@@ -260,14 +262,18 @@ class Reader {
   void read_dds(const YAML::Node& dds) {
     if (!dds.IsMap()) {
       problems_.add(dds,
-                    "'dds' must be a map (enabled, domain_id, shared_memory, discovery, "
-                    "security)");
+                    "'dds' must be a map (implementation, enabled, domain_id, shared_memory, "
+                    "discovery, security)");
       return;
     }
-    check_keys(
-        dds,
-        std::vector<std::string>{"enabled", "domain_id", "shared_memory", "discovery", "security"},
-        "'dds'", problems_);
+    check_keys(dds,
+               std::vector<std::string>{"implementation", "enabled", "domain_id", "shared_memory",
+                                        "discovery", "security"},
+               "'dds'", problems_);
+    if (YAML::Node n = dds["implementation"]) {
+      result_.dds.implementation = implementation_value(n);
+      implementation_line_ = line_of(n);
+    }
     if (YAML::Node n = dds["enabled"]) {
       if (auto v = bool_value(n, "enabled", problems_)) result_.dds.enabled = *v;
     }
@@ -277,8 +283,49 @@ class Reader {
     if (YAML::Node n = dds["shared_memory"]) {
       if (auto v = bool_value(n, "shared_memory", problems_)) result_.dds.shared_memory = *v;
     }
-    if (YAML::Node n = dds["discovery"]) read_discovery(n);
+    if (YAML::Node n = dds["discovery"]) {
+      read_discovery(n);
+      discovery_line_ = line_of(n);
+    }
     if (YAML::Node n = dds["security"]) read_security(n);
+  }
+
+  // "fastdds" or "cyclonedds"; "" (and a problem) for anything else.
+  std::string implementation_value(const YAML::Node& node) {
+    std::string name = string_value(node, "implementation", problems_).value_or("");
+    try {
+      if (!name.empty()) return resolve_dds_implementation(name);
+    } catch (const std::runtime_error& e) {
+      problems_.add(node, e.what());
+    }
+    return "";
+  }
+
+  // What a group's implementation cannot do: Fast DDS's Discovery Servers under Cyclone DDS.
+  void check_implementations() {
+    if (result_.dds.discovery_servers.empty()) return;
+    for (const LaunchGroup& group : result_.groups) {
+      std::string implementation;
+      try {
+        implementation = resolve_dds_implementation(result_.dds_of(group).implementation);
+      } catch (const std::runtime_error& e) {
+        problems_.add(group.line, e.what());
+        continue;
+      }
+      if (implementation == "cyclonedds") {
+        problems_.add(discovery_line_,
+                      fmt::format("dds.discovery.server: Fast DDS Discovery Servers do not work "
+                                  "with cyclonedds (group '{}'{}); run that group on fastdds, or "
+                                  "use multicast discovery, or give Cyclone DDS its peers "
+                                  "(Discovery/Peers) through CYCLONEDDS_URI",
+                                  group.name,
+                                  group.dds_implementation.empty()
+                                      ? implementation_line_ > 0
+                                            ? fmt::format(", line {}", implementation_line_)
+                                            : std::string(", from MOCAP_DDS_IMPLEMENTATION")
+                                      : fmt::format(", line {}", group.line)));
+      }
+    }
   }
 
   // discovery: {server: "host:port"} or {server: ["host:port", ...]}
@@ -346,8 +393,17 @@ class Reader {
     }
     LaunchGroup group;
     group.line = line_of(node);
-    check_keys(node, std::vector<std::string>{"name", "threads", "components"}, "a group",
+    check_keys(node, std::vector<std::string>{"name", "threads", "dds", "components"}, "a group",
                problems_);
+    if (YAML::Node dds = node["dds"]) {
+      if (!dds.IsMap()) {
+        problems_.add(dds, "a group's 'dds' must be a map with 'implementation'");
+      } else {
+        check_keys(dds, std::vector<std::string>{"implementation"}, "a group's 'dds'", problems_);
+        if (YAML::Node n = dds["implementation"])
+          group.dds_implementation = implementation_value(n);
+      }
+    }
     if (YAML::Node name = node["name"]) {
       group.name = string_value(name, "name", problems_).value_or("");
       if (!valid_component_name(group.name)) {
@@ -537,6 +593,8 @@ class Reader {
   Problems problems_;
   PluginLoader& plugins_;
   LaunchFile result_;
+  int implementation_line_ = 0;  // of dds.implementation, when given
+  int discovery_line_ = 0;       // of dds.discovery, when given
   std::map<std::string, int> component_lines_;
   // The --set option behind each overridden parameter.
   std::map<std::pair<const LaunchComponent*, std::string>, std::string> set_texts_;
@@ -553,6 +611,12 @@ const LaunchGroup* LaunchFile::find_group(std::string_view name) const {
     if (group.name == name) return &group;
   }
   return nullptr;
+}
+
+DdsOptions LaunchFile::dds_of(const LaunchGroup& group) const {
+  DdsOptions options = dds;
+  if (!group.dds_implementation.empty()) options.implementation = group.dds_implementation;
+  return options;
 }
 
 size_t LaunchFile::component_count() const {

@@ -27,6 +27,8 @@ struct LaunchComponent {
 struct LaunchGroup {
   std::string name;
   int threads = 0;
+  // The group's own `dds: {implementation: ...}`; empty: the file's.
+  std::string dds_implementation;
   std::vector<LaunchComponent> components;
   int line = 0;
 };
@@ -37,6 +39,8 @@ struct LaunchFile {
   std::vector<LaunchGroup> groups;
 
   const LaunchGroup* find_group(std::string_view name) const;
+  // The DDS options `group`'s process runs with: the file's, with the group's implementation.
+  DdsOptions dds_of(const LaunchGroup& group) const;
   size_t component_count() const;
 };
 

@@ -66,7 +66,8 @@ std::string describe(const mocap::LoadedPlugin& plugin) {
 int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
               std::optional<double> duration) {
   try {
-    mocap::ComponentHost host({group.name, group.threads, file.dds, mocap::known_topics(file)});
+    mocap::ComponentHost host(
+        {group.name, group.threads, file.dds_of(group), mocap::known_topics(file)});
     for (const mocap::LaunchComponent& component : group.components) {
       try {
         host.add(*component.plugin->factory, component.config);

@@ -15,7 +15,7 @@
 
 #include <mocap/raw_message_type.hpp>
 #include "cdr_format.hpp"
-#include "fastdds_transport.hpp"
+#include "dds_transport.hpp"
 #include "idl_schema.hpp"
 #include "rate_estimator.hpp"
 #include "shutdown_signal.hpp"
@@ -53,7 +53,7 @@ void sleep_unless_stopped(std::chrono::milliseconds duration) {
   mocap::ShutdownSignal::wait(duration);
 }
 
-int list(mocap::FastDdsTransport& transport, double wait_seconds) {
+int list(mocap::DdsTransport& transport, double wait_seconds) {
   sleep_unless_stopped(std::chrono::milliseconds(static_cast<int>(wait_seconds * 1000)));
   struct Topic {
     std::set<std::string> types;
@@ -73,8 +73,8 @@ int list(mocap::FastDdsTransport& transport, double wait_seconds) {
 }
 
 // Waits for the topic's publishers; returns their type and a QoS every one of them matches.
-std::optional<std::pair<std::string, mocap::Qos>> find_publishers(
-    mocap::FastDdsTransport& transport, const std::string& topic) {
+std::optional<std::pair<std::string, mocap::Qos>> find_publishers(mocap::DdsTransport& transport,
+                                                                  const std::string& topic) {
   auto start = std::chrono::steady_clock::now();
   bool announced = false;
   while (!mocap::ShutdownSignal::received()) {
@@ -108,7 +108,7 @@ std::optional<std::pair<std::string, mocap::Qos>> find_publishers(
 
 // Calls `each` for every message received, from this thread, until it returns false.
 template <class Each>
-int receive(mocap::FastDdsTransport& transport, const std::string& topic,
+int receive(mocap::DdsTransport& transport, const std::string& topic,
             const mocap::RawMessageType& type, const mocap::Qos& qos, Each each) {
   std::mutex mutex;
   std::condition_variable arrived;
@@ -130,7 +130,7 @@ int receive(mocap::FastDdsTransport& transport, const std::string& topic,
   return 0;
 }
 
-int echo(mocap::FastDdsTransport& transport, const std::string& topic, size_t count, bool full,
+int echo(mocap::DdsTransport& transport, const std::string& topic, size_t count, bool full,
          const std::vector<std::string>& idl_files) {
   auto found = find_publishers(transport, topic);
   if (!found) return 1;
@@ -177,7 +177,7 @@ int echo(mocap::FastDdsTransport& transport, const std::string& topic, size_t co
   });
 }
 
-int hz(mocap::FastDdsTransport& transport, const std::string& topic, size_t window, size_t count) {
+int hz(mocap::DdsTransport& transport, const std::string& topic, size_t window, size_t count) {
   auto found = find_publishers(transport, topic);
   if (!found) return 1;
   auto [dds_type, qos] = *found;
@@ -250,7 +250,8 @@ int main(int argc, char** argv) {
   mocap::ShutdownSignal::install();
   mocap::generated_message_types();  // registers the known types for echo
   try {
-    mocap::FastDdsTransport transport(mocap::DdsOptions{}, "mocap_topic");
+    auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_topic");
+    mocap::DdsTransport& transport = *dds;
     if (command == "list") return list(transport, wait_seconds);
     if (command == "echo") return echo(transport, *topic, count, full, idl_files);
     if (command == "hz") return hz(transport, *topic, window, count);

@@ -25,13 +25,17 @@ namespace mocap {
 struct DdsOptions {
   // Off: the process talks to nobody outside itself (no participant is created).
   bool enabled = true;
+  // The DDS implementation: "fastdds" (eProsima Fast DDS) or "cyclonedds" (Eclipse Cyclone
+  // DDS). Both put the same wire on the network, so processes on either talk to each other.
+  // Empty: the MOCAP_DDS_IMPLEMENTATION environment variable, else "fastdds".
+  std::string implementation = {};
   // 0..232; the MOCAP_DOMAIN_ID environment variable overrides it.
   int domain_id = 0;
-  // Off: UDP only. Needed between containers that do not share /dev/shm, and to force the
-  // network path between network namespaces.
+  // Off: UDP only (Cyclone DDS always is). Needed between containers that do not share /dev/shm,
+  // and to force the network path between network namespaces.
   bool shared_memory = true;
-  // Discovery through Fast DDS Discovery Servers instead of multicast: "host:port" each (host
-  // an IPv4 address or a name), the i-th being the server started with id i
+  // Discovery through Fast DDS Discovery Servers (Fast DDS only) instead of multicast: "host:port"
+  // each (host an IPv4 address or a name), the i-th being the server started with id i
   // (`fast-discovery-server -i i -l host -p port`, as ROS_DISCOVERY_SERVER). Empty: multicast
   // (SIMPLE) discovery. The MOCAP_DISCOVERY_SERVER environment variable ("host:port;..")
   // overrides it.
