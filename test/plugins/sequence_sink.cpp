@@ -23,6 +23,10 @@ class SequenceSink final : public Component {
     spec.parameter("timeout_s", 60.0, "give up after this long: summary, then exit code 3")
         .min(0.1);
     spec.parameter("log_every", 0, "log 'received N' every N messages; 0 for never").min(0);
+    spec.parameter("finish_at", -1,
+                   "finish when this sequence number arrives, however many came before it; -1 "
+                   "for never")
+        .min(-1);
     spec.parameter("stop_when_done", true, "stop the process once the summary is written");
     spec.parameter("work_s", 0.0, "seconds each message keeps the sink busy (a slow subscriber)")
         .range(0.0, 1.0);
@@ -38,6 +42,7 @@ class SequenceSink final : public Component {
     log_every_ = param<int64_t>("log_every");
     summary_file_ = param<std::string>("summary_file");
     stop_when_done_ = param<bool>("stop_when_done");
+    finish_at_ = param<int64_t>("finish_at");
     work_ = std::chrono::duration<double>(param<double>("work_s"));
     stall_every_ = param<int64_t>("stall_every");
     stall_ = std::chrono::duration<double>(param<double>("stall_s"));
@@ -72,7 +77,9 @@ class SequenceSink final : public Component {
     }
     ++received_;
     if (log_every_ > 0 && received_ % log_every_ == 0) log().info("received {}", received_);
-    if (expect_ > 0 && received_ == expect_) finish(0);
+    if ((expect_ > 0 && received_ == expect_) || (finish_at_ >= 0 && sequence == finish_at_)) {
+      finish(0);
+    }
   }
 
   void write_summary() {
@@ -99,6 +106,7 @@ class SequenceSink final : public Component {
   int64_t log_every_;
   std::string summary_file_;
   bool stop_when_done_;
+  int64_t finish_at_;
   std::chrono::duration<double> work_;
   int64_t stall_every_;
   std::chrono::duration<double> stall_;
