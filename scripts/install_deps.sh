@@ -7,8 +7,8 @@ set -euo pipefail
 packages=(
   # build
   build-essential cmake ninja-build pkg-config
-  # messages and DDS
-  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  # messages and DDS: Fast DDS, and Cyclone DDS as the second implementation
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools cyclonedds-dev
   # runtime
   libyaml-cpp-dev libfmt-dev
   # calibration: configuration and data files (JSON)

@@ -18,7 +18,7 @@
 #include <mocap_msgs/msg/fiducial.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "fastdds_transport.hpp"
+#include "dds_transport.hpp"
 #include "names.hpp"
 
 namespace mocap {
@@ -511,6 +511,36 @@ TEST(DomainId, TheEnvironmentOverridesTheLaunchFile) {
     }
   }
   unsetenv("MOCAP_DOMAIN_ID");
+}
+
+// The launch file's choice wins; MOCAP_DDS_IMPLEMENTATION is the default; Fast DDS without
+// either. An unknown name says where it came from and what there is.
+TEST(DdsImplementation, TheLaunchFileThenTheEnvironmentThenFastDds) {
+  const char* saved = std::getenv("MOCAP_DDS_IMPLEMENTATION");
+  std::string restore = saved != nullptr ? saved : "";
+  unsetenv("MOCAP_DDS_IMPLEMENTATION");
+  EXPECT_EQ(resolve_dds_implementation(""), "fastdds");
+  EXPECT_EQ(resolve_dds_implementation("cyclonedds"), "cyclonedds");
+  setenv("MOCAP_DDS_IMPLEMENTATION", "cyclonedds", 1);
+  EXPECT_EQ(resolve_dds_implementation(""), "cyclonedds");
+  EXPECT_EQ(resolve_dds_implementation("fastdds"), "fastdds");
+  setenv("MOCAP_DDS_IMPLEMENTATION", "connext", 1);
+  try {
+    resolve_dds_implementation("");
+    ADD_FAILURE() << "connext accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "MOCAP_DDS_IMPLEMENTATION 'connext' is not a DDS implementation here (available: "
+              "fastdds, cyclonedds)");
+  }
+  // A host on an unknown implementation does not start.
+  EXPECT_THROW(ComponentHost({.name = "bad", .dds = {.implementation = "opendds"}}),
+               std::runtime_error);
+  if (restore.empty()) {
+    unsetenv("MOCAP_DDS_IMPLEMENTATION");
+  } else {
+    setenv("MOCAP_DDS_IMPLEMENTATION", restore.c_str(), 1);
+  }
 }
 
 }  // namespace

@@ -336,6 +336,64 @@ groups:
   EXPECT_EQ(list[5], "launch.yaml:7: component name 'sink!' must use letters, digits, '_' and '-'");
 }
 
+// The DDS implementation: the file's, a group's own (which wins), and MOCAP_DDS_IMPLEMENTATION
+// when neither says; an unknown name, or what an implementation cannot do, is a problem at its
+// line.
+TEST_F(LaunchFileTest, DdsImplementationPerFileAndGroup) {
+  LaunchFile file = load(R"(dds: {implementation: cyclonedds}
+groups:
+  - name: a
+    components:
+      - plugin: sequence_source
+        name: source
+  - name: b
+    dds: {implementation: fastdds}
+    components:
+      - plugin: sequence_sink
+        name: sink
+)");
+  EXPECT_EQ(file.dds_of(file.groups[0]).implementation, "cyclonedds");
+  EXPECT_EQ(file.dds_of(file.groups[1]).implementation, "fastdds");
+
+  EXPECT_EQ(only_problem(R"(dds: {implementation: zenoh}
+groups:
+  - name: a
+    dds: {implementation: fastdds}
+    components:
+      - plugin: sequence_sink
+        name: sink
+)"),
+            "launch.yaml:1: dds: implementation 'zenoh' is not a DDS implementation here "
+            "(available: fastdds, cyclonedds)");
+  auto list = problems(R"(groups:
+  - name: a
+    dds: {implementation: cyclone, domain_id: 3}
+    components:
+      - plugin: sequence_sink
+        name: sink
+)");
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0],
+            "launch.yaml:3: unknown key 'domain_id' in a group's 'dds' (keys: implementation)");
+  EXPECT_EQ(list[1],
+            "launch.yaml:3: dds: implementation 'cyclone' is not a DDS implementation here "
+            "(available: fastdds, cyclonedds)");
+
+  // Fast DDS's Discovery Servers: not with a Cyclone DDS group.
+  EXPECT_EQ(only_problem(R"(dds:
+  discovery: {server: "127.0.0.1:11811"}
+groups:
+  - name: a
+    dds: {implementation: cyclonedds}
+    components:
+      - plugin: sequence_sink
+        name: sink
+)"),
+            "launch.yaml:2: dds.discovery.server: Fast DDS Discovery Servers do not work with "
+            "cyclonedds (group 'a', line 4); run that group on fastdds, or use multicast "
+            "discovery, or give Cyclone DDS its peers (Discovery/Peers) through CYCLONEDDS_URI");
+}
+
 TEST_F(LaunchFileTest, SetOptions) {
   EXPECT_THROW(parse_parameter_override("sink.expect"), LaunchError);
   EXPECT_THROW(parse_parameter_override("expect=3"), LaunchError);
