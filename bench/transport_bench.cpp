@@ -1,6 +1,9 @@
-// Latency and throughput of one hop: in-process through the runtime, between processes
-// through the runtime, and between processes through raw Fast DDS with the same type (its
-// fastddsgen type support) and the same QoS, all measured in this run.
+// Latency and throughput of one hop: in-process through the runtime; between processes through
+// the runtime on Fast DDS and through raw Fast DDS with the same type (its fastddsgen type
+// support) and the same QoS; through the runtime on Cyclone DDS and through raw Cyclone DDS (its
+// C API, with the runtime's type support, which serializes as fastddsgen's does) and the same
+// QoS; and across implementations, from the runtime on Fast DDS to the runtime on Cyclone DDS.
+// All measured in this run.
 //
 //   build/bin/transport_bench [--quick]
 //
@@ -18,6 +21,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -41,8 +45,10 @@
 
 #include "one_hop.hpp"
 
+#include "cyclonedds_transport.hpp"
+#include "cyclonedds_type_support.hpp"
+#include "dds_transport.hpp"
 #include "fastdds_qos.hpp"
-#include "fastdds_transport.hpp"
 
 namespace {
 
@@ -128,6 +134,80 @@ class RawEndpoint : public dds::DataReaderListener, public dds::DataWriterListen
   T sample_;
 };
 
+// --- raw Cyclone DDS ----------------------------------------------------------------------
+
+// A participant with one topic, through Cyclone's C API with the runtime's QoS.
+template <class T>
+class RawCycloneEndpoint {
+ public:
+  RawCycloneEndpoint() {
+    participant_ = dds_create_participant(mocap::resolve_domain_id(0), nullptr, nullptr);
+    ddsi_sertype* type = mocap::make_cyclonedds_sertype(mocap::message_type<T>());
+    topic_ = dds_create_topic_sertype(participant_, mocap::dds_topic_name(kTopic).c_str(), &type,
+                                      nullptr, nullptr, nullptr);
+  }
+  ~RawCycloneEndpoint() { dds_delete(participant_); }
+
+  void make_writer() {
+    dds_qos_t* qos = dds_create_qos();
+    mocap::to_cyclone_writer_qos(mocap::Qos::reliable(), qos);
+    dds_listener_t* listener = dds_create_listener(this);
+    dds_lset_publication_matched(
+        listener, [](dds_entity_t, const dds_publication_matched_status_t status, void* self) {
+          static_cast<RawCycloneEndpoint*>(self)->matched = int(status.current_count);
+        });
+    writer_ = dds_create_writer(participant_, topic_, qos, listener);
+    dds_delete_listener(listener);
+    dds_delete_qos(qos);
+  }
+
+  void make_reader() {
+    dds_qos_t* qos = dds_create_qos();
+    mocap::to_cyclone_reader_qos(mocap::Qos::reliable(), qos);
+    dds_listener_t* listener = dds_create_listener(this);
+    dds_lset_data_available(listener, [](dds_entity_t reader, void* self) {
+      static_cast<RawCycloneEndpoint*>(self)->take(reader);
+    });
+    dds_create_reader(participant_, topic_, qos, listener);
+    dds_delete_listener(listener);
+    dds_delete_qos(qos);
+  }
+
+  // As with raw Fast DDS: write again while the history is full.
+  void write(T& message) {
+    while (dds_write(writer_, &message) == DDS_RETCODE_TIMEOUT) {
+    }
+  }
+
+  std::atomic<int> matched{0};
+
+ private:
+  void take(dds_entity_t reader) {
+    ddsi_serdata* serdata = nullptr;
+    dds_sample_info_t info;
+    while (dds_takecdr(reader, &serdata, 1, &info, DDS_ANY_STATE) > 0) {
+      if (info.valid_data) {
+        mocap::message_type<T>().deserialize(mocap::serialized_bytes(serdata), &sample_);
+        received.add(sample_);
+      }
+      ddsi_serdata_unref(serdata);
+    }
+  }
+
+  dds_entity_t participant_ = 0;
+  dds_entity_t topic_ = 0;
+  dds_entity_t writer_ = 0;
+  T sample_;
+};
+
+// The middleware of the runtime on each side of a path.
+std::string publisher_implementation(const std::string& path) {
+  return path == "runtime-cyclonedds" ? "cyclonedds" : "fastdds";
+}
+std::string subscriber_implementation(const std::string& path) {
+  return path == "runtime-cyclonedds" || path == "cross" ? "cyclonedds" : "fastdds";
+}
+
 // --- the subscriber process -------------------------------------------------------------
 
 template <class T>
@@ -145,7 +225,17 @@ int run_subscriber(const std::string& path, int total, const std::string& out) {
     report();
     return 0;
   }
-  mocap::ComponentHost host({.name = "bench_subscriber", .threads = 2, .dds = {}});
+  if (path == "raw-cyclonedds") {
+    RawCycloneEndpoint<T> endpoint;
+    endpoint.make_reader();
+    received.wait_for(total, std::chrono::seconds(120));
+    std::lock_guard lock(received.mutex);
+    report();
+    return 0;
+  }
+  mocap::ComponentHost host({.name = "bench_subscriber",
+                             .threads = 2,
+                             .dds = {.implementation = subscriber_implementation(path)}});
   host.add(kSubscriberFactory<T>, {.name = "subscriber"});
   host.start();
   received.wait_for(total, std::chrono::seconds(120));
@@ -271,8 +361,20 @@ Result run_between_processes(const std::string& self, const std::string& path, c
       return stamp_ns(message);
     });
     waitpid(child, nullptr, 0);
+  } else if (path == "raw-cyclonedds") {
+    RawCycloneEndpoint<T> endpoint;
+    endpoint.make_writer();
+    wait_matched([&] { return endpoint.matched > 0; });
+    first = publish_all(count, rate, [&] {
+      stamp(message);
+      endpoint.write(message);
+      return stamp_ns(message);
+    });
+    waitpid(child, nullptr, 0);
   } else {
-    mocap::ComponentHost host({.name = "bench_publisher", .threads = 2, .dds = {}});
+    mocap::ComponentHost host({.name = "bench_publisher",
+                               .threads = 2,
+                               .dds = {.implementation = publisher_implementation(path)}});
     auto& publisher =
         static_cast<BenchPublisher<T>&>(host.add(kPublisherFactory<T>, {.name = "pub"}));
     host.start();
@@ -347,39 +449,58 @@ void print_row(const std::string& size, const std::string& path, const Result& l
              notes);
 }
 
+// The ratio of `a` to `b`: median and p99 latency, median throughput.
+void print_ratio(const std::string& label, const Result& a_latency, const Result& b_latency,
+                 const Result& a_throughput, const Result& b_throughput) {
+  fmt::print("| {:<22} | {:<30} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "", label,
+             quantile(a_latency.latencies_us, 0.5) / quantile(b_latency.latencies_us, 0.5),
+             quantile(a_latency.latencies_us, 0.99) / quantile(b_latency.latencies_us, 0.99),
+             median(a_throughput.msgs_per_s) / median(b_throughput.msgs_per_s), "");
+}
+
 template <class T>
 void measure(const std::string& self, const Size& size, int rounds) {
-  Result floor, intra_latency, intra_throughput, runtime_latency, raw_latency, runtime_throughput,
-      raw_throughput;
+  // Between processes: the runtime and the raw reference on each implementation, and the
+  // runtime from one implementation to the other.
+  const std::vector<std::string> paths = {"runtime", "raw", "runtime-cyclonedds", "raw-cyclonedds",
+                                          "cross"};
+  Result floor, intra_latency, intra_throughput;
+  std::map<std::string, Result> latency, throughput;
   Size part = size;
   part.latency_count = std::max(1, size.latency_count / rounds);
   for (int round = 0; round < rounds; ++round) {
-    // Alternate the order, so that drift in the machine's load favours neither path.
-    bool runtime_first = round % 2 == 0;
     floor.merge(measure_thread_wakeup(size.latency_rate_hz, part.latency_count));
     intra_latency.merge(run_intra<T>(part, false));
     intra_throughput.merge(run_intra<T>(part, true));
-    for (int turn = 0; turn < 2; ++turn) {
-      if ((turn == 0) == runtime_first) {
-        runtime_latency.merge(run_between_processes<T>(self, "runtime", part, false));
-        runtime_throughput.merge(run_between_processes<T>(self, "runtime", part, true));
-      } else {
-        raw_latency.merge(run_between_processes<T>(self, "raw", part, false));
-        raw_throughput.merge(run_between_processes<T>(self, "raw", part, true));
-      }
+    // Rotate the order, so that drift in the machine's load favours no path.
+    for (size_t turn = 0; turn < paths.size(); ++turn) {
+      const std::string& path = paths[(turn + round) % paths.size()];
+      latency[path].merge(run_between_processes<T>(self, path, part, false));
+      throughput[path].merge(run_between_processes<T>(self, path, part, true));
     }
   }
   std::string label = fmt::format("{} @{} Hz", size.label, size.latency_rate_hz);
   print_row(label, "thread wake-up (floor)", floor, nullptr);
   print_row("", "intra-process (runtime)", intra_latency, &intra_throughput);
-  print_row("", "inter-process (runtime)", runtime_latency, &runtime_throughput);
-  print_row("", "inter-process (raw Fast DDS)", raw_latency, &raw_throughput);
-  fmt::print(
-      "| {:<22} | {:<30} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "",
-      "runtime / raw Fast DDS",
-      quantile(runtime_latency.latencies_us, 0.5) / quantile(raw_latency.latencies_us, 0.5),
-      quantile(runtime_latency.latencies_us, 0.99) / quantile(raw_latency.latencies_us, 0.99),
-      median(runtime_throughput.msgs_per_s) / median(raw_throughput.msgs_per_s), "");
+  print_row("", "inter-process (runtime, Fast DDS)", latency["runtime"], &throughput["runtime"]);
+  print_row("", "inter-process (raw Fast DDS)", latency["raw"], &throughput["raw"]);
+  print_row("", "inter-process (runtime, Cyclone)", latency["runtime-cyclonedds"],
+            &throughput["runtime-cyclonedds"]);
+  print_row("", "inter-process (raw Cyclone DDS)", latency["raw-cyclonedds"],
+            &throughput["raw-cyclonedds"]);
+  print_row("", "Fast DDS -> Cyclone (runtime)", latency["cross"], &throughput["cross"]);
+  print_ratio("runtime / raw, Fast DDS", latency["runtime"], latency["raw"], throughput["runtime"],
+              throughput["raw"]);
+  print_ratio("runtime / raw, Cyclone DDS", latency["runtime-cyclonedds"],
+              latency["raw-cyclonedds"], throughput["runtime-cyclonedds"],
+              throughput["raw-cyclonedds"]);
+  // Against the slower of the two implementations' runtime hops (by median latency).
+  const std::string& slower = quantile(latency["runtime"].latencies_us, 0.5) >
+                                      quantile(latency["runtime-cyclonedds"].latencies_us, 0.5)
+                                  ? std::string("runtime")
+                                  : std::string("runtime-cyclonedds");
+  print_ratio("cross / slower implementation", latency["cross"], latency[slower],
+              throughput["cross"], throughput[slower]);
 }
 
 }  // namespace
@@ -415,7 +536,9 @@ int main(int argc, char** argv) {
   measure<sensor_msgs::msg::Image>(self, sizes[1], rounds);
   measure<sensor_msgs::msg::Image>(self, sizes[2], rounds);
   fmt::print(
-      "\ntargets: intra-process hop <= 10 us median; runtime inter-process hop <= 1.10 x "
-      "raw Fast DDS\n");
+      "\ntargets: intra-process hop <= 10 us median; runtime inter-process hop <= 1.10 x the "
+      "raw figure of its implementation; the hop from one implementation to the other <= 1.25 "
+      "x the slower implementation's (ratios above 1: slower latency, or, for msgs/s, below 1: "
+      "less throughput)\n");
   return 0;
 }

@@ -50,8 +50,9 @@ struct QosHandle {
   dds_qos_t* qos;
 };
 
-// The runtime's QoS, as FastDdsTransport sets it (fastdds_qos.cpp), in Cyclone's terms.
-void apply(const Qos& qos, dds_qos_t* out) {
+}  // namespace
+
+void to_cyclone_reader_qos(const Qos& qos, dds_qos_t* out) {
   dds_qset_reliability(out,
                        qos.reliability == Reliability::Reliable ? DDS_RELIABILITY_RELIABLE
                                                                 : DDS_RELIABILITY_BEST_EFFORT,
@@ -78,8 +79,8 @@ void apply(const Qos& qos, dds_qos_t* out) {
   dds_qset_data_representation(out, 1, xcdr1);
 }
 
-void apply_writer(const Qos& qos, dds_qos_t* out) {
-  apply(qos, out);
+void to_cyclone_writer_qos(const Qos& qos, dds_qos_t* out) {
+  to_cyclone_reader_qos(qos, out);
   if (qos.reliability == Reliability::Reliable && qos.durability == Durability::Volatile) {
     // On the wire as Fast DDS processes put theirs (fastdds_qos.cpp, to_writer_qos, says why):
     // transient-local, keeping one sample, with the mark that says it is volatile. So every
@@ -91,6 +92,8 @@ void apply_writer(const Qos& qos, dds_qos_t* out) {
     dds_qset_userdata(out, kVolatileWriterMark.data(), kVolatileWriterMark.size());
   }
 }
+
+namespace {
 
 Qos qos_of(const dds_qos_t* qos) {
   Qos out;
@@ -220,7 +223,7 @@ class CycloneDdsTransport::Writer final : public TransportPublisher {
       : transport_(transport), endpoint_(endpoint), report_(endpoint) {
     topic_ = transport.create_topic(endpoint);
     QosHandle qos;
-    apply_writer(endpoint.qos, qos.qos);
+    to_cyclone_writer_qos(endpoint.qos, qos.qos);
     dds_listener_t* listener = dds_create_listener(this);
     dds_lset_publication_matched(listener, &Writer::on_publication_matched);
     dds_lset_offered_incompatible_qos(listener, &Writer::on_offered_incompatible_qos);
@@ -362,7 +365,7 @@ class CycloneDdsTransport::Reader final : public TransportSubscription {
         drops_(endpoint, "subscriber") {
     topic_ = transport.create_topic(endpoint);
     QosHandle qos;
-    apply(endpoint.qos, qos.qos);
+    to_cyclone_reader_qos(endpoint.qos, qos.qos);
     dds_listener_t* listener = dds_create_listener(this);
     dds_lset_data_available(listener, &Reader::on_data_available);
     dds_lset_sample_lost(listener, &Reader::on_sample_lost);
@@ -449,8 +452,8 @@ class CycloneDdsTransport::Reader final : public TransportSubscription {
   }
 
   // A transient-local subscriber matches volatile reliable publishers, which are
-  // transient-local on the wire (apply_writer says why), but must not take from them, as in one
-  // process it is not connected to them.
+  // transient-local on the wire (to_cyclone_writer_qos says why), but must not take from them, as
+  // in one process it is not connected to them.
   bool from_volatile_publisher(dds_instance_handle_t publication) {
     if (endpoint_.qos.durability != Durability::TransientLocal) return false;
     auto known = volatile_publishers_.find(publication);
