@@ -25,6 +25,7 @@
 #include <mutex>
 #include <thread>
 
+#include <dds/ddsi/ddsi_serdata.h>
 #include <fmt/format.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
