@@ -25,7 +25,6 @@
 #include <mutex>
 #include <thread>
 
-#include <dds/ddsi/ddsi_serdata.h>
 #include <fmt/format.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -191,7 +190,7 @@ class RawCycloneEndpoint {
         mocap::message_type<T>().deserialize(mocap::serialized_bytes(serdata), &sample_);
         received.add(sample_);
       }
-      ddsi_serdata_unref(serdata);
+      mocap::release(serdata);
     }
   }
 

@@ -239,4 +239,6 @@ std::span<const uint8_t> serialized_bytes(const ddsi_serdata* serdata) {
   return {d->bytes.data(), d->size};
 }
 
+void release(ddsi_serdata* serdata) { ddsi_serdata_unref(serdata); }
+
 }  // namespace mocap

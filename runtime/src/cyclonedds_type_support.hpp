@@ -17,4 +17,8 @@ struct ddsi_sertype* make_cyclonedds_sertype(const MessageType& type);
 // The encapsulated CDR a serdata of such a sertype holds.
 std::span<const uint8_t> serialized_bytes(const struct ddsi_serdata* serdata);
 
+// Lets go of a serdata dds_takecdr() gave. (Cyclone's ddsi headers, which declare its own
+// function, cannot share a file with Fast DDS's.)
+void release(struct ddsi_serdata* serdata);
+
 }  // namespace mocap
