@@ -12,9 +12,11 @@
 #                          poses compute -> observer)
 # each with the camera at 30 Hz (latency) and at full speed (rate_hz 0: throughput). The
 # namespaces share this machine's clock, so latency is the pose's arrival time minus the
-# image's stamp, which the pose carries. Prints a markdown table.
+# image's stamp, which the pose carries. Prints a markdown table. Every process runs on the
+# DDS implementation MOCAP_DDS_IMPLEMENTATION names (default fastdds).
 #
 #   bench/distributed_bench.sh [--duration S] [--quick]   (default 15 s a run: about 2.5 min)
+#   MOCAP_DDS_IMPLEMENTATION=cyclonedds bench/distributed_bench.sh
 set -uo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -24,7 +26,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --duration) duration="${2:?}"; shift 2 ;;
     --quick) duration=8; shift ;;
-    -h | --help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "distributed_bench.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -43,7 +45,8 @@ add_row() {  # NAME CAMERA LOG NOTE
   rate="$(grep -o '[0-9.]* frames/s' "$log" | awk 'NR > 2 { print $1 }' | sort -n |
     awk '{ v[NR] = $1 } END { if (NR) printf "%.1f", v[int((NR + 1) / 2)]; else printf "-" }')"
   # | frames | lost | tracked | position | orientation | false ids | latency ms (median, p99) |
-  table="$(grep -A1 '| frames |' "$log" | tail -n 1 | sed 's/^.*\]: //')"
+  # (The row itself, not the line after the header: other processes' lines may come between.)
+  table="$(grep -E '\]: \| [0-9]+ \| [0-9]+ \| [0-9.]+ % \|' "$log" | tail -n 1 | sed 's/^.*\]: //')"
   if [ -z "$table" ]; then
     rows+=("| $name | $camera | - | - | - | - | - | no result: $(tail -n 2 "$log" | tr '\n' ' ' | cut -c1-120) |")
     return
@@ -67,7 +70,8 @@ awk -v config="$root/config" '
   { gsub(/\.\.\/\.\.\/config/, config); print }' \
   "$root/launch_yaml/distributed/tracking.yaml" >"$merged"
 
-echo "distributed_bench: ${duration} s a run, DDS domain $MOCAP_DOMAIN_ID" >&2
+echo "distributed_bench: ${duration} s a run, DDS domain $MOCAP_DOMAIN_ID," \
+  "${MOCAP_DDS_IMPLEMENTATION:-fastdds}" >&2
 servos=(--set "servos.device_link=$work/servos" --set "turret.port=$work/servos")
 for rate in 30 0; do
   camera="$([ "$rate" = 0 ] && echo "full speed" || echo "$rate Hz")"
@@ -114,4 +118,5 @@ printf '%s\n' "${rows[@]}"
 echo
 echo "Latency: the pose's arrival at the evaluator minus its image's capture stamp. 1280x720" \
   "synthetic camera, the demo scene (two boards); the robot's components run in every" \
-  "deployment but the demo's. $(nproc) CPU(s), $(uname -r)."
+  "deployment but the demo's. DDS: ${MOCAP_DDS_IMPLEMENTATION:-fastdds} (MOCAP_DDS_IMPLEMENTATION)." \
+  "$(nproc) CPU(s), $(uname -r)."

@@ -210,9 +210,17 @@ std::string subscriber_implementation(const std::string& path) {
 
 // --- the subscriber process -------------------------------------------------------------
 
+// Tells the publisher, through a file beside `out`, when the first priming message arrived,
+// then waits for `total` counted ones.
+void receive_all(int total, const std::string& out) {
+  if (received.wait_primed(std::chrono::seconds(60))) std::ofstream(out + ".ready");
+  received.wait_for(total, std::chrono::seconds(120));
+}
+
 template <class T>
 int run_subscriber(const std::string& path, int total, const std::string& out) {
   auto report = [&] {
+    std::lock_guard lock(received.mutex);
     std::ofstream file(out);
     file << received.count << " " << received.first_ns << " " << received.last_ns << "\n";
     for (double l : received.latencies_us) file << l << "\n";
@@ -220,16 +228,14 @@ int run_subscriber(const std::string& path, int total, const std::string& out) {
   if (path == "raw") {
     RawEndpoint<T> endpoint;
     endpoint.make_reader();
-    received.wait_for(total, std::chrono::seconds(120));
-    std::lock_guard lock(received.mutex);
+    receive_all(total, out);
     report();
     return 0;
   }
   if (path == "raw-cyclonedds") {
     RawCycloneEndpoint<T> endpoint;
     endpoint.make_reader();
-    received.wait_for(total, std::chrono::seconds(120));
-    std::lock_guard lock(received.mutex);
+    receive_all(total, out);
     report();
     return 0;
   }
@@ -238,9 +244,8 @@ int run_subscriber(const std::string& path, int total, const std::string& out) {
                              .dds = {.implementation = subscriber_implementation(path)}});
   host.add(kSubscriberFactory<T>, {.name = "subscriber"});
   host.start();
-  received.wait_for(total, std::chrono::seconds(120));
+  receive_all(total, out);
   host.stop();
-  std::lock_guard lock(received.mutex);
   report();
   return 0;
 }
@@ -346,15 +351,22 @@ Result run_between_processes(const std::string& self, const std::string& path, c
   T message = prototype<T>(size);
   int64_t first = 0;
   int rate = throughput ? 0 : size.latency_rate_hz;
-  auto wait_matched = [](auto matched) {
+  // Once the publisher sees its subscriber, priming messages until the subscriber got one.
+  std::string ready = out + ".ready";
+  auto wait_matched = [&](auto matched, auto write) {
     for (int i = 0; i < 1000 && !matched(); ++i)
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // let discovery settle
+    T priming = message;
+    priming.header().frame_id(kPrimingFrame);
+    for (int i = 0; i < 1000 && !std::filesystem::exists(ready); ++i) {
+      write(priming);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
   };
   if (path == "raw") {
     RawEndpoint<T> endpoint;
     endpoint.make_writer();
-    wait_matched([&] { return endpoint.matched > 0; });
+    wait_matched([&] { return endpoint.matched > 0; }, [&](T& m) { endpoint.write(m); });
     first = publish_all(count, rate, [&] {
       stamp(message);
       endpoint.write(message);
@@ -364,7 +376,7 @@ Result run_between_processes(const std::string& self, const std::string& path, c
   } else if (path == "raw-cyclonedds") {
     RawCycloneEndpoint<T> endpoint;
     endpoint.make_writer();
-    wait_matched([&] { return endpoint.matched > 0; });
+    wait_matched([&] { return endpoint.matched > 0; }, [&](T& m) { endpoint.write(m); });
     first = publish_all(count, rate, [&] {
       stamp(message);
       endpoint.write(message);
@@ -378,7 +390,8 @@ Result run_between_processes(const std::string& self, const std::string& path, c
     auto& publisher =
         static_cast<BenchPublisher<T>&>(host.add(kPublisherFactory<T>, {.name = "pub"}));
     host.start();
-    wait_matched([&] { return publisher.publisher.matched_subscribers() > 0; });
+    wait_matched([&] { return publisher.publisher.matched_subscribers() > 0; },
+                 [&](T& m) { publisher.publisher.publish(std::make_shared<T>(m)); });
     // Serialized during publish(): one object can be reused, as the raw reference does.
     auto shared = std::make_shared<T>(message);
     first = publish_all(count, rate, [&] {
@@ -390,6 +403,7 @@ Result run_between_processes(const std::string& self, const std::string& path, c
   }
   Result r = result_from(out, count, first, serialized_bytes(message), throughput);
   std::remove(out.c_str());
+  std::remove(ready.c_str());
   return r;
 }
 
@@ -444,7 +458,7 @@ void print_row(const std::string& size, const std::string& path, const Result& l
     msgs = fmt::format("{:.0f}", rate);
     mb = fmt::format("{:.1f}", rate * throughput->bytes / 1e6);
   }
-  fmt::print("| {:<22} | {:<30} | {:>9.1f} | {:>9.1f} | {:>10} | {:>8} |{}\n", size, path,
+  fmt::print("| {:<28} | {:<33} | {:>9.1f} | {:>9.1f} | {:>10} | {:>8} |{}\n", size, path,
              quantile(latency.latencies_us, 0.5), quantile(latency.latencies_us, 0.99), msgs, mb,
              notes);
 }
@@ -452,7 +466,7 @@ void print_row(const std::string& size, const std::string& path, const Result& l
 // The ratio of `a` to `b`: median and p99 latency, median throughput.
 void print_ratio(const std::string& label, const Result& a_latency, const Result& b_latency,
                  const Result& a_throughput, const Result& b_throughput) {
-  fmt::print("| {:<22} | {:<30} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "", label,
+  fmt::print("| {:<28} | {:<33} | {:>9.2f} | {:>9.2f} | {:>10.2f} | {:>8} |\n", "", label,
              quantile(a_latency.latencies_us, 0.5) / quantile(b_latency.latencies_us, 0.5),
              quantile(a_latency.latencies_us, 0.99) / quantile(b_latency.latencies_us, 0.99),
              median(a_throughput.msgs_per_s) / median(b_throughput.msgs_per_s), "");
@@ -529,9 +543,9 @@ int main(int argc, char** argv) {
       "interleaved.\nLatency: one-way, at the rate shown, pooled over rounds. Throughput: "
       "publishing as fast as flow control allows, median of rounds.\n\n",
       std::thread::hardware_concurrency(), rounds);
-  fmt::print("| {:<22} | {:<30} | {:>9} | {:>9} | {:>10} | {:>8} |\n", "message", "path",
+  fmt::print("| {:<28} | {:<33} | {:>9} | {:>9} | {:>10} | {:>8} |\n", "message", "path",
              "median us", "p99 us", "msgs/s", "MB/s");
-  fmt::print("|{:-<24}|{:-<32}|{:-<11}|{:-<11}|{:-<12}|{:-<10}|\n", "", "", "", "", "", "");
+  fmt::print("|{:-<30}|{:-<35}|{:-<11}|{:-<11}|{:-<12}|{:-<10}|\n", "", "", "", "", "", "");
   measure<mocap_msgs::msg::FiducialArray>(self, sizes[0], rounds);
   measure<sensor_msgs::msg::Image>(self, sizes[1], rounds);
   measure<sensor_msgs::msg::Image>(self, sizes[2], rounds);

@@ -64,7 +64,7 @@ std::string sink_yaml(const std::string& parameters, const std::string& qos = "r
 // The machine a reliable stream must not lose samples on: quiet, with every core busy with
 // other processes, with a subscriber that takes 5 ms over each message (far slower than its
 // publisher, which must then wait for it), both at once, or with a subscriber that stalls for
-// a second now and then.
+// two seconds now and then.
 enum class Load {
   Quiet,
   BusyCores,
@@ -110,7 +110,7 @@ class ReliableUnderLoad : public ::testing::TestWithParam<Load> {
   std::string sink(const std::string& parameters) const {
     if (slow()) return parameters + ", work_s: 0.005";
     if (GetParam() == Load::StallingSubscriber) {
-      return parameters + ", stall_every: 2500, stall_s: 1.0";
+      return parameters + ", stall_every: 2500, stall_s: 2.0";
     }
     return parameters;
   }
@@ -169,7 +169,9 @@ TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
         << output;
   }
   if (GetParam() == Load::StallingSubscriber) {
-    EXPECT_GT(source.at("longest_wait_ms"), 500);  // through a whole stall
+    // Through most of a stall: the publisher fills the subscriber's history and the
+    // implementation's window first (Cyclone DDS's 500 kB take a while on a busy machine).
+    EXPECT_GT(source.at("longest_wait_ms"), 500);
   }
 }
 

@@ -97,21 +97,26 @@ TEST(MixedDds, EachImplementationDiscoversTheOthersEndpoints) {
   const MessageType& type = *find_message_type("mocap_msgs/msg/FiducialArray");
   auto fast_writer = fast->advertise({"/mixed/fast", &type, Qos::latched(), "test"});
   auto cyclone_writer = cyclone->advertise({"/mixed/cyclone", &type, Qos::reliable(), "test"});
-  auto find = [](const DdsTransport& transport, const std::string& topic) {
+  // An endpoint may be seen before its participant's name (then named by its GUID prefix).
+  auto find = [](const DdsTransport& transport, const std::string& topic,
+                 const std::string& participant) {
+    DiscoveredEndpoint seen;
     auto deadline = std::chrono::steady_clock::now() + seconds(20);
     while (std::chrono::steady_clock::now() < deadline) {
       for (const DiscoveredEndpoint& endpoint : transport.discovered_endpoints()) {
-        if (endpoint.topic == topic && endpoint.is_publisher) return endpoint;
+        if (endpoint.topic != topic || !endpoint.is_publisher) continue;
+        seen = endpoint;
+        if (endpoint.participant == participant) return seen;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    return DiscoveredEndpoint{};
+    return seen;
   };
-  DiscoveredEndpoint seen_by_cyclone = find(*cyclone, "/mixed/fast");
+  DiscoveredEndpoint seen_by_cyclone = find(*cyclone, "/mixed/fast", "fastdds_participant");
   EXPECT_EQ(seen_by_cyclone.type, "mocap_msgs::msg::dds_::FiducialArray_");
   EXPECT_EQ(seen_by_cyclone.participant, "fastdds_participant");
   EXPECT_EQ(seen_by_cyclone.qos.durability, Durability::TransientLocal);
-  DiscoveredEndpoint seen_by_fast = find(*fast, "/mixed/cyclone");
+  DiscoveredEndpoint seen_by_fast = find(*fast, "/mixed/cyclone", "cyclonedds_participant");
   EXPECT_EQ(seen_by_fast.type, "mocap_msgs::msg::dds_::FiducialArray_");
   EXPECT_EQ(seen_by_fast.participant, "cyclonedds_participant");
   EXPECT_EQ(seen_by_fast.qos.reliability, Reliability::Reliable);
@@ -120,6 +125,54 @@ TEST(MixedDds, EachImplementationDiscoversTheOthersEndpoints) {
 }
 
 std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
+
+// A peer of the other implementation whose QoS cannot match: nothing connects, and
+// `mocap_topic list`, on either implementation, names the pair and why.
+TEST(MixedDds, TopicListNamesPairsThatCannotConnect) {
+  auto fast = participant("fastdds", 84);
+  auto cyclone = participant("cyclonedds", 84);
+  const MessageType& type = *find_message_type("mocap_msgs/msg/FiducialArray");
+  auto best_effort = fast->advertise({"/mixed/best_effort", &type, Qos::sensor_data(), "test"});
+  auto wants_reliable =
+      cyclone->subscribe({"/mixed/best_effort", &type, Qos::reliable(), "test"}, [](bool) {});
+  auto volatile_writer = cyclone->advertise({"/mixed/volatile", &type, Qos::reliable(), "test"});
+  auto wants_latched =
+      fast->subscribe({"/mixed/volatile", &type, Qos::latched(), "test"}, [](bool) {});
+  auto fine = fast->advertise({"/mixed/fine", &type, Qos::reliable(), "test"});
+  auto fine_reader =
+      cyclone->subscribe({"/mixed/fine", &type, Qos::reliable(), "test"}, [](bool) {});
+  for (const char* implementation : {"fastdds", "cyclonedds"}) {
+    SCOPED_TRACE(implementation);
+    auto [code, output] =
+        test::run_command({(test::bin_dir() / "mocap_topic").string(), "list", "--wait", "3"},
+                          {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(84))},
+                           {"MOCAP_DDS_IMPLEMENTATION", implementation}});
+    ASSERT_EQ(code, 0) << output;
+    EXPECT_NE(output.find("/mixed/best_effort [mocap_msgs/msg/FiducialArray] 1 publisher(s), 1 "
+                          "subscriber(s), 1 incompatible pair(s)\n  incompatible: publisher of "
+                          "'fastdds_participant' -> subscriber of 'cyclonedds_participant': the "
+                          "subscriber requests reliable delivery but the publisher offers "
+                          "best_effort\n"),
+              std::string::npos)
+        << output;
+    EXPECT_NE(output.find("/mixed/volatile [mocap_msgs/msg/FiducialArray] 1 publisher(s), 1 "
+                          "subscriber(s), 1 incompatible pair(s)\n  incompatible: publisher of "
+                          "'cyclonedds_participant' -> subscriber of 'fastdds_participant': the "
+                          "subscriber requests transient_local durability but the publisher is "
+                          "volatile\n"),
+              std::string::npos)
+        << output;
+    EXPECT_NE(output.find("/mixed/fine [mocap_msgs/msg/FiducialArray] 1 publisher(s), 1 "
+                          "subscriber(s)\n"),
+              std::string::npos)
+        << output;
+  }
+  EXPECT_EQ(best_effort->matched_subscribers(), 0u);
+  // (The volatile writer is matched on the wire, transient local there, but the latched
+  // subscriber takes nothing from it: dds_options.hpp.)
+  EXPECT_EQ(fine->matched_subscribers(), 1u);
+  fine.reset();
+}
 
 std::map<std::string, std::string> environment(int slot, const std::string& implementation) {
   return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))},

@@ -28,7 +28,8 @@ constexpr const char* kUsage = R"(usage:
   mocap_topic hz TOPIC [--window N] [--count N]
 options for all: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
 
-  list   topics seen on the domain, with their types and endpoint counts
+  list   topics seen on the domain, with their types and endpoint counts, and each
+         publisher/subscriber pair that cannot connect (QoS or type) and why
   echo   print each message (YAML-like); --count stops after N, --full prints whole arrays,
          --idl adds definitions for types this build does not know
   hz     publication rate from the publisher's timestamps, every second; --window sets the
@@ -53,21 +54,43 @@ void sleep_unless_stopped(std::chrono::milliseconds duration) {
   mocap::ShutdownSignal::wait(duration);
 }
 
+// Topics with their types and endpoint counts, and under each topic every publisher and
+// subscriber pair that DDS will not connect (QoS or type), whichever implementation each
+// runs on: such a subscriber gets nothing, and its own process only logs it.
 int list(mocap::DdsTransport& transport, double wait_seconds) {
   sleep_unless_stopped(std::chrono::milliseconds(static_cast<int>(wait_seconds * 1000)));
   struct Topic {
     std::set<std::string> types;
-    int publishers = 0, subscribers = 0;
+    std::vector<mocap::DiscoveredEndpoint> publishers, subscribers;
   };
   std::map<std::string, Topic> topics;
-  for (const auto& endpoint : transport.discovered_endpoints()) {
+  for (auto& endpoint : transport.discovered_endpoints()) {
     Topic& topic = topics[endpoint.topic];
     topic.types.insert(mocap::ros_type_name(endpoint.type));
-    (endpoint.is_publisher ? topic.publishers : topic.subscribers) += 1;
+    (endpoint.is_publisher ? topic.publishers : topic.subscribers).push_back(std::move(endpoint));
   }
   for (const auto& [name, topic] : topics) {
-    fmt::print("{} [{}] {} publisher(s), {} subscriber(s)\n", name, fmt::join(topic.types, ", "),
-               topic.publishers, topic.subscribers);
+    std::vector<std::string> mismatches;
+    for (const auto& subscriber : topic.subscribers) {
+      for (const auto& publisher : topic.publishers) {
+        auto why = publisher.type != subscriber.type
+                       ? std::optional<std::string>(fmt::format(
+                             "types differ ({} vs {})", mocap::ros_type_name(publisher.type),
+                             mocap::ros_type_name(subscriber.type)))
+                       : mocap::qos_mismatch(publisher.qos, subscriber.qos);
+        if (why) {
+          mismatches.push_back(
+              fmt::format("  incompatible: publisher of '{}' -> subscriber of "
+                          "'{}': {}",
+                          publisher.participant, subscriber.participant, *why));
+        }
+      }
+    }
+    fmt::print(
+        "{} [{}] {} publisher(s), {} subscriber(s){}\n", name, fmt::join(topic.types, ", "),
+        topic.publishers.size(), topic.subscribers.size(),
+        mismatches.empty() ? "" : fmt::format(", {} incompatible pair(s)", mismatches.size()));
+    for (const auto& line : mismatches) fmt::print("{}\n", line);
   }
   return 0;
 }
