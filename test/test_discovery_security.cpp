@@ -259,6 +259,33 @@ groups:
                                     credentials().string())),
             std::string::npos)
       << output;
+
+  // One identity on both implementations: the check refuses it (launch_yaml/README.md).
+  test::write_file(file, R"(dds:
+  security: {directory: credentials, identity: alice}
+groups:
+  - name: source
+    dds: {implementation: cyclonedds}
+    components:
+      - plugin: sequence_source
+        name: source
+  - name: sink
+    dds: {implementation: fastdds}
+    components:
+      - plugin: sequence_sink
+        name: sink
+)");
+  std::tie(code, output) =
+      test::run_command({launcher(), file.string(), "--check"}, environment(62));
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_NE(output.find(file.string() +
+                        ":2: dds.security: group 'sink' (fastdds, line 9) and group 'source' "
+                        "(cyclonedds, line 4) would authenticate each other only when the "
+                        "Cyclone DDS side starts the handshake, which with one identity is "
+                        "chance; run them on one implementation, or in separate launch files "
+                        "with identities ordered as launch_yaml/README.md explains"),
+            std::string::npos)
+      << output;
 }
 
 // Same CA, both allowed to: the stream arrives whole, over shared memory as over UDP.

@@ -287,7 +287,10 @@ class Reader {
       read_discovery(n);
       discovery_line_ = line_of(n);
     }
-    if (YAML::Node n = dds["security"]) read_security(n);
+    if (YAML::Node n = dds["security"]) {
+      security_line_ = line_of(n);
+      read_security(n);
+    }
   }
 
   // "fastdds" or "cyclonedds"; "" (and a problem) for anything else.
@@ -301,9 +304,10 @@ class Reader {
     return "";
   }
 
-  // What a group's implementation cannot do: Fast DDS's Discovery Servers under Cyclone DDS.
+  // What a group's implementation cannot do: Fast DDS's Discovery Servers under Cyclone DDS,
+  // and DDS Security between groups on different implementations.
   void check_implementations() {
-    if (result_.dds.discovery_servers.empty()) return;
+    std::map<std::string, const LaunchGroup*> first_on;  // implementation -> its first group
     for (const LaunchGroup& group : result_.groups) {
       std::string implementation;
       try {
@@ -312,20 +316,38 @@ class Reader {
         problems_.add(group.line, e.what());
         continue;
       }
-      if (implementation == "cyclonedds") {
+      first_on.emplace(implementation, &group);
+      if (implementation == "cyclonedds" && !result_.dds.discovery_servers.empty()) {
         problems_.add(discovery_line_,
                       fmt::format("dds.discovery.server: Fast DDS Discovery Servers do not work "
                                   "with cyclonedds (group '{}'{}); run that group on fastdds, or "
                                   "use multicast discovery, or give Cyclone DDS its peers "
                                   "(Discovery/Peers) through CYCLONEDDS_URI",
-                                  group.name,
-                                  group.dds_implementation.empty()
-                                      ? implementation_line_ > 0
-                                            ? fmt::format(", line {}", implementation_line_)
-                                            : std::string(", from MOCAP_DDS_IMPLEMENTATION")
-                                      : fmt::format(", line {}", group.line)));
+                                  group.name, where_chosen(group)));
       }
     }
+    // One identity on both sides: which side starts the handshake is chance, and Fast DDS 2.9
+    // starting it fails with Cyclone DDS 0.10 (launch_yaml/README.md).
+    if (!result_.dds.security_identity.empty() && first_on.size() > 1) {
+      const LaunchGroup& fast = *first_on.at("fastdds");
+      const LaunchGroup& cyclone = *first_on.at("cyclonedds");
+      problems_.add(
+          security_line_,
+          fmt::format("dds.security: group '{}' (fastdds{}) and group '{}' (cyclonedds{}) "
+                      "would authenticate each other only when the Cyclone DDS side "
+                      "starts the handshake, which with one identity is chance; run "
+                      "them on one implementation, or in separate launch files with "
+                      "identities ordered as launch_yaml/README.md explains",
+                      fast.name, where_chosen(fast), cyclone.name, where_chosen(cyclone)));
+    }
+  }
+
+  // Where a group's implementation comes from, for messages: ", line N" or ", from
+  // MOCAP_DDS_IMPLEMENTATION".
+  std::string where_chosen(const LaunchGroup& group) const {
+    if (!group.dds_implementation.empty()) return fmt::format(", line {}", group.line);
+    if (implementation_line_ > 0) return fmt::format(", line {}", implementation_line_);
+    return ", from MOCAP_DDS_IMPLEMENTATION";
   }
 
   // discovery: {server: "host:port"} or {server: ["host:port", ...]}
@@ -595,6 +617,7 @@ class Reader {
   LaunchFile result_;
   int implementation_line_ = 0;  // of dds.implementation, when given
   int discovery_line_ = 0;       // of dds.discovery, when given
+  int security_line_ = 0;        // of dds.security, when given
   std::map<std::string, int> component_lines_;
   // The --set option behind each overridden parameter.
   std::map<std::pair<const LaunchComponent*, std::string>, std::string> set_texts_;
