@@ -1,5 +1,5 @@
-// Speed and accuracy of the fiducial detector (components/fiducial_tracker) against the seed's
-// method in OpenCV (seed 000 §5.7: cv::threshold at 0.75 x the brightest pixel,
+// Speed and accuracy of the fiducial detector (components/tracking/fiducial_tracker) against the
+// seed's method in OpenCV (seed 000 §5.7: cv::threshold at 0.75 x the brightest pixel,
 // cv::findContours of the external contours, the mean of each contour's points as the
 // centroid, area and circularity filters), both measured in the same run on the same frames,
 // on one core (OpenCV's own threads are turned off).

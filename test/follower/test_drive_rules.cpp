@@ -1,5 +1,5 @@
-// The drive follower's library (components/drive_follower) and the simulated base
-// (components/mobile_base_sim): the seed's two driving rules on scripted positions, the
+// The drive follower's library (components/follower/drive_follower) and the simulated base
+// (components/sim/mobile_base_sim): the seed's two driving rules on scripted positions, the
 // object's place and facing from a camera pose and the turret, the acceleration limits and the
 // lost-track stop, the base's exact arcs, and the closed loop of rules and base in simulated
 // time: the base reaches the goal from several starts and follows a walking object.

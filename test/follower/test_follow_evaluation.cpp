@@ -1,5 +1,6 @@
-// The follower demo's figures (components/follower_monitor/follow_evaluation.hpp) on scripted
-// truth: pointing error, distance kept once the object has stood for settle_s, stop latency.
+// The follower demo's figures (components/follower/follower_monitor/follow_evaluation.hpp) on
+// scripted truth: pointing error, distance kept once the object has stood for settle_s, stop
+// latency.
 #include <gtest/gtest.h>
 
 #include <cmath>

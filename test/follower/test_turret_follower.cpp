@@ -1,4 +1,4 @@
-// The turret follower (components/dynamixel_follower): servo units, the joint history, the
+// The turret follower (components/follower/dynamixel_follower): servo units, the joint history, the
 // follower's modes, and the plugin driving the simulated AX-12A chain (ax12_sim) over a real
 // pseudo-terminal, with a camera stand-in that sees a fixed target through the turret's present
 // angles: the loop closes through real Dynamixel bytes.

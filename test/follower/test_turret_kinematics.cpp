@@ -1,4 +1,4 @@
-// The turret's kinematic chain (components/turret_kinematics): forward kinematics against
+// The turret's kinematic chain (components/follower/turret_kinematics): forward kinematics against
 // hand-computed poses, aiming at targets near and far (checked by the forward chain, not by
 // the aiming code's own arithmetic), limits, and the turret file's errors.
 #include <gtest/gtest.h>

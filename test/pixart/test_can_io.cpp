@@ -1,7 +1,7 @@
-// The PixArt bridge's CAN input layer (components/pixart_bridge, library can_io): frames in
+// The PixArt bridge's CAN input layer (components/pixart/pixart_bridge, library can_io): frames in
 // candump notation, the SLCAN protocol, candump -L logs, serial ports over real
-// pseudo-terminals (components/serial_io), and SocketCAN (frame conversion always; a live round
-// trip where a vcan0 interface exists).
+// pseudo-terminals (components/common/serial_io), and SocketCAN (frame conversion always; a live
+// round trip where a vcan0 interface exists).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Frame sources (components/camera_source): conversion to mono8, directories of images,
+// Frame sources (components/tracking/camera_source): conversion to mono8, directories of images,
 // video files, the errors for missing input, and the camera_source plugin in a launched graph.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// The fiducial detector (components/fiducial_tracker): sub-pixel centroids of rendered
+// The fiducial detector (components/tracking/fiducial_tracker): sub-pixel centroids of rendered
 // blurred discs, the filters (threshold floor, area, circularity, border, region of
 // interest), agreement with OpenCV's connected components and contours, the uncertainty
 // estimate, Image messages that cannot be read, and the plugin in a launched graph.

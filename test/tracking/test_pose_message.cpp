@@ -1,4 +1,4 @@
-// geometry_msgs/Pose <-> Eigen (components/pose_message): a round trip, and messages no
+// geometry_msgs/Pose <-> Eigen (components/common/pose_message): a round trip, and messages no
 // transform describes.
 #include <gtest/gtest.h>
 

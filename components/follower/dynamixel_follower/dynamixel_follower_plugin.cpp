@@ -1,0 +1,370 @@
+// dynamixel_follower: the pan/tilt turret of seed 000 §5.11 on two AX-12A servos. It keeps the
+// tracked constellation on the camera's optical axis (turret_follower.hpp) and drives the
+// servos over a Dynamixel Protocol 1.0 bus (dynamixel_bus.hpp) on its own thread, each cycle:
+//
+//   1. READ present position, speed and load of both servos -> /turret/joint_states;
+//   2. the command for now -> one SYNC_WRITE of goal position and moving speed to both
+//      (also on /turret/command, for inspection).
+//
+// Poses on /mocap/poses are placed in the base frame with the joint angles of their image's
+// time. A servo reporting overheating or overload gets its torque switched off, for both, and
+// an alert on /alerts; the follower then only reports, until restarted. A bus that goes away
+// (adaptor unplugged) is reopened with back-off.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/alert.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <sensor_msgs/msg/joint_state.hpp>
+
+#include "ax12_control_table.hpp"
+#include "dynamixel_bus.hpp"
+#include "joint_history.hpp"
+#include "servo_mapping.hpp"
+#include "turret_follower.hpp"
+#include "turret_model.hpp"
+
+namespace mocap::turret {
+namespace {
+
+namespace ax12 = dynamixel::ax12;
+using dynamixel::BusError;
+using dynamixel::BusErrorKind;
+using JointState = sensor_msgs::msg::JointState;
+
+constexpr const char* kPoseTopic = "/mocap/poses";
+constexpr const char* kStateTopic = "/turret/joint_states";
+constexpr const char* kCommandTopic = "/turret/command";
+constexpr const char* kAlertTopic = "/alerts";
+constexpr uint8_t kShutdownErrors =
+    dynamixel::error_bit::kOverheating | dynamixel::error_bit::kOverload;
+
+int64_t clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
+}
+
+class DynamixelFollower final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Keeps the tracked constellation centred with a pan/tilt turret of two AX-12A servos "
+        "(Dynamixel Protocol 1.0 on a serial port); publishes the joints' present state. "
+        "Overheating or overload: torque off and an alert.");
+    spec.parameter("port", std::string("/dev/ttyUSB0"),
+                   "serial device of the Dynamixel adaptor (or the ax12_sim's device_link)")
+        .path();
+    spec.parameter("baud", 1000000, "bus baud rate (the servos' setting)").range(9600, 3000000);
+    spec.parameter("pan_id", 1, "servo ID of the pan joint").range(0, 253);
+    spec.parameter("tilt_id", 2, "servo ID of the tilt joint").range(0, 253);
+    spec.parameter("turret", mocap::config_file("turret.yaml"),
+                   "the turret's kinematic chain and servo mapping (config/turret.yaml)")
+        .path();
+    spec.parameter("constellation", std::string(),
+                   "the constellation to follow; empty = the first of each pose array");
+    spec.parameter("rate_hz", 50.0, "control cycles per second").range(1, 500);
+    spec.parameter("pan_speed_rps", 1.5, "pan speed limit, rad/s (the seed's heavy turret: 0.1)")
+        .range(0.01, 11.9);
+    spec.parameter("tilt_speed_rps", 1.0, "tilt speed limit, rad/s (the seed's heavy turret: 0.05)")
+        .range(0.01, 11.9);
+    spec.parameter("lost_after_s", 0.3, "no pose for this long: the track is lost").range(0.01, 60);
+    spec.parameter("hold_s", 2.0, "after losing the track, hold still this long").range(0, 3600);
+    spec.parameter("search", false, "after holding, sweep the pan joint to find the object");
+    spec.parameter("search_speed_rps", 0.3, "pan speed while searching, rad/s").range(0.01, 11.9);
+    spec.parameter("reply_timeout_ms", 10, "wait for a servo's answer, per attempt").range(1, 1000);
+    spec.parameter("retries", 2, "further attempts after a timeout or a corrupt answer")
+        .range(0, 10);
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoseTopic, Qos::reliable(),
+                                                             "tracked poses, camera frame");
+    spec.publishes<JointState>(kStateTopic, Qos::reliable(),
+                               "joints pan and tilt: present position (rad), speed (rad/s), "
+                               "load (fraction of the maximum torque) as effort");
+    spec.publishes<JointState>(kCommandTopic, Qos::reliable(),
+                               "joints pan and tilt: goal position (rad) and speed limit "
+                               "(rad/s) sent each cycle");
+    spec.publishes<mocap_msgs::msg::Alert>(kAlertTopic, Qos::reliable(),
+                                           "servo faults: torque switched off");
+  }
+
+  explicit DynamixelFollower(Context& context)
+      : Component(context),
+        follower_(load_turret(param<std::string>("turret")), follower_options()) {
+    constellation_ = param<std::string>("constellation");
+    pan_id_ = static_cast<uint8_t>(param<int>("pan_id"));
+    tilt_id_ = static_cast<uint8_t>(param<int>("tilt_id"));
+    if (pan_id_ == tilt_id_) {
+      throw std::invalid_argument("pan_id and tilt_id are both " + std::to_string(pan_id_) +
+                                  "; each servo needs its own ID");
+    }
+    period_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
+        std::chrono::duration<double>(1 / param<double>("rate_hz")));
+    states_ = create_publisher<JointState>(kStateTopic);
+    commands_ = create_publisher<JointState>(kCommandTopic);
+    alerts_ = create_publisher<mocap_msgs::msg::Alert>(kAlertTopic);
+    create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
+        kPoseTopic,
+        [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { on_poses(poses); });
+    // The bus is driven from its own thread, started with the graph (timers run once every
+    // component exists), so that blocking serial I/O never holds up the executor.
+    create_timer(std::chrono::milliseconds(1), [this] {
+      if (!worker_.joinable()) worker_ = std::thread([this] { run(); });
+    });
+    log().info("servos {} (pan) and {} (tilt) on {} at {} bit/s, {} Hz; turret {}", pan_id_,
+               tilt_id_, param<std::string>("port"), param<int>("baud"), param<double>("rate_hz"),
+               follower_.turret().source());
+  }
+
+  ~DynamixelFollower() override {
+    stop_ = true;
+    if (worker_.joinable()) worker_.join();
+    log().info(
+        "{} cycles, {} poses used, {} without a joint reading; bus: {} packets, {} replies, {} "
+        "timeouts, {} corrupt, {} retries; {} reconnects",
+        cycles_, poses_used_, poses_early_, bus_stats_.packets_sent, bus_stats_.replies,
+        bus_stats_.timeouts, bus_stats_.corrupt_replies, bus_stats_.retries, reconnects_);
+  }
+
+ private:
+  TurretFollowerOptions follower_options() const {
+    TurretFollowerOptions options;
+    options.pan_speed_rps = param<double>("pan_speed_rps");
+    options.tilt_speed_rps = param<double>("tilt_speed_rps");
+    options.lost_after_s = param<double>("lost_after_s");
+    options.hold_s = param<double>("hold_s");
+    options.search = param<bool>("search");
+    options.search_speed_rps = param<double>("search_speed_rps");
+    return options;
+  }
+
+  // --- executor side ----------------------------------------------------------------------
+
+  void on_poses(const mocap_msgs::msg::ConstellationPoseArray& poses) {
+    for (const auto& pose : poses.poses()) {
+      if (!constellation_.empty() && pose.name() != constellation_) continue;
+      const auto& p = pose.pose().pose().position();
+      const int64_t stamp_ns = to_nanoseconds(pose.pose().header().stamp());
+      std::lock_guard lock(mutex_);
+      std::optional<JointAngles> angles = history_.at(stamp_ns);
+      if (!angles) {
+        ++poses_early_;  // the joints have not been read yet
+        return;
+      }
+      follower_.observe(stamp_ns, Eigen::Vector3d(p.x(), p.y(), p.z()), *angles);
+      ++poses_used_;
+      return;
+    }
+  }
+
+  // --- bus thread --------------------------------------------------------------------------
+
+  void run() {
+    std::chrono::milliseconds backoff(100);
+    auto next = std::chrono::steady_clock::now();
+    while (!stop_) {
+      try {
+        if (!bus_) {
+          connect();
+          backoff = std::chrono::milliseconds(100);
+        }
+        if (!faulted_)
+          cycle();
+        else
+          report_only();
+      } catch (const BusError& e) {
+        if (e.kind() == BusErrorKind::kPortGone) {
+          bus_stats_ = add(bus_stats_, bus_->stats());
+          bus_.reset();
+          log().warn("{}; reopening in {} ms", e.what(), backoff.count());
+          sleep_for(backoff);
+          backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
+          continue;
+        }
+        if (e.kind() == BusErrorKind::kServoError && (e.servo_errors() & kShutdownErrors)) {
+          shut_down(e);
+        } else if (++bus_errors_ <= 10 || bus_errors_ % 100 == 0) {
+          log().warn("{} ({} bus errors so far)", e.what(), bus_errors_);
+        }
+      } catch (const std::exception& e) {  // cannot open the device
+        log().warn("{}; retrying in {} ms", e.what(), backoff.count());
+        sleep_for(backoff);
+        backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
+        continue;
+      }
+      next += period_;
+      const auto now = std::chrono::steady_clock::now();
+      if (next < now) next = now;  // fell behind: no burst of cycles to catch up
+      std::this_thread::sleep_until(next);
+    }
+    if (bus_) bus_stats_ = add(bus_stats_, bus_->stats());
+  }
+
+  void connect() {
+    dynamixel::DynamixelBusOptions options;
+    options.baud_rate = param<int>("baud");
+    options.reply_timeout = std::chrono::milliseconds(param<int>("reply_timeout_ms"));
+    options.retries = param<int>("retries");
+    bus_ = std::make_unique<dynamixel::DynamixelBus>(param<std::string>("port"), options);
+    if (connections_++ > 0) ++reconnects_;
+    for (uint8_t id : {pan_id_, tilt_id_}) {
+      if (uint8_t errors = bus_->ping(id); errors != 0) {
+        log().warn("servo {} reports {}", id, dynamixel::describe_errors(errors));
+      }
+    }
+    // A servo that reports overheating or overload refuses nothing but says so: the caller
+    // switches both off again (shut_down).
+    for (uint8_t id : {pan_id_, tilt_id_}) bus_->write_u8(id, ax12::kTorqueEnable, 1);
+    log().info("servos {} and {} answer on {}; torque on", pan_id_, tilt_id_, bus_->device());
+  }
+
+  struct ServoReading {
+    uint16_t position = 0;
+    double speed_rps = 0;
+    double load = 0;
+  };
+
+  ServoReading read_servo(uint8_t id) {
+    std::vector<uint8_t> data;
+    try {
+      data = bus_->read(id, ax12::kPresentPosition, 6);
+    } catch (const BusError& e) {
+      // A servo reporting a condition still answers with its data.
+      if (e.kind() != BusErrorKind::kServoError || e.reply_data().size() != 6) throw;
+      if (!faulted_ && (e.servo_errors() & kShutdownErrors)) throw;
+      data = e.reply_data();
+    }
+    return {ax12::get_u16(data, 0), ax12::present_speed_to_rad_s(ax12::get_u16(data, 2)),
+            ax12::present_load_to_fraction(ax12::get_u16(data, 4))};
+  }
+
+  // Reads both joints, publishes them and keeps them for the poses. Returns the angles.
+  JointAngles read_joints() {
+    const ServoReading pan = read_servo(pan_id_), tilt = read_servo(tilt_id_);
+    const int64_t stamp_ns = clock_ns();
+    const TurretModel& turret = follower_.turret();
+    const JointAngles angles{joint_angle(turret.pan(), pan.position),
+                             joint_angle(turret.tilt(), tilt.position)};
+    {
+      std::lock_guard lock(mutex_);
+      history_.add(stamp_ns, angles);
+    }
+    auto state = std::make_shared<JointState>();
+    state->header().stamp(to_time_msg(Clock::time_point(std::chrono::nanoseconds(stamp_ns))));
+    state->name({"pan", "tilt"});
+    state->position({angles.pan, angles.tilt});
+    state->velocity({turret.pan().servo.direction * pan.speed_rps,
+                     turret.tilt().servo.direction * tilt.speed_rps});
+    state->effort(
+        {turret.pan().servo.direction * pan.load, turret.tilt().servo.direction * tilt.load});
+    states_.publish(std::move(state));
+    return angles;
+  }
+
+  void cycle() {
+    const JointAngles present = read_joints();
+    TurretCommand command;
+    {
+      std::lock_guard lock(mutex_);
+      command = follower_.update(clock_ns(), present);
+    }
+    if (command.mode != last_mode_) {
+      log().info("{}", to_string(command.mode));
+      last_mode_ = command.mode;
+    }
+    const TurretModel& turret = follower_.turret();
+    auto item = [](uint8_t id, uint16_t position, uint16_t speed) {
+      return dynamixel::SyncWriteItem{id,
+                                      {uint8_t(position & 0xFF), uint8_t(position >> 8),
+                                       uint8_t(speed & 0xFF), uint8_t(speed >> 8)}};
+    };
+    const dynamixel::SyncWriteItem items[] = {
+        item(pan_id_, servo_position(turret.pan(), command.goal.pan),
+             ax12::rad_s_to_moving_speed(command.speed.pan)),
+        item(tilt_id_, servo_position(turret.tilt(), command.goal.tilt),
+             ax12::rad_s_to_moving_speed(command.speed.tilt))};
+    bus_->sync_write(ax12::kGoalPosition, 4, items);
+    ++cycles_;
+
+    auto sent = std::make_shared<JointState>();
+    sent->header().stamp(to_time_msg(now()));
+    sent->name({"pan", "tilt"});
+    sent->position({command.goal.pan, command.goal.tilt});
+    sent->velocity({command.speed.pan, command.speed.tilt});
+    commands_.publish(std::move(sent));
+  }
+
+  // After a shutdown: keep reporting where the joints are.
+  void report_only() { read_joints(); }
+
+  void shut_down(const BusError& error) {
+    faulted_ = true;
+    for (uint8_t id : {pan_id_, tilt_id_}) {
+      try {
+        bus_->write_u8(id, ax12::kTorqueEnable, 0);
+      } catch (const BusError& e) {
+        // The servo executes a write while reporting its condition; only a lost answer is news.
+        if (e.kind() != BusErrorKind::kServoError) log().warn("torque off: {}", e.what());
+      }
+    }
+    const std::string text = std::string(error.what()) + ": torque off on both servos";
+    log().error("{}", text);
+    auto alert = std::make_shared<mocap_msgs::msg::Alert>();
+    alert->header().stamp(to_time_msg(now()));
+    alert->source(name());
+    alert->level(2);
+    alert->text(text);
+    alerts_.publish(std::move(alert));
+  }
+
+  void sleep_for(std::chrono::milliseconds duration) const {
+    for (auto waited = std::chrono::milliseconds(0); waited < duration && !stop_;
+         waited += std::chrono::milliseconds(20)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  static dynamixel::DynamixelBusStats add(dynamixel::DynamixelBusStats a,
+                                          const dynamixel::DynamixelBusStats& b) {
+    a.packets_sent += b.packets_sent;
+    a.replies += b.replies;
+    a.timeouts += b.timeouts;
+    a.corrupt_replies += b.corrupt_replies;
+    a.retries += b.retries;
+    return a;
+  }
+
+  // Shared between the pose callback and the bus thread.
+  std::mutex mutex_;
+  TurretFollower follower_;
+  JointHistory history_;
+  uint64_t poses_used_ = 0, poses_early_ = 0;
+
+  // Bus thread only (read by the destructor after it has ended).
+  std::unique_ptr<dynamixel::DynamixelBus> bus_;
+  dynamixel::DynamixelBusStats bus_stats_;
+  TurretMode last_mode_ = TurretMode::Idle;
+  bool faulted_ = false;
+  uint64_t cycles_ = 0, bus_errors_ = 0, connections_ = 0, reconnects_ = 0;
+
+  std::string constellation_;
+  uint8_t pan_id_ = 1, tilt_id_ = 2;
+  std::chrono::nanoseconds period_{20'000'000};
+  Publisher<JointState> states_;
+  Publisher<JointState> commands_;
+  Publisher<mocap_msgs::msg::Alert> alerts_;
+  std::atomic<bool> stop_{false};
+  std::thread worker_;
+};
+
+}  // namespace
+}  // namespace mocap::turret
+
+MOCAP_REGISTER_COMPONENT(mocap::turret::DynamixelFollower, "dynamixel_follower")

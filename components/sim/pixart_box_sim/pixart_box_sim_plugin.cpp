@@ -1,0 +1,332 @@
+// pixart_box_sim: the simulated PixArt camera box (pixart_box_simulator.hpp), the embedded
+// default when no box is attached. It writes real CAN frames, so that the real pixart_bridge
+// code path runs:
+//   - output "pty": it is a USB–CAN adaptor on a pseudo-terminal, speaking SLCAN
+//     (simulated_slcan_adaptor.hpp). It answers the host's commands and, while the host has the
+//     channel open at the box's bitrate, sends every sample's frames at real time. device_link
+//     gives the pseudo-terminal a fixed name for the bridge's `device` parameter.
+//   - output "candump": it writes duration_s of scene time to a `candump -L` log as fast as it
+//     can (to FILE.partial, renamed to FILE when complete), for the bridge's candump source.
+//
+// Scene time starts when the component is created and follows the steady clock: sample k is
+// sent at start + k / rate_hz. Ground truth, truth_rate_hz times per second of scene time:
+//   - pty: on /pixart/ground_truth, stamped with the wall-clock time now() at which it was
+//     computed, so a consumer pairs it with the bridge's fiducials (stamped when read) by stamp;
+//   - candump: in FILE.truth.csv (candump_recording.hpp), stamped on the log's time scale, so
+//     the poses localized from a replay of FILE pair with it by stamp.
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/robot_pose_array.hpp>
+
+#include "candump_recording.hpp"
+#include "device_link.hpp"
+#include "pixart_box_simulator.hpp"
+#include "pixart_rig.hpp"
+#include "pixart_scene.hpp"
+#include "sample_schedule.hpp"
+#include "serial_port.hpp"
+#include "simulated_slcan_adaptor.hpp"
+#include "slcan.hpp"
+
+namespace mocap::pixart {
+namespace {
+
+namespace fs = std::filesystem;
+using Steady = std::chrono::steady_clock;
+
+constexpr const char* kTruthTopic = "/pixart/ground_truth";
+constexpr const char* kTruthFrame = "world";
+// The adaptor thread checks for shutdown at least this often while nothing else wakes it.
+constexpr std::chrono::milliseconds kLongestWait{50};
+// A host that stops reading fills the pty's buffer; the box then drops the sample instead of
+// holding up the next ones for long.
+constexpr std::chrono::milliseconds kPtyWriteTimeout{200};
+
+int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+class PixartBoxSim final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Simulated PixArt camera box: robots carrying IR LEDs move on the floor under the "
+        "ceiling cameras; each camera's LEDs are sent as CAN frames at the sensor's rate, as an "
+        "SLCAN USB-CAN adaptor on a pseudo-terminal (for pixart_bridge source: slcan) or into a "
+        "candump -L log. Publishes the robots' true poses.");
+    spec.parameter("rig", mocap::config_file("pixart/rig.yaml"),
+                   "rig file: cameras, LED plane, robots' LED layouts (config/pixart/README.md)")
+        .path();
+    spec.parameter("scene", mocap::config_file("pixart/scenes/two_robots.yaml"),
+                   "scene file: robots' trajectories, calibration boards (config/pixart/README.md)")
+        .path();
+    spec.parameter("output", std::string("pty"),
+                   "pty (a simulated SLCAN adaptor on a pseudo-terminal) or candump (a log file)");
+    spec.parameter("device_link", std::string(),
+                   "pty: symbolic link to create to the pseudo-terminal (replacing an older link), "
+                   "for the bridge's `device`; empty = none (the log names the pty)")
+        .path();
+    spec.parameter("file", std::string(), "candump: the log to write").path();
+    spec.parameter("duration_s", 10.0, "candump: scene time to write, seconds").range(0.001, 1e6);
+    spec.parameter("start_stamp_s", 0.0,
+                   "candump: receive time of the first sample, seconds since the Unix epoch; "
+                   "0 = now")
+        .range(0, 4e9);
+    spec.parameter("rate_hz", 270.0, "samples per second, all cameras at once").range(1, 10000);
+    spec.parameter("bitrate", 1000000,
+                   "pty: the box's CAN bitrate; the adaptor passes frames only when the host "
+                   "opened the channel at it")
+        .range(10000, 1000000);
+    spec.parameter("base_id", 0x100, "CAN ID of camera 0, points 0-1").range(0, 0x7FF);
+    spec.parameter("noise_px", 0.0,
+                   "Gaussian noise on each coordinate before rounding, pixels (sigma); 0 = none")
+        .range(0, 100);
+    spec.parameter("seed", 1, "seed of the noise").range(0, 2147483647);
+    spec.parameter("truth_rate_hz", 50.0,
+                   "ground truth per second of scene time (pty: /pixart/ground_truth messages; "
+                   "candump: rows of FILE.truth.csv); 0 = none")
+        .range(0, 1000);
+    spec.publishes<mocap_msgs::msg::RobotPoseArray>(
+        kTruthTopic, Qos::reliable(),
+        "pty output: every robot's true floor pose (x, y, theta), frame id world, stamped with "
+        "the wall-clock time it describes");
+  }
+
+  explicit PixartBoxSim(Context& context) : Component(context) {
+    output_ = param<std::string>("output");
+    if (output_ != "pty" && output_ != "candump") {
+      throw std::invalid_argument("parameter 'output' is '" + output_ +
+                                  "'; expected pty or candump");
+    }
+    Rig rig = load_rig(param<std::string>("rig"));
+    PixartScene scene = load_pixart_scene(param<std::string>("scene"), rig);
+    const size_t cameras = rig.cameras.size(), objects = scene.objects.size();
+    simulator_ = std::make_unique<PixartBoxSimulator>(
+        std::move(rig), std::move(scene),
+        PixartBoxSimulatorOptions{.base_id = static_cast<uint32_t>(param<int>("base_id")),
+                                  .noise_px = param<double>("noise_px"),
+                                  .seed = static_cast<uint64_t>(param<int64_t>("seed"))});
+    rate_hz_ = param<double>("rate_hz");
+    scene_start_ = Steady::now();
+
+    if (output_ == "candump") {
+      start_log(cameras, objects);
+      return;
+    }
+    bitrate_ = param<int>("bitrate");
+    can::slcan_open_commands(bitrate_);  // throws, naming the supported bitrates, for others
+    truths_ = create_publisher<mocap_msgs::msg::RobotPoseArray>(kTruthTopic);
+    pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
+    const std::string link = param<std::string>("device_link");
+    if (!link.empty()) {
+      device_link_.emplace(link, pty_->slave_path());
+    }
+    log().info("simulated SLCAN adaptor on {}{}: {} cameras, {} objects, {} Hz, {} bit/s",
+               pty_->slave_path(), link.empty() ? "" : " (link " + link + ")", cameras, objects,
+               rate_hz_, bitrate_);
+    if (const double truth_rate = param<double>("truth_rate_hz"); truth_rate > 0) {
+      create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::duration<double>(1 / truth_rate)),
+                   [this] { publish_truth(); });
+    }
+    worker_ = std::jthread([this](std::stop_token stop) { play_adaptor(stop); });
+  }
+
+  ~PixartBoxSim() override {
+    worker_.request_stop();
+    if (worker_.joinable()) worker_.join();
+    device_link_.reset();
+    if (pty_) {
+      pty_->close_master();
+      const PixartBoxSimulatorStats& s = simulator_->stats();
+      log().info(
+          "{} samples sent, {} skipped (late), {} held back (channel closed or no host), {} "
+          "failed writes; {} points, {} beyond the sensors' 4; {} of {} host commands refused",
+          sent_, skipped_, held_back_, failed_writes_, s.points, s.excess_points,
+          adaptor_.stats().refused, adaptor_.stats().commands);
+    }
+  }
+
+ private:
+  // --- candump output ------------------------------------------------------------------------
+
+  void start_log(size_t cameras, size_t objects) {
+    const std::string file = param<std::string>("file");
+    if (file.empty()) {
+      throw std::invalid_argument("parameter 'file' is empty; output candump needs it");
+    }
+    const std::string partial = file + ".partial";
+    open_for_writing(log_stream_, partial);
+    const double truth_rate = param<double>("truth_rate_hz");
+    const std::string truth_file = truth_rate > 0 ? file + ".truth.csv" : std::string();
+    if (!truth_file.empty()) open_for_writing(truth_stream_, truth_file + ".partial");
+    const double start_s = param<double>("start_stamp_s");
+    CandumpRecordingOptions options{
+        .duration_s = param<double>("duration_s"),
+        .rate_hz = rate_hz_,
+        .start_ns =
+            start_s > 0 ? static_cast<int64_t>(std::llround(start_s * 1e9)) : wall_clock_ns(),
+        .truth = truth_file.empty() ? nullptr : &truth_stream_,
+        .truth_rate_hz = truth_rate};
+    log().info("writing {} s of {} cameras, {} objects at {} Hz to {}{}", options.duration_s,
+               cameras, objects, rate_hz_, file,
+               truth_file.empty() ? "" : ", ground truth to " + truth_file);
+    worker_ = std::jthread([this, options, file, partial, truth_file](std::stop_token stop) {
+      try {
+        const uint64_t frames = write_candump_recording(*simulator_, log_stream_, options, stop);
+        log_stream_.close();
+        truth_stream_.close();
+        if (stop.stop_requested()) {
+          log().warn("stopped after {} frames; the incomplete log stays in {}", frames, partial);
+          return;
+        }
+        // The truth first: whoever waits for FILE finds its truth there too.
+        if (!truth_file.empty()) fs::rename(truth_file + ".partial", truth_file);
+        fs::rename(partial, file);
+        log().info("wrote {} frames ({} samples) to {}", frames,
+                   SampleSchedule(options.rate_hz).samples_before(options.duration_s), file);
+      } catch (const std::exception& e) {
+        log().error("{}: {}", partial, e.what());
+      }
+    });
+  }
+
+  static void open_for_writing(std::ofstream& stream, const std::string& path) {
+    stream.open(path, std::ios::out | std::ios::trunc);
+    if (!stream) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  }
+
+  // --- pty output ----------------------------------------------------------------------------
+
+  double scene_time() const {
+    return std::chrono::duration<double>(Steady::now() - scene_start_).count();
+  }
+
+  // Plays the adaptor until stopped: answers the host's commands as they come and sends each
+  // sample when its time comes.
+  void play_adaptor(std::stop_token stop) {
+    const SampleSchedule schedule(rate_hz_);
+    uint64_t next = 0;
+    char buffer[512];
+    while (!stop.stop_requested()) {
+      const auto due_at = scene_start_ + std::chrono::duration_cast<Steady::duration>(
+                                             std::chrono::duration<double>(schedule.time_of(next)));
+      const auto wait =
+          std::clamp(std::chrono::ceil<std::chrono::milliseconds>(due_at - Steady::now()),
+                     std::chrono::milliseconds(0), kLongestWait);
+      size_t count = 0;
+      try {
+        count = pty_->read(buffer, sizeof buffer, wait);
+      } catch (const serial::SerialError& e) {
+        log().error("{}; the simulated adaptor stops", e.what());
+        return;
+      }
+      if (count > 0) answer_host(std::string_view(buffer, count));
+      const auto due = schedule.due(scene_time(), next);
+      if (!due) continue;
+      skipped_ += due->skipped;
+      send_sample(schedule.time_of(due->index));
+      next = due->index + 1;
+    }
+  }
+
+  void answer_host(std::string_view bytes) {
+    const bool was_open = adaptor_.is_open();
+    const uint64_t refused = adaptor_.stats().refused;
+    const std::string answers = adaptor_.feed(bytes);
+    if (adaptor_.stats().refused != refused) {
+      log().warn("refused a host command: {}", adaptor_.last_refusal());
+    }
+    if (adaptor_.is_open() != was_open) {
+      if (adaptor_.is_open()) {
+        log().info("host opened the channel at {} bit/s", *adaptor_.bitrate());
+        if (*adaptor_.bitrate() != bitrate_) {
+          log().warn("the box sends at {} bit/s: the host at {} bit/s receives nothing", bitrate_,
+                     *adaptor_.bitrate());
+        }
+      } else {
+        log().info("host closed the channel");
+      }
+    }
+    if (answers.empty()) return;
+    try {
+      pty_->write_all(answers);
+    } catch (const serial::SerialError& e) {
+      log().warn("cannot answer the host: {}", e.what());
+    }
+  }
+
+  void send_sample(double time_s) {
+    if (!adaptor_.is_open() || adaptor_.bitrate() != bitrate_ || !pty_->peer_connected()) {
+      ++held_back_;
+      return;
+    }
+    const int64_t stamp_ns = wall_clock_ns();
+    std::string bytes;
+    for (const can::CanFrame& frame : simulator_->frames_at(time_s, stamp_ns)) {
+      bytes += adaptor_.frame_message(frame, stamp_ns);
+    }
+    try {
+      pty_->write_all(bytes);
+      ++sent_;
+      writing_fails_ = false;
+    } catch (const serial::SerialError& e) {
+      ++failed_writes_;
+      if (!writing_fails_) log().warn("dropping samples: {}", e.what());
+      writing_fails_ = true;
+    }
+  }
+
+  void publish_truth() {
+    auto message = std::make_shared<mocap_msgs::msg::RobotPoseArray>();
+    message->header().stamp(to_time_msg(now()));
+    message->header().frame_id(kTruthFrame);
+    for (const RobotTruth& truth : simulator_->ground_truth(scene_time())) {
+      mocap_msgs::msg::RobotPose pose;
+      pose.name(truth.name);
+      pose.x(truth.pose.x);
+      pose.y(truth.pose.y);
+      pose.theta(truth.pose.theta);
+      message->robots().push_back(std::move(pose));
+    }
+    truths_.publish(std::move(message));
+  }
+
+  std::string output_;
+  std::unique_ptr<PixartBoxSimulator> simulator_;
+  double rate_hz_ = 270;
+  int bitrate_ = 1000000;
+  Steady::time_point scene_start_;
+  Publisher<mocap_msgs::msg::RobotPoseArray> truths_;
+  // pty output; the adaptor and the counters belong to the worker thread until it ends.
+  std::optional<serial::PseudoTerminal> pty_;
+  std::optional<serial::DeviceLink> device_link_;
+  SimulatedSlcanAdaptor adaptor_;
+  uint64_t sent_ = 0, skipped_ = 0, held_back_ = 0, failed_writes_ = 0;
+  bool writing_fails_ = false;
+  // candump output
+  std::ofstream log_stream_;
+  std::ofstream truth_stream_;
+  std::jthread worker_;  // last: starts once everything it uses exists
+};
+
+}  // namespace
+}  // namespace mocap::pixart
+
+MOCAP_REGISTER_COMPONENT(mocap::pixart::PixartBoxSim, "pixart_box_sim")

@@ -1,0 +1,208 @@
+// synthetic_ir_camera: renders a scene (ir_renderer.hpp) into mono8 images and publishes them
+// with the ground truth of each frame, the embedded default camera when there is no hardware.
+//
+// Frame k shows the scene at time k * time_step_s (by default 1 / rate_hz): scene time follows
+// the frame count, not the wall clock, so a run renders the same frames whatever the load of
+// the machine. Headers carry the wall-clock time of publication; an image and its ground truth
+// share header stamp and frame id, so consumers pair them by stamp.
+//
+// With moving_camera the camera is carried around (a turret on a mobile base, see
+// mobile_base_sim): its pose in the world (x forward, y left, z up) arrives on /sim/camera_pose
+// and each frame is rendered from the latest pose; frames wait for the first pose. The scene
+// then describes the world as a camera at the world's origin looking along its x axis would
+// see it (scene x = world −y, y = world −z, z = world x), so a scene reads the same for a
+// fixed camera and for one that starts at the origin.
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <geometry_msgs/msg/pose_stamped.hpp>
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "constellation_database.hpp"
+#include "image_message.hpp"
+#include "ir_renderer.hpp"
+#include "pose_message.hpp"
+#include "scene.hpp"
+
+namespace mocap::synthetic {
+namespace {
+
+constexpr const char* kImageTopic = "/camera/ir/image_raw";
+constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
+constexpr const char* kCameraPoseTopic = "/sim/camera_pose";
+// With rate_hz 0 frames follow each other as fast as they render: the timer only has to fire
+// again before a frame is done, and a faster timer would only wake its thread for nothing.
+constexpr std::chrono::microseconds kBackToBackPeriod{200};
+constexpr double kDefaultTimeStep_s = 1.0 / 30;
+
+// The scene's frame in the world's, for moving_camera: an optical frame at the origin looking
+// along world x.
+Eigen::Isometry3d world_from_scene() {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  return pose;
+}
+
+class SyntheticIrCamera final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Renders constellations moving through a scene, distractor lights and sensor noise "
+        "into mono8 infrared images, and publishes each frame's ground truth. Frame k shows "
+        "scene time k * time_step_s, whatever the wall clock does, so runs are reproducible.");
+    spec.parameter("scene", mocap::config_file("scenes/demo.yaml"),
+                   "scene file: objects, trajectories, rendering, distractors "
+                   "(config/scenes/README.md)")
+        .path();
+    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
+                   "camera file (ROS camera_info YAML): image size and lens")
+        .path();
+    spec.parameter("database", mocap::config_file("constellations.yaml"),
+                   "constellation database: YAML or the seed's constellation CSV")
+        .path();
+    spec.parameter("sub_constellations", std::string(),
+                   "the seed's sub-constellation CSV for a CSV database; empty = none")
+        .path();
+    spec.parameter("rate_hz", 30.0, "frames per second; 0 = as fast as they render")
+        .range(0, 10000);
+    spec.parameter("time_step_s", 0.0,
+                   "scene time between frames, seconds; 0 = 1 / rate_hz (1/30 when rate_hz is 0)")
+        .range(0, 3600);
+    spec.parameter("frame_id", std::string(), "frame id of the headers; empty = the camera file's");
+    spec.parameter("max_frames", 0, "frames to publish before stopping; 0 = no limit").min(0);
+    spec.parameter("wait_for_subscriber", true,
+                   "hold the first frame until the image topic has a subscriber, so a run "
+                   "across processes starts with frame 0 however long discovery takes");
+    spec.parameter("moving_camera", false,
+                   "false: the camera stands still and the scene is in its frame; true: its pose "
+                   "in the world comes on " +
+                       std::string(kCameraPoseTopic) +
+                       " and the scene is as seen from the world's origin looking along x");
+    spec.subscribes<geometry_msgs::msg::PoseStamped>(
+        kCameraPoseTopic, Qos::reliable(),
+        "moving_camera: the camera's optical frame in the world (e.g. from mobile_base_sim)");
+    spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
+                                            "rendered frames, mono8");
+    spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
+        kTruthTopic, Qos::reliable(),
+        "per frame, the true pose of every constellation in front of the camera (camera frame, "
+        "mid-exposure); points_used = its visible markers; same header as the image");
+  }
+
+  explicit SyntheticIrCamera(Context& context) : Component(context) {
+    // Load errors propagate: the runtime reports them with this component's name.
+    calibration::CameraFile camera = calibration::load_camera_file(param<std::string>("camera"));
+    constellations::ConstellationDatabase database = constellations::load_database(
+        param<std::string>("database"), param<std::string>("sub_constellations"));
+    Scene scene = load_scene(param<std::string>("scene"), database);
+    size_t object_count = scene.objects.size();
+    renderer_ = std::make_unique<IrRenderer>(std::move(scene), camera.model);
+
+    frame_id_ = param<std::string>("frame_id");
+    if (frame_id_.empty()) frame_id_ = camera.frame_id;
+    max_frames_ = param<int64_t>("max_frames");
+    wait_for_subscriber_ = param<bool>("wait_for_subscriber");
+    double rate_hz = param<double>("rate_hz");
+    time_step_s_ = param<double>("time_step_s");
+    if (time_step_s_ == 0) time_step_s_ = rate_hz > 0 ? 1 / rate_hz : kDefaultTimeStep_s;
+
+    if (param<bool>("moving_camera")) {
+      create_subscription<geometry_msgs::msg::PoseStamped>(
+          kCameraPoseTopic, [this](const geometry_msgs::msg::PoseStamped& pose) {
+            if (std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose())) {
+              camera_from_world_ = world_from_camera->inverse() * world_from_scene();
+            }
+          });
+    } else {
+      camera_from_world_ = Eigen::Isometry3d::Identity();
+    }
+    images_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
+    truths_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kTruthTopic);
+    std::chrono::nanoseconds period = rate_hz > 0
+                                          ? std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                                std::chrono::duration<double>(1 / rate_hz))
+                                          : std::chrono::nanoseconds(kBackToBackPeriod);
+    create_timer(period, [this] { tick(); });
+    log().info("{}x{} frames of {} ({} objects) at {} on {}, scene time step {:.6g} s",
+               camera.model->width(), camera.model->height(), param<std::string>("scene"),
+               object_count, rate_hz > 0 ? fmt::format("{} Hz", rate_hz) : "full speed",
+               images_.topic(), time_step_s_);
+  }
+
+ private:
+  void tick() {
+    if (wait_for_subscriber_) {
+      if (images_.matched_subscribers() == 0) {
+        if (!reported_waiting_) log().info("waiting for a subscriber on {}", images_.topic());
+        reported_waiting_ = true;
+        return;
+      }
+      wait_for_subscriber_ = false;
+    }
+    if (max_frames_ > 0 && frames_ >= static_cast<uint64_t>(max_frames_)) {
+      if (!reported_end_) {
+        log().info("published {} frames (max_frames); no more", frames_);
+        reported_end_ = true;
+      }
+      return;
+    }
+    if (!camera_from_world_) {
+      if (!reported_no_pose_) log().info("waiting for the camera's pose on {}", kCameraPoseTopic);
+      reported_no_pose_ = true;
+      return;
+    }
+    RenderedFrame frame = renderer_->render(static_cast<double>(frames_) * time_step_s_, frames_,
+                                            *camera_from_world_);
+    ++frames_;
+
+    std_msgs::msg::Header header;
+    header.stamp(to_time_msg(now()));
+    header.frame_id(frame_id_);
+
+    auto image = std::make_shared<sensor_msgs::msg::Image>();
+    image->header(header);
+    fill_image_message(frame.image, *image);
+
+    auto truth = std::make_shared<mocap_msgs::msg::ConstellationPoseArray>();
+    truth->header(header);
+    for (const ObjectTruth& object : frame.objects) {
+      if (!object.in_front) continue;
+      mocap_msgs::msg::ConstellationPose pose;
+      pose.name(object.constellation);
+      pose.pose().header(header);
+      pose.pose().pose(to_pose_message(object.pose));
+      pose.reprojection_rms_px(0);
+      pose.points_used(static_cast<uint32_t>(object.visible_markers()));
+      truth->poses().push_back(std::move(pose));
+    }
+    images_.publish(std::move(image));
+    truths_.publish(std::move(truth));
+  }
+
+  std::unique_ptr<IrRenderer> renderer_;
+  std::string frame_id_;
+  int64_t max_frames_ = 0;
+  bool wait_for_subscriber_ = true;
+  bool reported_waiting_ = false;
+  double time_step_s_ = 0;
+  uint64_t frames_ = 0;
+  bool reported_end_ = false;
+  bool reported_no_pose_ = false;
+  // The camera's place; none until the first pose arrives (moving_camera). Callbacks of one
+  // component never overlap, so the pose callback and tick() share it without a lock.
+  std::optional<Eigen::Isometry3d> camera_from_world_;
+  Publisher<sensor_msgs::msg::Image> images_;
+  Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
+};
+
+}  // namespace
+}  // namespace mocap::synthetic
+
+MOCAP_REGISTER_COMPONENT(mocap::synthetic::SyntheticIrCamera, "synthetic_ir_camera")

@@ -1,0 +1,169 @@
+// constellation_identifier: FiducialArray -> ConstellationArray (constellation_identifier.hpp).
+#include <chrono>
+#include <limits>
+#include <memory>
+#include <optional>
+
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap_msgs/msg/constellation_array.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+
+#include "constellation_identifier.hpp"
+#include "cross_ratio.hpp"
+
+namespace mocap::constellations {
+namespace {
+
+constexpr const char* kInput = "/mocap/fiducials";
+constexpr const char* kOutput = "/mocap/constellations";
+
+class ConstellationIdentifierComponent final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Finds collinear fiducials, names lines by their cross-ratio and constellations by "
+        "their lines; publishes each constellation's image points in database order.");
+    spec.parameter("database", mocap::config_file("constellations.yaml"),
+                   "constellation database: YAML, or the seed's constellation CSV")
+        .path();
+    spec.parameter("sub_constellations", std::string(),
+                   "the seed's sub-constellation CSV (line types), optional")
+        .path();
+    spec.parameter("camera", std::string(),
+                   "camera file; when given, lens distortion is removed before the line search")
+        .path();
+    spec.parameter("cross_ratio_tolerance", 0.03,
+                   "largest relative cross-ratio difference (the seed used 0.20)")
+        .range(1e-4, 0.5);
+    spec.parameter("line_tolerance_px", 1.5, "largest distance of a point from its line, pixels")
+        .range(0.01, 100);
+    spec.parameter("min_lines", 3, "fewest lines that identify a constellation").range(1, 64);
+    spec.parameter("min_extra_markers", 2,
+                   "with two whole lines only, markers that must lie where their plane puts "
+                   "them (a board with a hidden corner); 0 = never identify from two lines")
+        .range(0, 1000);
+    spec.parameter("max_fit_error_px", 3.0,
+                   "largest distance of a point from the constellation's plane fit, pixels")
+        .range(0.01, 1000);
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(kInput, Qos::reliable(),
+                                                    "fiducials of one image, pixels");
+    spec.publishes<mocap_msgs::msg::ConstellationArray>(
+        kOutput, Qos::reliable(),
+        "constellations identified in each fiducial array: each line's fiducials in database "
+        "order, NaN for a marker not seen");
+  }
+
+  explicit ConstellationIdentifierComponent(Context& context) : Component(context) {
+    database_ =
+        load_database(param<std::string>("database"), param<std::string>("sub_constellations"));
+    if (!param<std::string>("camera").empty()) {
+      camera_ = calibration::load_camera_file(param<std::string>("camera")).model;
+    }
+    IdentifierOptions options;
+    options.cross_ratio_tolerance = param<double>("cross_ratio_tolerance");
+    options.line_search.tolerance_px = param<double>("line_tolerance_px");
+    options.min_lines = param<int>("min_lines");
+    options.min_extra_markers = param<int>("min_extra_markers");
+    options.max_fit_error_px = param<double>("max_fit_error_px");
+    identifier_.emplace(database_, options);
+    for (const std::string& problem : database_.ambiguities(options.cross_ratio_tolerance)) {
+      log().warn("{}", problem);
+    }
+    log().info("{} constellations from {}", database_.constellations().size(),
+               param<std::string>("database"));
+    publisher_ = create_publisher<mocap_msgs::msg::ConstellationArray>(kOutput);
+    create_subscription<mocap_msgs::msg::FiducialArray>(
+        kInput, [this](const mocap_msgs::msg::FiducialArray& array) { identify(array); });
+  }
+
+  ~ConstellationIdentifierComponent() override {
+    log().info("{} arrays, {} constellations identified, {} non-finite fiducials ignored", arrays_,
+               identified_, non_finite_);
+  }
+
+ private:
+  void identify(const mocap_msgs::msg::FiducialArray& array) {
+    ++arrays_;
+    const auto& fiducials = array.fiducials();
+    points_.resize(fiducials.size());
+    for (size_t i = 0; i < fiducials.size(); ++i) {
+      Eigen::Vector2d pixel(fiducials[i].x(), fiducials[i].y());
+      points_[i] = ideal_pixel(pixel);
+      if (!points_[i].allFinite()) ++non_finite_;
+    }
+    auto message = std::make_shared<mocap_msgs::msg::ConstellationArray>();
+    message->header(array.header());
+    for (const IdentifiedConstellation& found : identifier_->identify(points_)) {
+      const ConstellationModel& model = *found.model;
+      mocap_msgs::msg::Constellation constellation;
+      constellation.name(model.name);
+      constellation.point_names(model.line_names());
+      constellation.xyz_tol(static_cast<float>(found.fit_rms_px));
+      // Every line with a marker seen, its fiducials in database order; a marker not seen
+      // (hidden, out of view) is a fiducial with NaN coordinates.
+      for (size_t l = 0; l < model.lines.size(); ++l) {
+        const ConstellationLine& model_line = model.lines[l];
+        mocap_msgs::msg::SubConstellation sub;
+        sub.name(model_line.name);
+        sub.fiducial_array().header(array.header());
+        float cx = 0, cy = 0;
+        int seen = 0;
+        for (int marker : model_line.points) {
+          int index = found.image_point_of[marker];
+          if (index < 0) {
+            mocap_msgs::msg::Fiducial unseen;
+            unseen.x(std::numeric_limits<float>::quiet_NaN());
+            unseen.y(std::numeric_limits<float>::quiet_NaN());
+            sub.fiducial_array().fiducials().push_back(unseen);
+            continue;
+          }
+          sub.fiducial_array().fiducials().push_back(fiducials[index]);
+          cx += fiducials[index].x();
+          cy += fiducials[index].y();
+          ++seen;
+        }
+        if (seen == 0) continue;
+        sub.Cx(cx / seen);
+        sub.Cy(cy / seen);
+        sub.Cz(0);
+        // How far the measured cross-ratio is from the database's; NaN for a broken line.
+        float difference = std::numeric_limits<float>::quiet_NaN();
+        for (const IdentifiedLine& line : found.lines) {
+          if (line.model_line == static_cast<int>(l)) {
+            difference =
+                static_cast<float>(relative_difference(line.cross_ratio, model_line.cross_ratio));
+          }
+        }
+        sub.uncertainty(difference);
+        constellation.sub_constellations().push_back(std::move(sub));
+      }
+      message->constellations().push_back(std::move(constellation));
+      ++identified_;
+    }
+    publisher_.publish(std::move(message));
+  }
+
+  // Lines are straight only without lens distortion: pixels through the camera model,
+  // scaled back to pixel units so the tolerances keep their meaning.
+  Eigen::Vector2d ideal_pixel(const Eigen::Vector2d& pixel) const {
+    if (!camera_ || !pixel.allFinite()) return pixel;
+    auto ray = camera_->unproject(pixel);
+    if (!ray) return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    return camera_->focal_length_px() * ray->head<2>();
+  }
+
+  ConstellationDatabase database_;
+  std::shared_ptr<const calibration::CameraModel> camera_;
+  std::optional<ConstellationIdentifier> identifier_;
+  Publisher<mocap_msgs::msg::ConstellationArray> publisher_;
+  std::vector<Eigen::Vector2d> points_;
+  uint64_t arrays_ = 0, identified_ = 0, non_finite_ = 0;
+};
+
+}  // namespace
+}  // namespace mocap::constellations
+
+MOCAP_REGISTER_COMPONENT(mocap::constellations::ConstellationIdentifierComponent,
+                         "constellation_identifier")

@@ -1,0 +1,145 @@
+// overlay: draws fiducials, identified lines and pose axes on the camera image, publishes the
+// picture and saves PNG snapshots (overlay_drawing.hpp).
+#include <chrono>
+#include <filesystem>
+#include <map>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_array.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "image_message.hpp"
+#include "overlay_drawing.hpp"
+#include "pose_message.hpp"
+
+namespace mocap::overlay {
+namespace {
+
+constexpr const char* kImage = "/camera/ir/image_raw";
+constexpr const char* kFiducials = "/mocap/fiducials";
+constexpr const char* kConstellations = "/mocap/constellations";
+constexpr const char* kPoses = "/mocap/poses";
+constexpr const char* kOverlay = "/mocap/overlay";
+// Frames waiting for their poses; older ones are dropped.
+constexpr size_t kPendingFrames = 30;
+
+class OverlayComponent final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Debug picture: fiducials, identified lines and names, pose axes drawn on the image; "
+        "published as bgr8 and saved as PNG snapshots.");
+    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
+                   "camera file, to project the pose axes")
+        .path();
+    spec.parameter("snapshot_directory", std::string(), "where PNG snapshots go (empty: none)")
+        .path();
+    spec.parameter("snapshot_period_s", 1.0, "seconds between snapshots").range(0.01, 3600);
+    spec.subscribes<sensor_msgs::msg::Image>(kImage, Qos::sensor_data(), "camera images, mono8");
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(kFiducials, Qos::reliable(), "fiducials");
+    spec.subscribes<mocap_msgs::msg::ConstellationArray>(kConstellations, Qos::reliable(),
+                                                         "identified constellations");
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoses, Qos::reliable(),
+                                                             "estimated poses; draws the frame");
+    spec.publishes<sensor_msgs::msg::Image>(kOverlay, Qos::sensor_data(), "the picture, bgr8");
+  }
+
+  explicit OverlayComponent(Context& context) : Component(context) {
+    camera_ = calibration::load_camera_file(param<std::string>("camera"));
+    snapshot_directory_ = param<std::string>("snapshot_directory");
+    snapshot_period_ = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(param<double>("snapshot_period_s")));
+    if (!snapshot_directory_.empty()) std::filesystem::create_directories(snapshot_directory_);
+    publisher_ = create_publisher<sensor_msgs::msg::Image>(kOverlay);
+    create_subscription<sensor_msgs::msg::Image>(
+        kImage, [this](const std::shared_ptr<const sensor_msgs::msg::Image>& image) {
+          keep(frames_[to_nanoseconds(image->header().stamp())]).image = image;
+        });
+    create_subscription<mocap_msgs::msg::FiducialArray>(
+        kFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
+          auto& fiducials = keep(frames_[to_nanoseconds(array.header().stamp())]).content.fiducials;
+          for (const auto& f : array.fiducials()) fiducials.emplace_back(f.x(), f.y());
+        });
+    create_subscription<mocap_msgs::msg::ConstellationArray>(
+        kConstellations, [this](const mocap_msgs::msg::ConstellationArray& array) {
+          auto& frame = keep(frames_[to_nanoseconds(array.header().stamp())]).content;
+          for (const auto& c : array.constellations()) {
+            OverlayConstellation constellation{c.name(), {}};
+            for (const auto& sub : c.sub_constellations()) {
+              const auto& f = sub.fiducial_array().fiducials();
+              if (f.size() != 4) continue;
+              OverlayLine line{sub.name(), {}};
+              for (int k = 0; k < 4; ++k) line.pixels[k] = {f[k].x(), f[k].y()};
+              constellation.lines.push_back(line);
+            }
+            frame.constellations.push_back(std::move(constellation));
+          }
+        });
+    create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
+        kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { draw(poses); });
+  }
+
+ private:
+  struct Pending {
+    std::shared_ptr<const sensor_msgs::msg::Image> image;
+    OverlayFrame content;
+  };
+
+  Pending& keep(Pending& pending) {
+    while (frames_.size() > kPendingFrames) frames_.erase(frames_.begin());
+    return pending;
+  }
+
+  void draw(const mocap_msgs::msg::ConstellationPoseArray& poses) {
+    auto found = frames_.find(to_nanoseconds(poses.header().stamp()));
+    if (found == frames_.end() || !found->second.image) return;
+    Pending pending = std::move(found->second);
+    frames_.erase(frames_.begin(), std::next(found));
+    Mono8View view = view_mono8(*pending.image);
+    if (!view.problem.empty()) return;  // the tracker reports bad images
+    for (const auto& p : poses.poses()) {
+      if (std::optional<Eigen::Isometry3d> pose = to_isometry(p.pose().pose())) {
+        pending.content.poses.push_back({p.name(), *pose});
+      }
+    }
+    cv::Mat picture = draw_overlay(view.pixels, pending.content, camera_.model.get());
+    auto message = std::make_shared<sensor_msgs::msg::Image>();
+    message->header(poses.header());
+    message->width(static_cast<uint32_t>(picture.cols));
+    message->height(static_cast<uint32_t>(picture.rows));
+    message->encoding("bgr8");
+    message->step(static_cast<uint32_t>(picture.cols * 3));
+    message->data().assign(picture.datastart, picture.dataend);
+    publisher_.publish(std::move(message));
+    save_snapshot(picture);
+  }
+
+  void save_snapshot(const cv::Mat& picture) {
+    if (snapshot_directory_.empty()) return;
+    Clock::time_point t = now();
+    if (snapshots_ > 0 && t - last_snapshot_ < snapshot_period_) return;
+    last_snapshot_ = t;
+    std::string path = fmt::format("{}/overlay_{:05d}.png", snapshot_directory_, snapshots_++);
+    if (!cv::imwrite(path, picture)) log().warn("cannot write {}", path);
+  }
+
+  calibration::CameraFile camera_;
+  std::string snapshot_directory_;
+  Clock::duration snapshot_period_{};
+  Clock::time_point last_snapshot_{};
+  int snapshots_ = 0;
+  std::map<int64_t, Pending> frames_;
+  Publisher<sensor_msgs::msg::Image> publisher_;
+};
+
+}  // namespace
+}  // namespace mocap::overlay
+
+MOCAP_REGISTER_COMPONENT(mocap::overlay::OverlayComponent, "overlay")
