@@ -6,7 +6,8 @@
 # type header: no message uses bounded strings, and it would make every component include a
 # Fast DDS header.
 #
-# Inputs: FASTDDSGEN, IDL_ROOT, IDL (relative to IDL_ROOT, e.g. std_msgs/msg/Header.idl), OUT.
+# Inputs: FASTDDSGEN, IDL_ROOT, IDL (relative to IDL_ROOT, e.g. std_msgs/msg/Header.idl), OUT,
+# INCLUDE_DIRS (where included IDL files are, separated by '|').
 get_filename_component(type "${IDL}" NAME_WE)
 get_filename_component(dir "${IDL}" DIRECTORY)
 string(REPLACE "/" "_" scratch_name "${dir}_${type}")
@@ -14,8 +15,13 @@ set(scratch "${OUT}/.fastddsgen/${scratch_name}")
 file(REMOVE_RECURSE "${scratch}")
 file(MAKE_DIRECTORY "${scratch}" "${OUT}/${dir}")
 
+set(include_flags)
+string(REPLACE "|" ";" INCLUDE_DIRS "${INCLUDE_DIRS}")
+foreach(dir IN LISTS INCLUDE_DIRS)
+  list(APPEND include_flags -I "${dir}")
+endforeach()
 execute_process(
-  COMMAND "${FASTDDSGEN}" -cs -typeros2 -replace -I "${IDL_ROOT}" -d "${scratch}" "${IDL_ROOT}/${IDL}"
+  COMMAND "${FASTDDSGEN}" -cs -typeros2 -replace ${include_flags} -d "${scratch}" "${IDL_ROOT}/${IDL}"
   RESULT_VARIABLE result
   OUTPUT_VARIABLE output
   ERROR_VARIABLE output)

@@ -227,7 +227,7 @@ TEST(Distributed, DockerRuntimeStageHasEveryLibraryTheBinariesNeed) {
   }
   ASSERT_GE(files.size(), 2u) << "mocap_launch and mocap_topic at least";
   fs::path lib_dir = test::bin_dir().parent_path() / "lib";
-  for (const auto& entry : fs::directory_iterator(lib_dir)) {
+  for (const auto& entry : fs::recursive_directory_iterator(lib_dir)) {
     if (entry.path().extension() == ".so") files.push_back(entry.path());
   }
   // In debian:bookworm-slim already (libc6, libstdc++6, libgcc-s1).

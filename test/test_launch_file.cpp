@@ -10,7 +10,7 @@ namespace {
 
 class LaunchFileTest : public ::testing::Test {
  protected:
-  PluginLoader plugins{{test::bin_dir() / ".." / "lib", test::test_plugin_dir()}};
+  PluginLoader plugins{{test::plugin_dir(), test::test_plugin_dir()}};
   test::TempDir dir;
 
   LaunchFile load(const std::string& yaml, const std::vector<std::string>& sets = {}) {

@@ -18,6 +18,7 @@ namespace fs = std::filesystem;
 
 fs::path bin_dir() { return MOCAP_TEST_BIN_DIR; }
 fs::path test_plugin_dir() { return MOCAP_TEST_PLUGIN_DIR; }
+fs::path plugin_dir() { return bin_dir().parent_path() / "lib" / "mocap_graph" / "plugins"; }
 fs::path source_dir() { return MOCAP_TEST_SOURCE_DIR; }
 
 TempDir::TempDir() {

@@ -13,6 +13,7 @@ namespace mocap::test {
 
 std::filesystem::path bin_dir();          // build/bin
 std::filesystem::path test_plugin_dir();  // build/test_plugins
+std::filesystem::path plugin_dir();       // build/lib/mocap_graph/plugins: the shipped plugins
 std::filesystem::path source_dir();       // the repository
 
 // A fresh directory, removed with everything in it when the object goes.

@@ -18,6 +18,7 @@
 #include <mocap/raw_message_type.hpp>
 
 #include "dds_transport.hpp"
+#include "plugin_loader.hpp"
 #include "shutdown_signal.hpp"
 
 namespace {
@@ -325,6 +326,10 @@ int main(int argc, char** argv) {
   if (command != "record" && !bag) usage_error(fmt::format("{} needs a bag DIR", command));
 
   mocap::ShutdownSignal::install();
+  mocap::generated_message_types();  // the shipped types, and below those of your projects
+  for (const std::string& error : mocap::PluginLoader().load_message_libraries()) {
+    fmt::print(stderr, "mocap_bag: {}\n", error);
+  }
   try {
     if (command == "record")
       return record(output.value_or(mocap::bag::default_bag_directory()), topics, all, duration);

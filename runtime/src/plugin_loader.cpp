@@ -38,7 +38,10 @@ std::vector<fs::path> PluginLoader::default_search_path() {
   }
   std::error_code error;
   fs::path executable = fs::read_symlink("/proc/self/exe", error);
-  if (!error) path.push_back((executable.parent_path() / ".." / "lib").lexically_normal());
+  if (!error) {
+    path.push_back(
+        (executable.parent_path() / ".." / "lib" / "mocap_graph" / "plugins").lexically_normal());
+  }
   return path;
 }
 
@@ -59,6 +62,25 @@ std::vector<std::string> PluginLoader::available() const {
     }
   }
   return {names.begin(), names.end()};
+}
+
+std::vector<std::string> PluginLoader::load_message_libraries() const {
+  std::vector<std::string> errors;
+  std::set<std::string> loaded;  // by file name: a directory twice on the path loads once
+  for (const fs::path& directory : search_path_) {
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(directory, error)) {
+      std::string file = entry.path().filename().string();
+      if (!file.starts_with(kMessagePrefix) || !file.ends_with(".so")) continue;
+      if (!loaded.insert(file).second) continue;
+      // Stays loaded: the types it registers point into it.
+      if (dlopen(entry.path().c_str(), RTLD_NOW | RTLD_LOCAL) == nullptr) {
+        errors.push_back(
+            fmt::format("cannot load message library {}: {}", entry.path().string(), dlerror()));
+      }
+    }
+  }
+  return errors;
 }
 
 const LoadedPlugin& PluginLoader::load(std::string_view plugin) {

@@ -31,7 +31,8 @@ Runs the components of a launch file (launch_yaml/README.md describes the format
   --duration S     stop after S seconds (default, or 0: run until Ctrl-C)
   --check          validate the file and exit: 0 when valid
   --describe NAME  print a plugin's description, parameters and topics
-  --plugins        list the plugins on the search path (MOCAP_PLUGIN_PATH, then build/lib)
+  --plugins        list the plugins on the search path (MOCAP_PLUGIN_PATH, then
+                   lib/mocap_graph/plugins beside bin/)
 Environment: MOCAP_DOMAIN_ID overrides the DDS domain, MOCAP_LOG_LEVEL=debug|info|warn|error.
 )";
 

@@ -17,6 +17,7 @@
 #include "cdr_format.hpp"
 #include "dds_transport.hpp"
 #include "idl_schema.hpp"
+#include "plugin_loader.hpp"
 #include "rate_estimator.hpp"
 #include "shutdown_signal.hpp"
 
@@ -272,6 +273,9 @@ int main(int argc, char** argv) {
 
   mocap::ShutdownSignal::install();
   mocap::generated_message_types();  // registers the known types for echo
+  for (const std::string& error : mocap::PluginLoader().load_message_libraries()) {
+    fmt::print(stderr, "mocap_topic: {}\n", error);  // its types stay unknown: echo says so
+  }
   try {
     auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_topic");
     mocap::DdsTransport& transport = *dds;

@@ -521,7 +521,7 @@ TEST(ImageMessage, UnreadableImagesSayWhy) {
 // --- The plugin -----------------------------------------------------------------------------
 
 std::filesystem::path plugin_library(const std::string& plugin) {
-  return test::bin_dir().parent_path() / "lib" / ("libmocap_plugin_" + plugin + ".so");
+  return test::plugin_dir() / ("libmocap_plugin_" + plugin + ".so");
 }
 
 // The plugin's factory, or nullptr when the library is not built or cannot be loaded.
