@@ -8,12 +8,15 @@
 #   P/share/mocap_graph/config/    the shipped configuration (plugins' default files)
 #   P/share/mocap_graph/launch_yaml/  the shipped launch files (their ../config paths hold)
 #   P/share/mocap_graph/idl/       the shipped IDL files, for your own messages to include
+#   P/share/mocap_graph/scripts/   scenario.sh: one host of the multi-host scenario
 #   P/lib/cmake/mocap_graph/       find_package(mocap_graph): imported targets mocap_graph::*,
 #                                  mocap_add_plugin and mocap_generate_messages
 include(CMakePackageConfigHelpers)
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config DESTINATION share/mocap_graph)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/launch_yaml DESTINATION share/mocap_graph)
+# One host's share of the multi-host scenario (the containers' entry point).
+install(PROGRAMS ${PROJECT_SOURCE_DIR}/scripts/scenario.sh DESTINATION share/mocap_graph/scripts)
 
 set(package_dir lib/cmake/mocap_graph)
 install(EXPORT mocap_graph_targets NAMESPACE mocap_graph:: DESTINATION ${package_dir}

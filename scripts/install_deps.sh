@@ -19,6 +19,8 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
+  # tests: the Debian package in a clean Debian 12 root
+  debootstrap dpkg-dev
   # benchmarks: instruction counts
   valgrind
   # containers: docker-compose validates docker/compose.yaml (no Docker engine needed)

@@ -14,7 +14,8 @@
 #
 # Environment:
 #   MOCAP_DOMAIN_ID    the DDS domain, as for every tool (default 0)
-#   MOCAP_BIN_DIR      where mocap_launch and mocap_topic are (default: build/bin here)
+#   MOCAP_BIN_DIR      where mocap_launch and mocap_topic are (default: build/bin in a
+#                      checkout; installed, as share/mocap_graph/scripts/, the prefix's bin/)
 #   MOCAP_LAUNCH_FILE  the launch file (default: launch_yaml/distributed/tracking.yaml)
 #   MOCAP_SERVO_LINK   robot: the servo simulator's pseudo-terminal link (default: one per
 #                      process in /tmp, so robots on one machine do not share it)
@@ -24,7 +25,9 @@
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bin_dir="${MOCAP_BIN_DIR:-$root/build/bin}"
+default_bin_dir="$root/build/bin"
+[ -d "$default_bin_dir" ] || default_bin_dir="$(cd "$root/../.." && pwd)/bin"
+bin_dir="${MOCAP_BIN_DIR:-$default_bin_dir}"
 launch_file="${MOCAP_LAUNCH_FILE:-$root/launch_yaml/distributed/tracking.yaml}"
 
 usage() {

@@ -3,7 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install_deps.sh
-scripts/build.sh -DMOCAP_WERROR=ON
+scripts/build.sh -DMOCAP_WERROR=ON -DMOCAP_BUILD_TESTS=ON -DMOCAP_BUILD_BENCHMARKS=ON
 scripts/check_format.sh
 cd build
 ctest --output-on-failure --parallel "$(nproc)"

@@ -173,95 +173,37 @@ TEST(Distributed, ComposeFileHasAServicePerHostAndTheChecker) {
   EXPECT_NE(config.find("restart: \"no\""), std::string::npos) << config;
 }
 
-// The Dockerfile's build stage builds as the CI does: .ci/run runs scripts/test.sh, whose
-// install and build commands the Dockerfile runs as they are.
-TEST(Distributed, DockerfileBuildsWithTheCiCommands) {
+// The Dockerfile's build stage installs the packages as the CI does (.ci/run runs
+// scripts/test.sh) and builds the Debian package; the runtime stage installs that package
+// (test/install/debian_package.sh proves it installs and runs in a clean Debian 12 root).
+TEST(Distributed, DockerImageIsTheDebianPackage) {
   std::string dockerfile = test::read_file(repo("docker/Dockerfile"));
   ASSERT_FALSE(dockerfile.empty());
   EXPECT_NE(test::read_file(repo(".ci/run")).find("scripts/test.sh"), std::string::npos);
   std::string ci = test::read_file(repo("scripts/test.sh"));
   std::string install = line_starting(ci, "scripts/install_deps.sh");
-  std::string build = line_starting(ci, "scripts/build.sh");
   ASSERT_NE(install, "") << ci;
-  ASSERT_NE(build, "") << ci;
   size_t build_stage = dockerfile.find("FROM debian:bookworm AS build");
   size_t runtime_stage = dockerfile.find("FROM debian:bookworm-slim");
   ASSERT_NE(build_stage, std::string::npos) << dockerfile;
   ASSERT_NE(runtime_stage, std::string::npos) << dockerfile;
   size_t install_at = dockerfile.find("\nRUN " + install + "\n");
-  size_t build_at = dockerfile.find("\nRUN " + build + "\n");
+  size_t package_at = dockerfile.find("\nRUN scripts/package.sh");
   EXPECT_NE(install_at, std::string::npos) << "RUN " << install << "\n" << dockerfile;
-  EXPECT_NE(build_at, std::string::npos) << "RUN " << build << "\n" << dockerfile;
-  EXPECT_TRUE(build_stage < install_at && install_at < build_at && build_at < runtime_stage);
-  // The containers run the scenario's script, as the namespaces do.
-  EXPECT_NE(dockerfile.find(R"(ENTRYPOINT ["/opt/mocap-graph/scripts/scenario.sh"])"),
+  EXPECT_TRUE(build_stage < install_at && install_at < package_at && package_at < runtime_stage)
+      << dockerfile;
+  size_t copy_at = dockerfile.find(
+      "COPY --from=build /opt/mocap-graph/build-package/mocap-graph_*_amd64.deb", runtime_stage);
+  size_t apt_at = dockerfile.find("apt-get install -y --no-install-recommends /tmp/mocap-graph_",
+                                  runtime_stage);
+  EXPECT_TRUE(copy_at != std::string::npos && apt_at != std::string::npos && copy_at < apt_at)
+      << dockerfile;
+  // The containers run the installed scenario script, as the namespaces run the tree's.
+  EXPECT_NE(dockerfile.find(R"(ENTRYPOINT ["/usr/share/mocap_graph/scripts/scenario.sh"])"),
             std::string::npos);
-}
-
-// The runtime stage installs, for every shared library the shipped tools and plugins need, a
-// package that holds it; and those are Debian 12 packages (installed here with the -dev ones).
-TEST(Distributed, DockerRuntimeStageHasEveryLibraryTheBinariesNeed) {
-  std::string dockerfile = test::read_file(repo("docker/Dockerfile"));
-  size_t runtime_stage = dockerfile.find("FROM debian:bookworm-slim");
-  ASSERT_NE(runtime_stage, std::string::npos);
-  size_t install = dockerfile.find("apt-get install", runtime_stage);
-  ASSERT_NE(install, std::string::npos);
-  std::set<std::string> packages;
-  for (const std::string& word : words(dockerfile.substr(install + 15))) {
-    if (word == "&&") break;
-    if (word != "\\" && !word.starts_with("-")) packages.insert(word);
-  }
-  ASSERT_GE(packages.size(), 5u) << dockerfile;
-  for (const std::string& package : packages) {
-    auto [code, status] = test::run_command({"dpkg-query", "-W", "-f=${Status}", package});
-    EXPECT_EQ(status, "install ok installed") << package;
-  }
-
-  // The shipped files: the tools the Dockerfile copies from build/bin, every library.
-  std::vector<fs::path> files;
-  for (const char* tool : {"mocap_launch", "mocap_topic", "mocap_bag", "mocap_calibrate",
-                           "mocap_calibration_record"}) {
-    if (dockerfile.find(fmt::format("build/bin/{}", tool)) != std::string::npos) {
-      files.push_back(test::bin_dir() / tool);
-    }
-  }
-  ASSERT_GE(files.size(), 2u) << "mocap_launch and mocap_topic at least";
-  fs::path lib_dir = test::bin_dir().parent_path() / "lib";
-  for (const auto& entry : fs::recursive_directory_iterator(lib_dir)) {
-    if (entry.path().extension() == ".so") files.push_back(entry.path());
-  }
-  // In debian:bookworm-slim already (libc6, libstdc++6, libgcc-s1).
-  const std::set<std::string> base = {"libc.so.6", "libm.so.6", "libstdc++.so.6", "libgcc_s.so.1",
-                                      "ld-linux-x86-64.so.2"};
-  std::set<std::string> needed;
-  for (const fs::path& file : files) {
-    auto [code, dump] = test::run_command({"objdump", "-p", file.string()});
-    ASSERT_EQ(code, 0) << file << ": " << dump;
-    for (const std::string& line : lines_of(dump)) {
-      std::vector<std::string> parts = words(line);
-      if (parts.size() == 2 && parts[0] == "NEEDED" && !base.contains(parts[1]) &&
-          !fs::exists(lib_dir / parts[1])) {
-        needed.insert(parts[1]);
-      }
-    }
-  }
-  ASSERT_FALSE(needed.empty());
-  for (const std::string& soname : needed) {
-    // "pkg[:arch][, pkg...]: /path" for every installed file named so.
-    auto [code, owners] = test::run_command({"dpkg", "-S", "*/" + soname});
-    std::set<std::string> holders;
-    for (const std::string& line : lines_of(owners)) {
-      size_t colon_space = line.find(": ");
-      if (colon_space == std::string::npos) continue;
-      std::string list = line.substr(0, colon_space);
-      std::replace(list.begin(), list.end(), ',', ' ');
-      for (std::string name : words(list)) holders.insert(name.substr(0, name.find(':')));
-    }
-    bool installed = std::any_of(holders.begin(), holders.end(),
-                                 [&](const std::string& p) { return packages.contains(p); });
-    EXPECT_TRUE(installed) << soname << " is in " << fmt::format("{}", fmt::join(holders, ", "))
-                           << ", none of which the runtime stage installs";
-  }
+  EXPECT_NE(test::read_file(repo("cmake/Install.cmake"))
+                .find("scripts/scenario.sh DESTINATION share/mocap_graph/scripts"),
+            std::string::npos);
 }
 
 }  // namespace
