@@ -3,6 +3,7 @@
 # alone (a copy outside the source tree, a fresh configure), runs its launch file with the
 # shipped tracking pipeline, and checks /mocap/filtered_poses through the installed
 # mocap_topic and mocap_bag: the example's own message type, filtered values near the raw ones.
+# Then builds and runs the README's "Writing your own component" files the same way.
 #
 #   example_against_install.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
@@ -70,4 +71,22 @@ awk -v file="$work/echo.txt" '
 "$prefix/bin/mocap_bag" info "$work/bag" > "$work/info.txt" 2>&1 || { cat "$work/record.log"; fail "no bag"; }
 grep -q "pose_filter_msgs/msg/FilteredPoseArray" "$work/info.txt" ||
   { cat "$work/info.txt"; fail "the bag does not hold pose_filter_msgs/msg/FilteredPoseArray"; }
+# The README's five-minute path ("Writing your own component"), its three files as they stand.
+mkdir "$work/counter"
+cd "$work/counter"
+awk '/^## Writing your own component/ { on = 1 } /^## How messages travel/ { on = 0 }
+     on && /^   ```(cpp|cmake|yaml)$/ { lang = substr($1, 4); n++; next }
+     on && /^   ```$/ { lang = ""; next }
+     lang != "" && n <= 3 { file = (lang == "cpp") ? "counter.cpp" : (lang == "cmake") ? \
+       "CMakeLists.txt" : "counter.yaml"; sub(/^   /, ""); print > file }' "$source_dir/README.md"
+for file in counter.cpp CMakeLists.txt counter.yaml; do
+  [ -s "$file" ] || fail "README.md: no $file in \"Writing your own component\""
+done
+{ cmake -S . -B build -G Ninja -DCMAKE_PREFIX_PATH="$prefix" && cmake --build build; } \
+  > "$work/counter.log" 2>&1 || { cat "$work/counter.log"; fail "the README's counter does not build"; }
+MOCAP_PLUGIN_PATH=$work/counter/build/plugins "$prefix/bin/mocap_launch" counter.yaml \
+  --duration 3 > "$work/counter_run.log" 2>&1 || { cat "$work/counter_run.log"; fail "counter.yaml"; }
+grep -q "\[counter\]: 60 poses" "$work/counter_run.log" ||
+  { cat "$work/counter_run.log"; fail "the README's counter did not count 60 poses"; }
+
 echo "PASS: installed, built the example against the prefix, $(grep -c '^  - name' "$work/echo.txt") filtered poses checked, bag: $(grep FilteredPoseArray "$work/info.txt" | tr -s ' ')"
