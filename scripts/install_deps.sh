@@ -19,8 +19,8 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
-  # tests: the Debian package in a clean Debian 12 root
-  debootstrap dpkg-dev
+  # the Debian package (cpack: dpkg-shlibdeps, file) and its test in a clean Debian 12 root
+  dpkg-dev file debootstrap
   # benchmarks: instruction counts
   valgrind
   # containers: docker-compose validates docker/compose.yaml (no Docker engine needed)

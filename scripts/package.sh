@@ -10,5 +10,5 @@ cmake -S . -B build-package -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOCAP_B
 cmake --build build-package --parallel "$(nproc)"
 cd build-package
 rm -f mocap-graph_*_amd64.deb
-cpack -G DEB > cpack.log
+cpack -G DEB > cpack.log 2>&1 || { cat cpack.log; exit 1; }
 ls "$PWD"/mocap-graph_*_amd64.deb
