@@ -26,8 +26,8 @@ configure_package_config_file(cmake/mocap_graphConfig.cmake.in
                               ${CMAKE_CURRENT_BINARY_DIR}/mocap_graphConfig.cmake
                               INSTALL_DESTINATION ${package_dir}
                               PATH_VARS MOCAP_SHARE_DIR)
-# The component ABI (ComponentFactory::kAbiVersion) changes only with the minor version, so a
-# project asking for 0.1 gets any 0.1.x; the loader refuses a plugin of another ABI by name.
+# A project asking for 0.1 accepts any 0.1.x. Whatever the version, the loader checks the
+# component ABI (ComponentFactory::kAbiVersion) and refuses a plugin built for another by name.
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/mocap_graphConfigVersion.cmake
                                  COMPATIBILITY SameMinorVersion)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/mocap_graphConfig.cmake

@@ -1,7 +1,7 @@
 # mocap_add_plugin(<name> SOURCES <files>... [LIBRARIES <targets>...] [OUTPUT_DIRECTORY <dir>]
 #                  [NO_INSTALL])
 #
-# Builds the component plugin <name> as lib<prefix>mocap_plugin_<name>.so, the name launch
+# Builds the component plugin <name> as libmocap_plugin_<name>.so, the name launch
 # files use (`plugin: <name>`), linked to the runtime and the messages. Only the registration
 # symbol is exported, so plugins cannot clash with each other.
 #
