@@ -23,8 +23,8 @@ packages=(
   dpkg-dev file debootstrap
   # benchmarks: instruction counts
   valgrind
-  # containers: docker-compose validates docker/compose.yaml (no Docker engine needed)
-  docker-compose
+  # containers: the engine and compose, for scripts/docker_test.sh
+  docker.io docker-compose
 )
 
 missing=()
