@@ -13,7 +13,7 @@ get_filename_component(dir "${IDL}" DIRECTORY)
 string(REPLACE "/" "_" scratch_name "${dir}_${type}")
 set(scratch "${OUT}/.fastddsgen/${scratch_name}")
 file(REMOVE_RECURSE "${scratch}")
-file(MAKE_DIRECTORY "${scratch}" "${OUT}/${dir}")
+file(MAKE_DIRECTORY "${scratch}/tmp" "${OUT}/${dir}")
 
 set(include_flags)
 string(REPLACE "|" ";" INCLUDE_DIRS "${INCLUDE_DIRS}")
@@ -21,7 +21,11 @@ foreach(dir IN LISTS INCLUDE_DIRS)
   list(APPEND include_flags -I "${dir}")
 endforeach()
 execute_process(
-  COMMAND "${FASTDDSGEN}" -cs -typeros2 -replace ${include_flags} -d "${scratch}" "${IDL_ROOT}/${IDL}"
+  # -t: fastddsgen's preprocessed copies of the IDL files go to a temporary directory under
+  # fixed names (/tmp by default); two runs at once, in one build or two, would overwrite
+  # each other's (seen: an included file read back empty).
+  COMMAND "${FASTDDSGEN}" -cs -typeros2 -replace -t "${scratch}/tmp" ${include_flags} -d "${scratch}"
+          "${IDL_ROOT}/${IDL}"
   RESULT_VARIABLE result
   OUTPUT_VARIABLE output
   ERROR_VARIABLE output)
