@@ -15,6 +15,9 @@ if(NOT DEFINED MOCAP_PLUGIN_OUTPUT_DIRECTORY)
   set(MOCAP_PLUGIN_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/plugins)
 endif()
 set(MOCAP_PLUGIN_INSTALL_DIRECTORY lib/mocap_graph/plugins)
+# Installed: lib/mocap_graph/plugins/ -> lib/ (the runtime, the messages) and the message
+# libraries of your own beside the plugins.
+set(MOCAP_PLUGIN_INSTALL_RPATH "$ORIGIN/../..;$ORIGIN")
 
 function(mocap_add_plugin name)
   cmake_parse_arguments(ARG "NO_INSTALL" "OUTPUT_DIRECTORY" "SOURCES;LIBRARIES" ${ARGN})
@@ -32,9 +35,7 @@ function(mocap_add_plugin name)
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON
     LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY}
-    # Installed: lib/mocap_graph/plugins/ -> lib/ (the runtime, the messages) and message
-    # libraries beside it.
-    INSTALL_RPATH "$ORIGIN/../..;$ORIGIN")
+    INSTALL_RPATH "${MOCAP_PLUGIN_INSTALL_RPATH}")
   if(NOT ARG_NO_INSTALL)
     install(TARGETS ${target} LIBRARY DESTINATION ${MOCAP_PLUGIN_INSTALL_DIRECTORY})
     set_property(GLOBAL APPEND PROPERTY MOCAP_PLUGINS ${target})

@@ -16,8 +16,9 @@
 # Outside this repository the library is named libmocap_messages_<target>.so and goes beside
 # your plugins (MOCAP_PLUGIN_OUTPUT_DIRECTORY; installed: lib/mocap_graph/plugins), where
 # mocap_topic and mocap_bag load every libmocap_messages_*.so so that they know your types.
-# Sets <target>_DDS_SOURCES (fastddsgen's Fast DDS type supports, for programs that use Fast
-# DDS directly) in the caller's scope.
+# Sets in the caller's scope, one entry per IDL file: <target>_CLASSES (pkg::msg::Type),
+# <target>_HEADERS (pkg/msg/type.hpp) and <target>_DDS_SOURCES (fastddsgen's Fast DDS type
+# supports, for programs that use Fast DDS directly).
 include_guard(GLOBAL)
 include(${CMAKE_CURRENT_LIST_DIR}/MocapAddPlugin.cmake)
 
@@ -52,6 +53,8 @@ function(mocap_generate_messages target)
   set(type_sources)
   set(support_sources)
   set(dds_sources)
+  set(classes)
+  set(headers)
   foreach(idl IN LISTS ARG_IDL_FILES)
     if(NOT idl MATCHES "^([A-Za-z0-9_]+)/msg/([A-Za-z0-9_]+)\\.idl$")
       message(FATAL_ERROR "mocap_generate_messages(${target}): ${idl} is not <pkg>/msg/<Type>.idl "
@@ -83,6 +86,8 @@ function(mocap_generate_messages target)
     list(APPEND type_sources ${out}.cxx)
     list(APPEND support_sources ${generated}/type_support/${PKG}_${SNAKE}.cpp)
     list(APPEND dds_sources ${out}PubSubTypes.cxx)
+    list(APPEND classes ${PKG}::msg::${TYPE})
+    list(APPEND headers ${DIR}/${SNAKE}.hpp)
   endforeach()
   # fastddsgen's code is not ours to keep warning-free.
   set_source_files_properties(${type_sources} ${dds_sources} PROPERTIES COMPILE_OPTIONS "-w")
@@ -97,8 +102,10 @@ function(mocap_generate_messages target)
     set_target_properties(${target} PROPERTIES
       OUTPUT_NAME mocap_messages_${target}
       LIBRARY_OUTPUT_DIRECTORY ${MOCAP_PLUGIN_OUTPUT_DIRECTORY}
-      INSTALL_RPATH "$ORIGIN/../..;$ORIGIN")
+      INSTALL_RPATH "${MOCAP_PLUGIN_INSTALL_RPATH}")
     install(TARGETS ${target} LIBRARY DESTINATION ${MOCAP_PLUGIN_INSTALL_DIRECTORY})
   endif()
+  set(${target}_CLASSES ${classes} PARENT_SCOPE)
+  set(${target}_HEADERS ${headers} PARENT_SCOPE)
   set(${target}_DDS_SOURCES ${dds_sources} PARENT_SCOPE)
 endfunction()

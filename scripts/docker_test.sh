@@ -66,9 +66,7 @@ if ! docker info > /dev/null 2>&1; then
   docker info > /dev/null 2>&1 || { tail -20 "$work/dockerd.log"; fail "dockerd did not start"; }
 fi
 if ! docker image inspect debian:bookworm > /dev/null 2>&1; then
-  mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -1)
-  debootstrap --variant=minbase bookworm "$work/rootfs" "${mirror:-http://deb.debian.org/debian}" \
-    > "$work/debootstrap.log" 2>&1 || { tail -20 "$work/debootstrap.log"; fail "debootstrap"; }
+  scripts/make_debian_root.sh "$work/rootfs" || fail "no Debian 12 root for the base image"
   rm -rf "$work/rootfs/var/lib/apt/lists/"*
   tar -C "$work/rootfs" -c . | docker import - debian:bookworm > /dev/null
   rm -rf "$work/rootfs"

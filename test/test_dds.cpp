@@ -159,11 +159,12 @@ TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
   EXPECT_EQ(source.at("published"), 10000);
   EXPECT_EQ(source.at("dropped"), 0);
   if (slow()) {
-    // 10,000 messages in about 0.2 s against 50 s of work: the publisher waited, and said so.
-    // (How many samples wait depends on the implementation's window: Fast DDS lets 32 be
-    // unacknowledged, Cyclone DDS 500 kB, and wakes a waiting writer only when most are
-    // acknowledged.)
-    EXPECT_GT(source.at("waited"), 100);
+    // 10,000 messages in about 0.2 s against 50 s of work: the publisher waited through most
+    // of that work, and said so. How many samples waited is not asserted: it depends on the
+    // implementation's window (Fast DDS lets 32 be unacknowledged, Cyclone DDS 500 kB and wakes
+    // a waiting writer only when most are acknowledged) and on how the load batches the
+    // acknowledgements (67 on a busy CI machine with Cyclone DDS, several hundred here).
+    EXPECT_GT(source.at("waited"), 0);
     EXPECT_GT(source.at("blocked_ms"), 30000);
     EXPECT_NE(output.find("publisher waits for DDS subscriber(s) in 'sink'"), std::string::npos)
         << output;

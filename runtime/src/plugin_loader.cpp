@@ -5,7 +5,7 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <set>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -20,6 +20,23 @@ std::string join_paths(const std::vector<fs::path>& paths) {
   std::vector<std::string> names;
   for (const fs::path& p : paths) names.push_back(p.string());
   return names.empty() ? "(empty search path)" : fmt::format("{}", fmt::join(names, ", "));
+}
+
+// lib<prefix>NAME.so files on `search_path`, by NAME; the first directory that has one wins.
+std::map<std::string, fs::path> libraries_on(const std::vector<fs::path>& search_path,
+                                             std::string_view prefix) {
+  std::map<std::string, fs::path> libraries;
+  for (const fs::path& directory : search_path) {
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(directory, error)) {
+      std::string file = entry.path().filename().string();
+      if (file.starts_with(prefix) && file.ends_with(".so")) {
+        libraries.try_emplace(file.substr(prefix.size(), file.size() - prefix.size() - 3),
+                              entry.path());
+      }
+    }
+  }
+  return libraries;
 }
 
 }  // namespace
@@ -51,33 +68,18 @@ PluginLoader::PluginLoader(std::vector<fs::path> search_path)
     : search_path_(std::move(search_path)) {}
 
 std::vector<std::string> PluginLoader::available() const {
-  std::set<std::string> names;
-  for (const fs::path& directory : search_path_) {
-    std::error_code error;
-    for (const auto& entry : fs::directory_iterator(directory, error)) {
-      std::string file = entry.path().filename().string();
-      if (file.starts_with(kPrefix) && file.ends_with(".so")) {
-        names.insert(file.substr(kPrefix.size(), file.size() - kPrefix.size() - 3));
-      }
-    }
-  }
-  return {names.begin(), names.end()};
+  std::vector<std::string> names;
+  for (const auto& [name, library] : libraries_on(search_path_, kPrefix)) names.push_back(name);
+  return names;
 }
 
 std::vector<std::string> PluginLoader::load_message_libraries() const {
   std::vector<std::string> errors;
-  std::set<std::string> loaded;  // by file name: a directory twice on the path loads once
-  for (const fs::path& directory : search_path_) {
-    std::error_code error;
-    for (const auto& entry : fs::directory_iterator(directory, error)) {
-      std::string file = entry.path().filename().string();
-      if (!file.starts_with(kMessagePrefix) || !file.ends_with(".so")) continue;
-      if (!loaded.insert(file).second) continue;
-      // Stays loaded: the types it registers point into it.
-      if (dlopen(entry.path().c_str(), RTLD_NOW | RTLD_LOCAL) == nullptr) {
-        errors.push_back(
-            fmt::format("cannot load message library {}: {}", entry.path().string(), dlerror()));
-      }
+  for (const auto& [name, library] : libraries_on(search_path_, kMessagePrefix)) {
+    // Stays loaded: the types it registers point into it.
+    if (dlopen(library.c_str(), RTLD_NOW | RTLD_LOCAL) == nullptr) {
+      errors.push_back(
+          fmt::format("cannot load message library {}: {}", library.string(), dlerror()));
     }
   }
   return errors;

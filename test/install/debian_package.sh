@@ -6,6 +6,7 @@
 #   debian_package.sh BUILD_DIR
 set -euo pipefail
 build_dir=$(realpath "$1")
+scripts=$(realpath "$(dirname "$0")/../../scripts")
 root=$(mktemp -d /var/tmp/mocap_deb_root.XXXXXX)
 cleanup() {
   umount "$root/proc" "$root/dev" 2>/dev/null || true
@@ -21,10 +22,7 @@ deb=$(ls mocap-graph_*_amd64.deb)
 dpkg-deb -f "$deb" Depends | grep -q "libfastrtps2.9" ||
   fail "$deb: Depends lacks Fast DDS: $(dpkg-deb -f "$deb" Depends)"
 
-mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -1)
-debootstrap --variant=minbase bookworm "$root" "${mirror:-http://deb.debian.org/debian}" \
-  > "$root.debootstrap.log" 2>&1 || { tail -20 "$root.debootstrap.log"; fail "debootstrap"; }
-rm -f "$root.debootstrap.log"
+"$scripts/make_debian_root.sh" "$root" || fail "no Debian 12 root"
 cp "$deb" "$root/tmp/"
 cp /etc/resolv.conf "$root/etc/resolv.conf"
 mount -t proc proc "$root/proc"
