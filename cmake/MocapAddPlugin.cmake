@@ -1,5 +1,5 @@
 # mocap_add_plugin(<name> SOURCES <files>... [LIBRARIES <targets>...] [OUTPUT_DIRECTORY <dir>]
-#                  [NO_INSTALL])
+#                  [COMPONENT <install component>] [NO_INSTALL])
 #
 # Builds the component plugin <name> as libmocap_plugin_<name>.so, the name launch
 # files use (`plugin: <name>`), linked to the runtime and the messages. Only the registration
@@ -8,7 +8,8 @@
 # The library goes to OUTPUT_DIRECTORY, else MOCAP_PLUGIN_OUTPUT_DIRECTORY (in this
 # repository: build/lib/mocap_graph/plugins; in a project of your own: <build>/plugins, which
 # you put on MOCAP_PLUGIN_PATH). `cmake --install` puts it in lib/mocap_graph/plugins, where
-# the installed mocap_launch looks by default (not with NO_INSTALL: plugins for tests).
+# the installed mocap_launch looks by default (not with NO_INSTALL: plugins for tests), as part
+# of COMPONENT if given (`cmake --install --component`, and which package ships it).
 include_guard(GLOBAL)
 
 if(NOT DEFINED MOCAP_PLUGIN_OUTPUT_DIRECTORY)
@@ -20,7 +21,7 @@ set(MOCAP_PLUGIN_INSTALL_DIRECTORY lib/mocap_graph/plugins)
 set(MOCAP_PLUGIN_INSTALL_RPATH "$ORIGIN/../..;$ORIGIN")
 
 function(mocap_add_plugin name)
-  cmake_parse_arguments(ARG "NO_INSTALL" "OUTPUT_DIRECTORY" "SOURCES;LIBRARIES" ${ARGN})
+  cmake_parse_arguments(ARG "NO_INSTALL" "OUTPUT_DIRECTORY;COMPONENT" "SOURCES;LIBRARIES" ${ARGN})
   if(NOT ARG_SOURCES)
     message(FATAL_ERROR "mocap_add_plugin(${name}): no SOURCES")
   endif()
@@ -37,7 +38,12 @@ function(mocap_add_plugin name)
     LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY}
     INSTALL_RPATH "${MOCAP_PLUGIN_INSTALL_RPATH}")
   if(NOT ARG_NO_INSTALL)
-    install(TARGETS ${target} LIBRARY DESTINATION ${MOCAP_PLUGIN_INSTALL_DIRECTORY})
+    if(ARG_COMPONENT)
+      install(TARGETS ${target} LIBRARY DESTINATION ${MOCAP_PLUGIN_INSTALL_DIRECTORY}
+              COMPONENT ${ARG_COMPONENT})
+    else()
+      install(TARGETS ${target} LIBRARY DESTINATION ${MOCAP_PLUGIN_INSTALL_DIRECTORY})
+    endif()
     set_property(GLOBAL APPEND PROPERTY MOCAP_PLUGINS ${target})
   endif()
 endfunction()

@@ -6,18 +6,24 @@
 #
 # IMAGE: test that image instead of building one (kept at the end).
 # Starts a Docker engine if none answers (and stops only that one at the end), makes the
-# debian:bookworm base image with debootstrap if it is missing (no registry is needed), builds
-# the image (docker/Dockerfile), starts docker/compose.yaml's four hosts, then:
-#   start         poses reach the checker container
+# debian:bookworm and debian:bookworm-slim base images with debootstrap if they are missing (no
+# registry is needed), builds the image (docker/Dockerfile) and checks it as a user would: at
+# most 400 MB, runs as the user mocap, `mocap_launch launch_yaml/mobile_mocap_demo.yaml` in it
+# publishes poses. Then starts docker/compose.yaml's four hosts and runs the phases:
+#   start         poses reach the checker container; `mocap_topic list` in another container
+#                 and `mocap_topic echo` on this machine (outside the containers) see them
 #   crash_compute compute's mocap_launch is killed (SIGKILL) inside its container; Docker's
 #                 restart policy brings the container back; poses resume
+#   stall_compute compute's process is stopped (SIGSTOP): its HEALTHCHECK must turn unhealthy,
+#                 and healthy again once it continues (SIGCONT); poses resume
 #   link_compute  compute's link goes down for longer than the DDS lease (its veth, host side,
 #                 as a pulled cable) and up again; poses resume
-# After each fault the other containers must not have restarted, the robot must follow the
-# board again and the observer's evaluator must evaluate poses. Prints a table (per phase: the
-# check, pose arrays/s at the checker, the observer's frames/s and latency median/max, and
-# restarts) and exits non-zero on any failed check. Everything it made (containers, network,
-# image) is removed at the end, also on failure or Ctrl-C.
+# After each phase every host is healthy, the other containers have not restarted, the robot
+# follows the board again and the observer's evaluator evaluates poses. Prints a table (per
+# phase: the check, pose arrays/s at the checker, the observer's frames/s, latency median and
+# p99, frames lost, compute's restarts and health) and exits non-zero on any failed check.
+# Everything it made (containers, network, image) is removed at the end, also on failure or
+# Ctrl-C; the base images stay, as pulled ones would.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -65,13 +71,17 @@ if ! docker info > /dev/null 2>&1; then
   for _ in $(seq 60); do docker info > /dev/null 2>&1 && break; sleep 0.5; done
   docker info > /dev/null 2>&1 || { tail -20 "$work/dockerd.log"; fail "dockerd did not start"; }
 fi
-if ! docker image inspect debian:bookworm > /dev/null 2>&1; then
-  scripts/make_debian_root.sh "$work/rootfs" || fail "no Debian 12 root for the base image"
+# The Dockerfile's two bases, as a registry would give them: debian:bookworm for the build,
+# debian:bookworm-slim (no documentation, manual pages or translations) for the image.
+for tag in bookworm bookworm-slim; do
+  docker image inspect "debian:$tag" > /dev/null 2>&1 && continue
+  option=""
+  [ $tag = bookworm-slim ] && option=--slim
+  scripts/make_debian_root.sh $option "$work/rootfs" || fail "no Debian 12 root for debian:$tag"
   rm -rf "$work/rootfs/var/lib/apt/lists/"*
-  tar -C "$work/rootfs" -c . | docker import - debian:bookworm > /dev/null
+  tar -C "$work/rootfs" -c . | docker import - "debian:$tag" > /dev/null
   rm -rf "$work/rootfs"
-fi
-docker image inspect debian:bookworm-slim > /dev/null 2>&1 || docker tag debian:bookworm debian:bookworm-slim
+done
 
 # --- image
 if [ $# -eq 0 ]; then
@@ -81,21 +91,40 @@ if [ $# -eq 0 ]; then
     { tail -40 "$work/build.log"; fail "docker build"; }
   echo "image: $image built in $((SECONDS - build_start)) s"
 fi
-echo "image: $image, $(($(docker image inspect -f '{{.Size}}' "$image") / 1000000)) MB"
+size_mb=$(($(docker image inspect -f '{{.Size}}' "$image") / 1000000))
+echo "image: $image, $size_mb MB"
+[ "$size_mb" -le 400 ] || fail "the image is $size_mb MB, over its 400 MB budget"
+[ "$(docker run --rm --network none "$image" id -un)" = mocap ] ||
+  fail "the image does not run as its user mocap"
+# The shipped demo, as a user would run it (in-process DDS only: no network).
+docker run --rm --network none "$image" mocap_launch launch_yaml/mobile_mocap_demo.yaml \
+  --duration 5 > "$work/demo.log" 2>&1 || { tail -20 "$work/demo.log"; fail "the demo in the image"; }
+poses=$(sed -n 's/.*\[pose\]: \([0-9]*\) poses published.*/\1/p' "$work/demo.log")
+[ "${poses:-0}" -ge 100 ] || { tail -20 "$work/demo.log"; fail "the demo in the image: ${poses:-0} poses in 5 s"; }
+echo "image: docker run ... mocap_launch launch_yaml/mobile_mocap_demo.yaml --duration 5: $poses poses"
 
 # --- phases
 rows=()
 failed=0
 restarts() { docker inspect -f '{{.RestartCount}}' "$(container "$1")"; }
+health() { docker inspect -f '{{.State.Health.Status}}' "$(container "$1")"; }
+# True once HOST's HEALTHCHECK reports STATUS (waits at most S seconds).
+wait_health() {  # HOST STATUS S
+  local deadline=$((SECONDS + $3))
+  until [ "$(health "$1")" = "$2" ]; do
+    [ $SECONDS -lt $deadline ] || return 1
+    sleep 1
+  done
+}
 check() {  # TIMEOUT COUNT -> check_line, status
-  check_line=$(compose run --rm -T checker check --timeout "$1" --count "$2" 2>&1 | grep -m1 '^check: ' || true)
+  check_line=$(compose run --rm -T checker scenario.sh check --timeout "$1" --count "$2" 2>&1 | grep -m1 '^check: ' || true)
   [[ $check_line == "check: PASS"* ]]
 }
 # True once the last line of HOST's log that matches SELECT matches WANT too (waits 15 s).
 log_says() {  # HOST SELECT WANT
   local deadline=$((SECONDS + 15)) last
   while :; do
-    last=$(docker logs --since 5s "$(container "$1")" 2>&1 | grep -E "$2" | tail -n 1 || true)
+    last=$(docker logs "$(container "$1")" 2>&1 | grep -E "$2" | tail -n 1 || true)
     grep -qE "$3" <<< "$last" && return 0
     [ $SECONDS -lt $deadline ] || return 1
     sleep 1
@@ -112,23 +141,33 @@ phase() {  # NAME EXEMPT_HOST
     [ "$(restarts "$h")" = "${start_restarts[$h]}" ] || others+="$h "
   done
   if [ -n "$others" ]; then verdict=FAIL why+=" restarted: $others"; fi
+  local unhealthy=""
+  for h in sensor compute robot observer; do
+    wait_health "$h" healthy 30 || unhealthy+="$h "
+  done
+  if [ -n "$unhealthy" ]; then verdict=FAIL why+=" unhealthy: $unhealthy"; fi
   if ! log_says robot 'track of [A-Za-z0-9_]+ [a-z]+: ' ': following'; then
     verdict=FAIL why+=" the robot does not follow the board"
   fi
-  # The observer's per-second lines during the check: frames/s and latency.
+  # The observer's per-second lines during the phase: frames/s, latency median (the median
+  # second's) and p99 (the worst second's), frames lost (summed).
   local stats
   stats=$(docker logs --since "$((SECONDS - since + 2))s" "$(container observer)" 2>&1 |
-    sed -n 's/.*\[evaluator\]: \([0-9.]*\) frames\/s, latency \([0-9.]*\) ms.*/\1 \2/p' |
-    sort -k2 -g | awk '{ f[NR] = $1; l[NR] = $2 } END {
-      if (NR == 0) { print "- - -"; exit }
-      fs = 0; for (i = 1; i <= NR; i++) fs += f[i]
-      printf "%.1f %.2f %.2f\n", fs / NR, l[int((NR + 1) / 2)], l[NR] }')
-  if [ "$stats" = "- - -" ]; then verdict=FAIL why+=" the observer evaluates no poses"; fi
+    sed -n 's/.*\[evaluator\]: \([0-9.]*\) frames\/s, latency \([0-9.a-z]*\) ms (p99 \([0-9.a-z]*\) ms), \([0-9]*\) frame.*/\1 \2 \3 \4/p' |
+    awk '{ n++; f += $1; lost += $4 }  # seconds without poses have latency "nan"
+      $2 != "nan" { l[++m] = $2; if ($3 > p99) p99 = $3 }
+      END {
+        if (m == 0) { print "- - - -"; exit }
+        for (i = 2; i <= m; i++) for (j = i; j > 1 && l[j - 1] > l[j]; j--) {
+          t = l[j]; l[j] = l[j - 1]; l[j - 1] = t
+        }
+        printf "%.1f %.2f %.2f %d\n", f / n, l[int((m + 1) / 2)], p99, lost }')
+  if [ "$stats" = "- - - -" ]; then verdict=FAIL why+=" the observer evaluates no poses"; fi
   local rate
   rate=$(sed -n 's/^check: PASS \([0-9]*\) of [0-9]* .* in \([0-9.]*\) s;.*/\1 \2/p' <<< "$check_line" |
     awk '{ if ($2 > 0) printf "%.1f", $1 / $2; else print "-" }')
-  read -r fps median max <<< "$stats"
-  rows+=("| $name | $verdict | ${rate:--} | $fps | $median | $max | $(restarts compute) |")
+  read -r fps median p99 lost <<< "$stats"
+  rows+=("| $name | $verdict | ${rate:--} | $fps | $median | $p99 | $lost | $(restarts compute) | $(health compute) |")
   echo "phase $name: $verdict ${why:-$check_line}"
   [ $verdict = PASS ] || failed=$((failed + 1))
 }
@@ -140,6 +179,21 @@ snapshot() { for h in sensor compute robot observer; do start_restarts[$h]=$(res
 snapshot
 phase start none
 
+# The image's mocap_topic on the compose network, as a user would look at a running graph.
+docker run --rm --network "${project}_mocap" "$image" mocap_topic list --wait 5 \
+  > "$work/list.log" 2>&1 || { cat "$work/list.log"; fail "mocap_topic list in a container"; }
+grep -q '/mocap/poses' "$work/list.log" || { cat "$work/list.log"; fail "mocap_topic list in a container does not see /mocap/poses"; }
+echo "outside: mocap_topic list in another container sees $(grep -c '^/' "$work/list.log") topics"
+# A subscriber outside the containers: this machine, which is the compose network's gateway
+# (its bridge interface), with the tree's own mocap_topic.
+if [ -x "$root/build/bin/mocap_topic" ]; then
+  timeout 60 "$root/build/bin/mocap_topic" echo /mocap/poses --count 5 > "$work/echo.log" 2>&1 ||
+    { tail -5 "$work/echo.log"; fail "mocap_topic echo on the machine got no poses from the containers"; }
+  echo "outside: mocap_topic echo on the machine received $(grep -c '^header:' "$work/echo.log") pose arrays"
+else
+  fail "no $root/build/bin/mocap_topic to subscribe from outside the containers (build the tree first: scripts/test.sh)"
+fi
+
 snapshot
 # Crash: SIGKILL the host's process inside its container, as a crash would end it. (docker
 # kill would be a manual stop, which the restart policy leaves stopped.)
@@ -147,6 +201,20 @@ docker exec "$(container compute)" sh -c 'kill -KILL $(cat /proc/1/task/1/childr
 for _ in $(seq 30); do [ "$(restarts compute)" -ge 1 ] && break; sleep 1; done
 [ "$(restarts compute)" -ge 1 ] || fail "compute was not restarted after its crash"
 phase crash_compute compute
+
+snapshot
+# Stall: compute's process stops (SIGSTOP) without dying; only the HEALTHCHECK can tell. It must
+# say unhealthy, and healthy again once the process continues.
+docker exec "$(container compute)" sh -c 'kill -STOP $(cat /proc/1/task/1/children)'
+stalled=$SECONDS
+if wait_health compute unhealthy 60; then
+  echo "stall: compute's HEALTHCHECK says unhealthy $((SECONDS - stalled)) s after its process stopped"
+else
+  echo "phase stall_compute: compute stalled but its HEALTHCHECK says $(health compute)"
+  failed=$((failed + 1))
+fi
+docker exec "$(container compute)" sh -c 'kill -CONT $(cat /proc/1/task/1/children)'
+phase stall_compute none
 
 snapshot
 # Link: down longer than the DDS lease (netns_scenario.sh's 7 s), then up. The container's
@@ -166,8 +234,8 @@ ip link set "$veth" up
 phase link_compute none
 
 echo
-echo "| phase | verdict | pose arrays/s at the checker | observer frames/s | latency median ms | latency max ms | compute restarts |"
-echo "|---|---|---|---|---|---|---|"
+echo "| phase | verdict | pose arrays/s at the checker | observer frames/s | latency median ms | latency p99 ms (worst second) | frames lost | compute restarts | compute health |"
+echo "|---|---|---|---|---|---|---|---|---|"
 printf '%s\n' "${rows[@]}"
 [ $failed -eq 0 ] || fail "$failed check(s) failed"
 echo "result: PASS"

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Builds the Debian package in build-package/: the tests' optimisation (RelWithDebInfo, -O2;
-# cpack strips the debug information) without tests and benchmarks, then cpack ->
-# build-package/mocap-graph_<version>_amd64.deb (Depends computed from the binaries). Not -O3
-# (Release): GCC 12 gives false -Wrestrict warnings on std::string there. Install it with: sudo apt install ./build-package/mocap-graph_*_amd64.deb
+# Builds the Debian packages in build-package/ (cmake/Package.cmake): mocap-graph (tools,
+# plugins, launch files), mocap-graph-camera (camera_source, mocap_calibrate) and
+# mocap-graph-dev (headers, find_package), each with Depends computed from its binaries. The
+# tests' optimisation (RelWithDebInfo, -O2; cpack strips the debug information), no tests or
+# benchmarks. Not -O3 (Release): GCC 12 gives false -Wrestrict warnings on std::string there.
+# Install with: sudo apt install ./build-package/mocap-graph_*_amd64.deb (and the others)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build-package -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOCAP_BUILD_TESTS=OFF \
   -DMOCAP_BUILD_BENCHMARKS=OFF "$@" > /dev/null
 cmake --build build-package --parallel "$(nproc)"
 cd build-package
-rm -f mocap-graph_*_amd64.deb
+rm -f mocap-graph*_amd64.deb
 cpack -G DEB > cpack.log 2>&1 || { cat cpack.log; exit 1; }
-ls "$PWD"/mocap-graph_*_amd64.deb
+ls "$PWD"/mocap-graph*_amd64.deb

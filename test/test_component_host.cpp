@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -20,6 +21,7 @@
 
 #include "dds_transport.hpp"
 #include "names.hpp"
+#include "test_support.hpp"
 
 namespace mocap {
 namespace {
@@ -540,6 +542,51 @@ TEST(DdsImplementation, TheLaunchFileThenTheEnvironmentThenFastDds) {
     unsetenv("MOCAP_DDS_IMPLEMENTATION");
   } else {
     setenv("MOCAP_DDS_IMPLEMENTATION", restore.c_str(), 1);
+  }
+}
+
+// The health file: written when the host starts, and again every second while the executor
+// runs callbacks (a HEALTHCHECK compares its age; here, a removed file comes back).
+TEST(ComponentHostHealth, TheHealthFileIsRewrittenWhileTheHostRuns) {
+  test::TempDir dir;
+  std::filesystem::path file = dir / "health";
+  HostOptions options = in_process();
+  options.health_file = file.string();
+  ComponentHost host(options);
+  auto before = std::chrono::system_clock::now();
+  host.start();
+  ASSERT_TRUE(std::filesystem::exists(file));
+  std::string text = test::read_file(file);
+  long long seconds = 0;
+  ASSERT_EQ(std::sscanf(text.c_str(), "test alive at %lld", &seconds), 1) << text;
+  EXPECT_GE(seconds,
+            std::chrono::duration_cast<std::chrono::seconds>(before.time_since_epoch()).count());
+  std::filesystem::remove(file);
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!std::filesystem::exists(file) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(std::filesystem::exists(file)) << "not rewritten within 30 s";
+  host.stop();
+  // Stopped: no more rewriting, and no partial file left behind.
+  std::filesystem::remove(file);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_FALSE(std::filesystem::exists(file));
+  EXPECT_FALSE(std::filesystem::exists(dir / "health.partial"));
+}
+
+TEST(ComponentHostHealth, AHealthFileThatCannotBeWrittenStopsTheStart) {
+  test::TempDir dir;
+  HostOptions options = in_process();
+  std::string file = (dir / "no_such_folder" / "health").string();
+  options.health_file = file;
+  ComponentHost host(options);
+  try {
+    host.start();
+    FAIL() << "started without its health file";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "cannot write the health file " + file + ": cannot write " + file + ".partial");
   }
 }
 

@@ -165,11 +165,12 @@ TEST(Distributed, ComposeFileHasAServicePerHostAndTheChecker) {
       << services;
   // Each host runs its own role; the checker the check, and never restarts.
   for (const char* role : kRoles) {
-    EXPECT_NE(config.find(fmt::format("command:\n    - {}\n", role)), std::string::npos)
+    EXPECT_NE(config.find(fmt::format("command:\n    - scenario.sh\n    - {}\n", role)),
+              std::string::npos)
         << role << "\n"
         << config;
   }
-  EXPECT_NE(config.find("command:\n    - check\n"), std::string::npos) << config;
+  EXPECT_NE(config.find("command:\n    - scenario.sh\n    - check\n"), std::string::npos) << config;
   EXPECT_NE(config.find("restart: \"no\""), std::string::npos) << config;
 }
 
@@ -199,10 +200,9 @@ TEST(Distributed, DockerImageIsTheDebianPackage) {
   EXPECT_TRUE(copy_at != std::string::npos && apt_at != std::string::npos && copy_at < apt_at)
       << dockerfile;
   // The containers run the installed scenario script, as the namespaces run the tree's.
-  EXPECT_NE(dockerfile.find(R"(ENTRYPOINT ["/usr/share/mocap_graph/scripts/scenario.sh"])"),
-            std::string::npos);
-  EXPECT_NE(test::read_file(repo("cmake/Install.cmake"))
-                .find("scripts/scenario.sh DESTINATION share/mocap_graph/scripts"),
+  EXPECT_NE(dockerfile.find("ENV PATH=/usr/share/mocap_graph/scripts:$PATH"), std::string::npos)
+      << dockerfile;
+  EXPECT_NE(test::read_file(repo("cmake/Install.cmake")).find("scripts/scenario.sh\n"),
             std::string::npos);
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <filesystem>
+#include <fstream>
 
 #include <fmt/format.h>
 
@@ -10,6 +12,7 @@
 #include "intra_process_transport.hpp"
 #include "names.hpp"
 #include "shutdown_signal.hpp"
+#include "throttle.hpp"
 #include "timer_service.hpp"
 
 namespace mocap {
@@ -189,6 +192,13 @@ struct ComponentHost::Impl {
   std::atomic<bool> shutdown_requested{false};
   std::atomic<int> exit_code{0};
   bool started = false;
+  // HostOptions::health_file's writer, on a strand of its own.
+  std::unique_ptr<Strand> health_strand;
+  std::shared_ptr<Timer> health_timer;
+  Throttle health_failures{std::chrono::seconds(60)};
+
+  // "" or why the file could not be written.
+  std::string write_health_file() const;
 
   std::vector<KnownTopic> known_topics() const;
 };
@@ -439,9 +449,50 @@ Component& ComponentHost::add(const ComponentFactory& factory, ComponentConfig c
   return *impl_->components.back();
 }
 
+std::string ComponentHost::Impl::write_health_file() const {
+  // Written beside and renamed: a reader never sees half a file.
+  std::string partial = options.health_file + ".partial";
+  std::ofstream out(partial, std::ios::trunc);
+  out << fmt::format("{} alive at {}\n", options.name,
+                     std::chrono::duration_cast<std::chrono::seconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count());
+  out.close();
+  if (!out)
+    return fmt::format("cannot write the health file {}: cannot write {}", options.health_file,
+                       partial);
+  std::error_code error;
+  std::filesystem::rename(partial, options.health_file, error);
+  if (error) {
+    return fmt::format("cannot write the health file {}: {}", options.health_file, error.message());
+  }
+  return {};
+}
+
 void ComponentHost::start() {
   if (impl_->started) return;
   impl_->started = true;
+  if (!impl_->options.health_file.empty()) {
+    if (std::string error = impl_->write_health_file(); !error.empty()) {
+      impl_->started = false;
+      throw std::runtime_error(error);
+    }
+    impl_->health_strand = std::make_unique<Strand>(impl_->executor, impl_->logger);
+    impl_->health_timer = std::make_shared<Timer>(
+        "health file", std::chrono::seconds(1),
+        [impl = impl_.get()] {
+          // Later failures (a full disk) leave the file to age: the HEALTHCHECK then says so.
+          if (std::string error = impl->write_health_file(); !error.empty()) {
+            if (auto times = impl->health_failures.count()) {
+              impl->logger.warn("{} ({} time(s) since the last report)", error, *times);
+            }
+          }
+        },
+        *impl_->health_strand);
+    impl_->health_strand->add(impl_->health_timer);
+    impl_->health_strand->enable();
+    impl_->timers.add(impl_->health_timer);
+  }
   impl_->executor.start();
   impl_->timers.start();
 }

@@ -3,6 +3,7 @@
 
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -19,7 +20,8 @@
 namespace {
 
 constexpr const char* kUsage = R"(usage:
-  mocap_launch FILE [--group NAME] [--set COMPONENT.PARAM=VALUE]... [--duration SECONDS] [--check]
+  mocap_launch FILE [--group NAME] [--set COMPONENT.PARAM=VALUE]... [--duration SECONDS]
+               [--health-file PATH] [--check]
   mocap_launch --describe PLUGIN
   mocap_launch --plugins
 
@@ -29,6 +31,8 @@ Runs the components of a launch file (launch_yaml/README.md describes the format
   --group NAME     run only this group, in this process (one host's share of a deployment)
   --set C.P=V      set parameter P of component C to V (YAML: 3, 0.5, true, [1, 2], text)
   --duration S     stop after S seconds (default, or 0: run until Ctrl-C)
+  --health-file P  rewrite P every second while callbacks run (several groups: P.GROUP each);
+                   a container's HEALTHCHECK reads its age (default: $MOCAP_HEALTH_FILE)
   --check          validate the file and exit: 0 when valid
   --describe NAME  print a plugin's description, parameters and topics
   --plugins        list the plugins on the search path (MOCAP_PLUGIN_PATH, then
@@ -65,10 +69,10 @@ std::string describe(const mocap::LoadedPlugin& plugin) {
 }
 
 int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
-              std::optional<double> duration) {
+              std::optional<double> duration, const std::string& health_file) {
   try {
     mocap::ComponentHost host(
-        {group.name, group.threads, file.dds_of(group), mocap::known_topics(file)});
+        {group.name, group.threads, file.dds_of(group), mocap::known_topics(file), health_file});
     for (const mocap::LaunchComponent& component : group.components) {
       try {
         host.add(*component.plugin->factory, component.config);
@@ -93,6 +97,8 @@ int main(int argc, char** argv) {
   std::optional<std::string> file, group, describe_plugin;
   std::vector<std::string> set_texts;
   std::optional<double> duration;
+  const char* health_file_variable = std::getenv("MOCAP_HEALTH_FILE");
+  std::string health_file = health_file_variable ? health_file_variable : "";
   bool check = false, list_plugins = false;
 
   for (size_t i = 0; i < args.size(); ++i) {
@@ -117,6 +123,8 @@ int main(int argc, char** argv) {
       }
       // The last one given counts, so a wrapper's default can be overridden; 0 means none.
       duration = seconds > 0 ? std::optional<double>(seconds) : std::nullopt;
+    } else if (arg == "--health-file") {
+      health_file = value(arg);
     } else if (arg == "--check") {
       check = true;
     } else if (arg == "--describe") {
@@ -179,8 +187,10 @@ int main(int argc, char** argv) {
                launch.component_count());
     return 0;
   }
-  if (group) return run_group(launch, *launch.find_group(*group), duration);
-  if (launch.groups.size() == 1) return run_group(launch, launch.groups.front(), duration);
+  if (group) return run_group(launch, *launch.find_group(*group), duration, health_file);
+  if (launch.groups.size() == 1) {
+    return run_group(launch, launch.groups.front(), duration, health_file);
+  }
 
   // One child process per group, each running this program with --group.
   std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
@@ -194,6 +204,10 @@ int main(int argc, char** argv) {
     if (duration) {
       child.argv.push_back("--duration");
       child.argv.push_back(fmt::format("{}", *duration));
+    }
+    if (!health_file.empty()) {
+      child.argv.push_back("--health-file");
+      child.argv.push_back(health_file + "." + g.name);
     }
     children.push_back(std::move(child));
   }

@@ -4,8 +4,6 @@
 #include <filesystem>
 #include <map>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/component.hpp>
 #include <mocap/config_files.hpp>
@@ -17,6 +15,7 @@
 
 #include "image_message.hpp"
 #include "overlay_drawing.hpp"
+#include "png_file.hpp"
 #include "pose_message.hpp"
 
 namespace mocap::overlay {
@@ -127,7 +126,7 @@ class OverlayComponent final : public Component {
     if (snapshots_ > 0 && t - last_snapshot_ < snapshot_period_) return;
     last_snapshot_ = t;
     std::string path = fmt::format("{}/overlay_{:05d}.png", snapshot_directory_, snapshots_++);
-    if (!cv::imwrite(path, picture)) log().warn("cannot write {}", path);
+    if (std::string error = write_png(path, picture); !error.empty()) log().warn("{}", error);
   }
 
   calibration::CameraFile camera_;

@@ -91,9 +91,10 @@ class PoseEvaluatorComponent final : public Component {
       return;
     }
     log().info(
-        "{:.1f} frames/s, latency {:.2f} ms, tracked {:.1f} %, position error {:.2f} mm, "
-        "orientation error {:.3f} deg, false identifications {}",
+        "{:.1f} frames/s, latency {:.2f} ms (p99 {:.2f} ms), {} frame(s) lost, tracked {:.1f} %, "
+        "position error {:.2f} mm, orientation error {:.3f} deg, false identifications {}",
         window.frames / period_s_, EvaluationSummary::quantile(window_latencies_s_, 0.5) * 1e3,
+        EvaluationSummary::quantile(window_latencies_s_, 0.99) * 1e3, window.frames_lost,
         window.tracked_percent(), EvaluationSummary::quantile(window.position_errors_m, 0.5) * 1e3,
         EvaluationSummary::quantile(window.orientation_errors_deg, 0.5),
         window.false_identifications);

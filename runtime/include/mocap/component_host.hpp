@@ -55,6 +55,10 @@ struct HostOptions {
   // The topics of the whole deployment (every group of the launch file), for
   // Context::known_topics(). Empty: those of the components added to this host.
   std::vector<KnownTopic> known_topics = {};
+  // Rewritten every second by a callback on the executor, while the host runs: its age tells
+  // a supervisor (a container's HEALTHCHECK) that the process still dispatches callbacks, which
+  // a live PID alone does not. Empty: no file.
+  std::string health_file = {};
 };
 
 struct ComponentConfig {
