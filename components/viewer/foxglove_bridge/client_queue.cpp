@@ -1,0 +1,39 @@
+#include "client_queue.hpp"
+
+namespace mocap::foxglove {
+
+void ClientQueue::push(std::string frame, Clock::time_point now) {
+  if (frame.size() > options_.limit_bytes) {
+    ++dropped_;
+    if (!dropping_since_) dropping_since_ = now;
+    return;
+  }
+  bool dropped_any = false;
+  while (!frames_.empty() && bytes_ + frame.size() > options_.limit_bytes) {
+    bytes_ -= frames_.front().size();
+    frames_.pop_front();
+    ++dropped_;
+    dropped_any = true;
+  }
+  if (dropped_any) {
+    if (!dropping_since_) dropping_since_ = now;
+  } else {
+    dropping_since_.reset();
+  }
+  bytes_ += frame.size();
+  frames_.push_back(std::move(frame));
+}
+
+std::optional<std::string> ClientQueue::pop() {
+  if (frames_.empty()) return std::nullopt;
+  std::string frame = std::move(frames_.front());
+  frames_.pop_front();
+  bytes_ -= frame.size();
+  return frame;
+}
+
+bool ClientQueue::should_disconnect(Clock::time_point now) const {
+  return dropping_since_ && now - *dropping_since_ >= options_.disconnect_after;
+}
+
+}  // namespace mocap::foxglove

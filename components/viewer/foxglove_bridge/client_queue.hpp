@@ -1,0 +1,45 @@
+// What one Foxglove client has yet to receive: frames in order, within a byte budget. A client
+// that reads slower than the graph publishes loses its oldest frames, never slows the graph;
+// one that stays over its budget is to be disconnected.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+
+namespace mocap::foxglove {
+
+struct ClientQueueOptions {
+  size_t limit_bytes = 10'000'000;
+  // Over the limit (dropping) for this long without a break: disconnect.
+  std::chrono::steady_clock::duration disconnect_after = std::chrono::seconds(5);
+};
+
+class ClientQueue {
+ public:
+  using Clock = std::chrono::steady_clock;
+  explicit ClientQueue(ClientQueueOptions options = {}) : options_(options) {}
+
+  // Appends a frame; drops the oldest frames while the queue would exceed the limit (a frame
+  // larger than the limit on its own is dropped itself).
+  void push(std::string frame, Clock::time_point now);
+  // The oldest frame, if any.
+  std::optional<std::string> pop();
+
+  size_t bytes() const { return bytes_; }
+  size_t frames() const { return frames_.size(); }
+  uint64_t dropped() const { return dropped_; }
+  // True once the queue has been dropping frames for disconnect_after without a push that fit.
+  bool should_disconnect(Clock::time_point now) const;
+
+ private:
+  ClientQueueOptions options_;
+  std::deque<std::string> frames_;
+  size_t bytes_ = 0;
+  uint64_t dropped_ = 0;
+  std::optional<Clock::time_point> dropping_since_;
+};
+
+}  // namespace mocap::foxglove

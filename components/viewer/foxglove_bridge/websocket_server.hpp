@@ -1,0 +1,65 @@
+// A WebSocket server with plain HTTP on the same port, on a thread of its own: what the
+// Foxglove bridge needs from the network, over websocketpp (Debian's libwebsocketpp-dev), with
+// none of websocketpp's types in sight, so that its users need not build as it must (C++17).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mocap::foxglove {
+
+struct HttpResponse {
+  int status = 404;
+  std::string content_type = "text/plain; charset=utf-8";
+  std::string body = "not found\n";
+};
+
+struct WebSocketServerOptions {
+  std::string address = "0.0.0.0";  // an IPv4 or IPv6 address to listen on
+  uint16_t port = 8765;             // 0: any free port (WebSocketServer::port() tells which)
+  // Accepted subprotocols, preferred first; a client offering none of them gets HTTP 400.
+  std::vector<std::string> subprotocols;
+  // Largest message a client may send; a larger one closes its connection.
+  size_t max_incoming_message_bytes = 1 << 20;
+};
+
+// Called on the server's thread. A ClientId is never reused within one server.
+using ClientId = uint64_t;
+struct WebSocketHandlers {
+  std::function<void(ClientId, const std::string& subprotocol)> on_open;
+  std::function<void(ClientId, const std::string& text)> on_text;
+  std::function<void(ClientId, const std::string& bytes)> on_binary;
+  std::function<void(ClientId)> on_close;
+  // GET requests that are not WebSocket upgrades: the resource ("/index.html?x") -> response.
+  std::function<HttpResponse(const std::string& resource)> on_http;
+};
+
+class WebSocketServer {
+ public:
+  // Listens and starts the thread. Throws std::runtime_error naming address:port when the
+  // address cannot be bound (in use, not an address of this machine).
+  WebSocketServer(WebSocketServerOptions options, WebSocketHandlers handlers);
+  // Closes every connection ("server stopping") and joins the thread.
+  ~WebSocketServer();
+  WebSocketServer(const WebSocketServer&) = delete;
+  WebSocketServer& operator=(const WebSocketServer&) = delete;
+
+  uint16_t port() const;
+
+  // Thread-safe. Queue a frame to a client; false when it is gone.
+  bool send_text(ClientId client, const std::string& text);
+  bool send_binary(ClientId client, const void* data, size_t size);
+  // Bytes queued for a client and not yet handed to the socket (0 when it is gone).
+  size_t buffered_bytes(ClientId client) const;
+  // Closes a client's connection with a reason (at most 123 bytes are sent).
+  void close(ClientId client, const std::string& reason);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mocap::foxglove

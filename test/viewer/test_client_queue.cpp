@@ -1,0 +1,56 @@
+// A Foxglove client's queue (components/viewer/foxglove_bridge/client_queue.hpp): frames in
+// order within the byte budget, the oldest dropped first and counted, and the verdict that a
+// client stays too slow.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+
+#include "client_queue.hpp"
+
+namespace mocap::foxglove {
+namespace {
+
+using namespace std::chrono_literals;
+const ClientQueue::Clock::time_point t0{};
+
+TEST(ClientQueue, KeepsFramesInOrderWithinItsBudget) {
+  ClientQueue queue({.limit_bytes = 10});
+  queue.push("aaa", t0);
+  queue.push("bbb", t0);
+  EXPECT_EQ(queue.bytes(), 6u);
+  EXPECT_EQ(queue.pop(), "aaa");
+  EXPECT_EQ(queue.pop(), "bbb");
+  EXPECT_FALSE(queue.pop());
+  EXPECT_EQ(queue.dropped(), 0u);
+}
+
+TEST(ClientQueue, DropsTheOldestFirstAndCountsThem) {
+  ClientQueue queue({.limit_bytes = 10});
+  queue.push("1111", t0);
+  queue.push("2222", t0);
+  queue.push("3333", t0);  // 12 bytes would not fit: "1111" goes
+  EXPECT_EQ(queue.dropped(), 1u);
+  EXPECT_EQ(queue.bytes(), 8u);
+  EXPECT_EQ(queue.pop(), "2222");
+  queue.push(std::string(11, 'x'), t0);  // larger than the budget on its own: itself dropped
+  EXPECT_EQ(queue.dropped(), 2u);
+  EXPECT_EQ(queue.pop(), "3333");
+  EXPECT_FALSE(queue.pop());
+}
+
+TEST(ClientQueue, AClientDroppingForTooLongIsToBeDisconnected) {
+  ClientQueue queue({.limit_bytes = 4, .disconnect_after = 5s});
+  queue.push("1234", t0);
+  EXPECT_FALSE(queue.should_disconnect(t0 + 60s));  // never dropped
+  queue.push("5678", t0 + 1s);                      // drops: dropping since 1 s
+  EXPECT_FALSE(queue.should_disconnect(t0 + 5s));
+  queue.push("9abc", t0 + 3s);  // still dropping: the clock keeps running from 1 s
+  EXPECT_TRUE(queue.should_disconnect(t0 + 6s));
+  queue.pop();
+  queue.push("defg", t0 + 7s);  // fits again: no longer behind
+  EXPECT_FALSE(queue.should_disconnect(t0 + 60s));
+}
+
+}  // namespace
+}  // namespace mocap::foxglove

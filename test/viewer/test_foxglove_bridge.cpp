@@ -1,0 +1,182 @@
+// The foxglove_bridge plugin in a running graph, seen by clients that are not ours:
+// @foxglove/ws-protocol's FoxgloveClient decoding with @foxglove/rosmsg2-serialization
+// (foxglove_client.mjs), and clients that break the protocol (bad_clients.mjs). Needs Node and
+// test/viewer/node_modules (`npm ci` there; scripts/test.sh runs it).
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.hpp"
+
+namespace mocap {
+namespace {
+
+using nlohmann::json;
+
+std::filesystem::path viewer_tests() { return test::source_dir() / "test" / "viewer"; }
+
+// A TCP port nobody listens on right now.
+int free_port() {
+  int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address));
+  socklen_t size = sizeof(address);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
+  close(fd);
+  return ntohs(address.sin_port);
+}
+
+// The synthetic camera, the tracking pipeline and the bridge, in one process.
+class FoxgloveBridgeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(std::filesystem::exists(viewer_tests() / "node_modules"))
+        << "run `npm ci` in test/viewer (scripts/test.sh does)";
+    auto [node_code, node_version] = test::run_command({"node", "--version"});
+    ASSERT_EQ(node_code, 0) << "node is needed: " << node_version;
+    port_ = free_port();
+    auto config = [](const char* file) { return (test::source_dir() / "config" / file).string(); };
+    test::write_file(dir_ / "graph.yaml",
+                     fmt::format(R"(groups:
+  - name: viewer_test
+    components:
+      - plugin: synthetic_ir_camera
+        name: camera
+        parameters: {{scene: {0}, camera: {1}, rate_hz: 30.0}}
+      - plugin: fiducial_tracker
+        name: tracker
+      - plugin: constellation_identifier
+        name: identifier
+        parameters: {{camera: {1}}}
+      - plugin: pose_estimator
+        name: pose
+        parameters: {{camera: {1}}}
+      - plugin: foxglove_bridge
+        name: bridge
+        parameters: {{address: 127.0.0.1, port: {2}}}
+)",
+                                 config("scenes/demo.yaml"),
+                                 config("cameras/synthetic_ir_1280x720.yaml"), port_));
+    graph_ = std::make_unique<test::ChildProcess>(
+        std::vector<std::string>{(test::bin_dir() / "mocap_launch").string(),
+                                 (dir_ / "graph.yaml").string()},
+        std::map<std::string, std::string>{
+            {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(61))}},
+        dir_ / "graph.log");
+    ASSERT_TRUE(graph_->wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+        << graph_->output();
+  }
+
+  std::string url() const { return fmt::format("ws://127.0.0.1:{}", port_); }
+
+  // foxglove_client.mjs's decoded messages, by topic.
+  std::map<std::string, std::vector<json>> receive(int count, std::vector<std::string> topics) {
+    std::vector<std::string> argv = {"node", (viewer_tests() / "foxglove_client.mjs").string(),
+                                     url(), std::to_string(count)};
+    argv.insert(argv.end(), topics.begin(), topics.end());
+    auto [code, output] = test::run_command(argv, {}, std::chrono::seconds(90));
+    EXPECT_EQ(code, 0) << output << "\n--- graph ---\n" << graph_->output();
+    std::map<std::string, std::vector<json>> messages;
+    std::istringstream lines(output);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.empty() || line[0] != '{') continue;
+      json item = json::parse(line);
+      messages[item["topic"]].push_back(item["message"]);
+    }
+    return messages;
+  }
+
+  test::TempDir dir_;
+  int port_ = 0;
+  std::unique_ptr<test::ChildProcess> graph_;
+};
+
+std::pair<int64_t, int64_t> stamp_of(const json& message) {
+  return {message["header"]["stamp"]["sec"], message["header"]["stamp"]["nsec"]};
+}
+
+TEST_F(FoxgloveBridgeTest, AnIndependentClientDecodesPosesFiducialsAndImages) {
+  auto messages = receive(
+      30, {"/mocap/poses", "/camera/ir/ground_truth", "/mocap/fiducials", "/camera/ir/image_raw"});
+  ASSERT_EQ(messages["/mocap/poses"].size(), 30u);
+  ASSERT_EQ(messages["/camera/ir/image_raw"].size(), 30u);
+
+  // The estimated poses against the camera's ground truth of the same frame (same stamp):
+  // decoded field by field from the advertised schema, they must agree to the millimetre.
+  std::map<std::pair<int64_t, int64_t>, json> truth;
+  for (const json& t : messages["/camera/ir/ground_truth"]) truth[stamp_of(t)] = t;
+  int compared = 0;
+  for (const json& estimate : messages["/mocap/poses"]) {
+    auto found = truth.find(stamp_of(estimate));
+    if (found == truth.end()) continue;
+    for (const json& pose : estimate["poses"]) {
+      for (const json& true_pose : found->second["poses"]) {
+        if (true_pose["name"] != pose["name"]) continue;
+        const json& p = pose["pose"]["pose"]["position"];
+        const json& q = true_pose["pose"]["pose"]["position"];
+        double error = std::hypot(p["x"].get<double>() - q["x"].get<double>(),
+                                  p["y"].get<double>() - q["y"].get<double>(),
+                                  p["z"].get<double>() - q["z"].get<double>());
+        EXPECT_LT(error, 0.001) << pose << "\n" << true_pose;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GE(compared, 10) << "poses with a ground truth of the same frame";
+
+  for (const json& fiducials : messages["/mocap/fiducials"]) {
+    ASSERT_GE(fiducials["fiducials"].size(), 8u) << fiducials;
+    for (const json& f : fiducials["fiducials"]) {
+      EXPECT_TRUE(f["x"] >= 0 && f["x"] < 1280 && f["y"] >= 0 && f["y"] < 720) << f;
+    }
+  }
+  // Images whole (their bytes counted by the client), throttled to 10 a second per client.
+  for (const json& image : messages["/camera/ir/image_raw"]) {
+    EXPECT_EQ(image["width"], 1280);
+    EXPECT_EQ(image["height"], 720);
+    EXPECT_EQ(image["encoding"], "mono8");
+    EXPECT_EQ(image["data"]["bytes"], 1280 * 720);
+  }
+  const auto& images = messages["/camera/ir/image_raw"];
+  auto seconds = [](const json& m) {
+    return m["header"]["stamp"]["sec"].get<double>() +
+           m["header"]["stamp"]["nsec"].get<double>() * 1e-9;
+  };
+  for (size_t i = 1; i < images.size(); ++i) {
+    EXPECT_GE(seconds(images[i]) - seconds(images[i - 1]), 0.09) << "max_image_rate_hz: 10";
+  }
+}
+
+TEST_F(FoxgloveBridgeTest, ClientsThatBreakTheProtocolAreClosedWithTheReason) {
+  auto [code, output] = test::run_command(
+      {"node", (viewer_tests() / "bad_clients.mjs").string(), url()}, {}, std::chrono::seconds(60));
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("garbage: closed 1008 malformed JSON"), std::string::npos) << output;
+  EXPECT_NE(output.find("unknown_op: closed 1008 unknown op \"explode\""), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("binary: closed 1008 client publishing is not offered by this server"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("wrong_subprotocol: HTTP 400"), std::string::npos) << output;
+  EXPECT_NE(output.find("half_message: closed"), std::string::npos) << output;
+  // The graph and the bridge go on: a proper client still gets poses.
+  EXPECT_FALSE(graph_->wait(std::chrono::seconds(0)).has_value()) << graph_->output();
+  EXPECT_EQ(receive(5, {"/mocap/poses"})["/mocap/poses"].size(), 5u);
+}
+
+}  // namespace
+}  // namespace mocap
