@@ -79,7 +79,7 @@ for rate in 30 0; do
 
   echo "camera $camera: one process (mobile_mocap_demo.yaml) ..." >&2
   "$bin_dir/mocap_launch" "$root/launch_yaml/mobile_mocap_demo.yaml" --duration "$duration" \
-    "${set_rate[@]}" >"$work/demo_$rate.log" 2>&1
+    "${set_rate[@]}" --set viewer.port=0 >"$work/demo_$rate.log" 2>&1
   add_row "one process (mobile_mocap_demo.yaml)" "$camera" "$work/demo_$rate.log" \
     "pointers in-process; runs the overlay too"
 

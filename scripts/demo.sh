@@ -3,9 +3,11 @@
 # tracking pipeline on a camera carried by a pan/tilt turret on a mobile base, following a
 # person with a board. Builds only what the demo runs (mocap_launch and the plugins), not the
 # tests and benchmarks. Extra arguments go to mocap_launch: --duration 0 runs until Ctrl-C.
+# Watch it live at http://localhost:8765/ (the built-in viewer), or from Foxglove/Lichtblick.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install_deps.sh
 [ -f build/build.ninja ] || cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
 cmake --build build --parallel "$(nproc)" --target mocap_launch mocap_plugins
+echo "demo: open http://localhost:8765/ to watch (or ws://localhost:8765 in Foxglove/Lichtblick)"
 exec build/bin/mocap_launch launch_yaml/follower_demo.yaml --duration 40 "$@"

@@ -19,8 +19,8 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev
   # the overlay's PNG snapshots
   zlib1g-dev
-  # the Foxglove WebSocket bridge
-  libwebsocketpp-dev libasio-dev
+  # the Foxglove WebSocket bridge; its browser test (Node and npm come with the machine)
+  libwebsocketpp-dev libasio-dev chromium
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
   # the Debian package (cpack: dpkg-shlibdeps, file) and its test in a clean Debian 12 root

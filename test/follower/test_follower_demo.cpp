@@ -22,7 +22,7 @@ TEST(FollowerDemo, TurretCentresBaseKeepsItsDistanceAndStopsWhenTheTrackIsLost) 
       {(test::bin_dir() / "mocap_launch").string(),
        (test::source_dir() / "launch_yaml" / "follower_demo.yaml").string(), "--duration", "26",
        "--set", "servos.device_link=" + servos, "--set", "turret.port=" + servos, "--set",
-       "monitor.summary_file=" + summary},
+       "monitor.summary_file=" + summary, "--set", "viewer.port=0"},
       {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(30))}}, std::chrono::seconds(120));
   ASSERT_EQ(code, 0) << output;
   YAML::Node figures = YAML::LoadFile(summary);

@@ -48,7 +48,8 @@ chroot "$root" sh -c "apt-get update -q && DEBIAN_FRONTEND=noninteractive \
 
 domain=$((100 + $$ % 100))
 chroot "$root" sh -c "cd /usr/share/mocap_graph && MOCAP_DOMAIN_ID=$domain \
-  timeout 120 mocap_launch launch_yaml/mobile_mocap_demo.yaml --duration 5" > demo.log 2>&1 ||
+  timeout 120 mocap_launch launch_yaml/mobile_mocap_demo.yaml --duration 5 \
+  --set viewer.port=0" > demo.log 2>&1 ||
   { cat demo.log; fail "mocap_launch from the installed package exited with $?"; }
 poses=$(sed -n 's/.*\[pose\]: \([0-9]*\) poses published.*/\1/p' demo.log)
 [ "${poses:-0}" -ge 100 ] || { cat demo.log; fail "only ${poses:-0} poses in 5 s"; }

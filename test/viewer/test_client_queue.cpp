@@ -39,16 +39,18 @@ TEST(ClientQueue, DropsTheOldestFirstAndCountsThem) {
   EXPECT_FALSE(queue.pop());
 }
 
-TEST(ClientQueue, AClientDroppingForTooLongIsToBeDisconnected) {
+TEST(ClientQueue, AClientBehindForTooLongIsToBeDisconnected) {
   ClientQueue queue({.limit_bytes = 4, .disconnect_after = 5s});
   queue.push("1234", t0);
   EXPECT_FALSE(queue.should_disconnect(t0 + 60s));  // never dropped
-  queue.push("5678", t0 + 1s);                      // drops: dropping since 1 s
+  queue.push("5678", t0 + 1s);                      // drops: behind since 1 s
   EXPECT_FALSE(queue.should_disconnect(t0 + 5s));
-  queue.push("9abc", t0 + 3s);  // still dropping: the clock keeps running from 1 s
+  queue.push("ab", t0 + 3s);  // drops again; behind since 1 s all the same
   EXPECT_TRUE(queue.should_disconnect(t0 + 6s));
+  queue.push("c", t0 + 7s);  // fits, but the queue was never emptied: still behind
+  EXPECT_TRUE(queue.should_disconnect(t0 + 7s));
   queue.pop();
-  queue.push("defg", t0 + 7s);  // fits again: no longer behind
+  queue.pop();  // emptied: caught up
   EXPECT_FALSE(queue.should_disconnect(t0 + 60s));
 }
 

@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <map>
 #include <sstream>
 #include <string>
@@ -40,7 +42,6 @@ int free_port() {
   return ntohs(address.sin_port);
 }
 
-// The synthetic camera, the tracking pipeline and the bridge, in one process.
 class FoxgloveBridgeTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -49,34 +50,24 @@ class FoxgloveBridgeTest : public ::testing::Test {
     auto [node_code, node_version] = test::run_command({"node", "--version"});
     ASSERT_EQ(node_code, 0) << "node is needed: " << node_version;
     port_ = free_port();
-    auto config = [](const char* file) { return (test::source_dir() / "config" / file).string(); };
-    test::write_file(dir_ / "graph.yaml",
-                     fmt::format(R"(groups:
-  - name: viewer_test
-    components:
-      - plugin: synthetic_ir_camera
-        name: camera
-        parameters: {{scene: {0}, camera: {1}, rate_hz: 30.0}}
-      - plugin: fiducial_tracker
-        name: tracker
-      - plugin: constellation_identifier
-        name: identifier
-        parameters: {{camera: {1}}}
-      - plugin: pose_estimator
-        name: pose
-        parameters: {{camera: {1}}}
-      - plugin: foxglove_bridge
-        name: bridge
-        parameters: {{address: 127.0.0.1, port: {2}}}
-)",
-                                 config("scenes/demo.yaml"),
-                                 config("cameras/synthetic_ir_1280x720.yaml"), port_));
+    start_graph();
+  }
+
+  // launch_yaml/follower_demo.yaml as shipped, its viewer on this test's port; the image rate
+  // and queue made small enough to show throttling and a stalled client within seconds.
+  void start_graph() {
+    graph_.reset();
+    const std::string servos = (dir_ / "servos").string();
     graph_ = std::make_unique<test::ChildProcess>(
-        std::vector<std::string>{(test::bin_dir() / "mocap_launch").string(),
-                                 (dir_ / "graph.yaml").string()},
+        std::vector<std::string>{
+            (test::bin_dir() / "mocap_launch").string(),
+            (test::source_dir() / "launch_yaml" / "follower_demo.yaml").string(), "--set",
+            "servos.device_link=" + servos, "--set", "turret.port=" + servos, "--set",
+            "viewer.address=127.0.0.1", "--set", fmt::format("viewer.port={}", port_), "--set",
+            "viewer.max_image_rate_hz=10", "--set", "viewer.send_buffer_limit_bytes=2000000"},
         std::map<std::string, std::string>{
             {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(61))}},
-        dir_ / "graph.log");
+        dir_ / fmt::format("graph{}.log", ++starts_));
     ASSERT_TRUE(graph_->wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
         << graph_->output();
   }
@@ -103,6 +94,7 @@ class FoxgloveBridgeTest : public ::testing::Test {
   test::TempDir dir_;
   int port_ = 0;
   std::unique_ptr<test::ChildProcess> graph_;
+  int starts_ = 0;
 };
 
 std::pair<int64_t, int64_t> stamp_of(const json& message) {
@@ -176,6 +168,58 @@ TEST_F(FoxgloveBridgeTest, ClientsThatBreakTheProtocolAreClosedWithTheReason) {
   // The graph and the bridge go on: a proper client still gets poses.
   EXPECT_FALSE(graph_->wait(std::chrono::seconds(0)).has_value()) << graph_->output();
   EXPECT_EQ(receive(5, {"/mocap/poses"})["/mocap/poses"].size(), 5u);
+}
+
+// Twenty clients at once and one that subscribes to everything and never reads: the twenty get
+// their poses, and the stalled one is disconnected by the bridge (it dropped its oldest
+// messages for 5 s), not waited for.
+TEST_F(FoxgloveBridgeTest, ManyClientsAndOneThatNeverReads) {
+  std::filesystem::path flag = dir_ / "dropped";
+  test::ChildProcess load({"node", (viewer_tests() / "load_clients.mjs").string(), url(), "20",
+                           "30", "/mocap/poses", flag.string()},
+                          {}, dir_ / "load.log");
+  ASSERT_TRUE(load.wait_for_output("clients: ", std::chrono::seconds(90))) << load.output();
+  EXPECT_NE(load.output().find("clients: 20 of 20 received 30"), std::string::npos)
+      << load.output();
+  EXPECT_TRUE(graph_->wait_for_output("too slow: behind for 5 s", std::chrono::seconds(60)))
+      << graph_->output();
+  test::write_file(flag, "");
+  EXPECT_EQ(load.wait(std::chrono::seconds(30)), 0) << load.output();
+  // It read nothing, not even a close frame: its connection was cut.
+  EXPECT_NE(load.output().find("stalled: closed"), std::string::npos) << load.output();
+  // And the graph went on: a new client gets poses.
+  EXPECT_EQ(receive(5, {"/mocap/poses"})["/mocap/poses"].size(), 5u);
+}
+
+// The built-in viewer in Debian's chromium (headless, playwright-core): frames drawn with one
+// circle per fiducial the tracker found, a changing pose readout, a screenshot
+// (MOCAP_VIEWER_SCREENSHOT, else the test's folder: docs/viewer.png is made this way), and the
+// disconnected state while the bridge is gone, then the reconnection.
+TEST_F(FoxgloveBridgeTest, TheViewerDrawsInARealBrowserAndSurvivesTheBridgeGoingAway) {
+  ASSERT_TRUE(std::filesystem::exists("/usr/bin/chromium") || std::getenv("MOCAP_CHROMIUM"))
+      << "chromium is needed (scripts/install_deps.sh installs it)";
+  const char* wanted = std::getenv("MOCAP_VIEWER_SCREENSHOT");
+  std::string screenshot = wanted ? wanted : (dir_ / "viewer.png").string();
+  std::filesystem::path flag = dir_ / "restarted";
+  test::ChildProcess browser(
+      {"node", (viewer_tests() / "browser_check.mjs").string(),
+       fmt::format("http://127.0.0.1:{}/", port_), screenshot, "--outage", flag.string()},
+      {}, dir_ / "browser.log");
+  ASSERT_TRUE(browser.wait_for_output("WAITING_FOR_STOP", std::chrono::seconds(90)))
+      << browser.output();
+  graph_->signal(SIGTERM);
+  ASSERT_EQ(graph_->wait(std::chrono::seconds(30)), 0) << graph_->output();
+  ASSERT_TRUE(browser.wait_for_output("WAITING_FOR_START", std::chrono::seconds(60)))
+      << browser.output();
+  start_graph();
+  test::write_file(flag, "");
+  ASSERT_EQ(browser.wait(std::chrono::seconds(90)), 0) << browser.output();
+  std::string output = browser.output();
+  EXPECT_EQ(output.find("FAIL"), std::string::npos) << output;
+  EXPECT_NE(output.find("circles drawn for the"), std::string::npos) << output;
+  EXPECT_NE(output.find("PASS the page says: disconnected"), std::string::npos) << output;
+  EXPECT_NE(output.find("PASS reconnected"), std::string::npos) << output;
+  EXPECT_GT(std::filesystem::file_size(screenshot), 10000u);
 }
 
 }  // namespace

@@ -8,17 +8,11 @@ void ClientQueue::push(std::string frame, Clock::time_point now) {
     if (!dropping_since_) dropping_since_ = now;
     return;
   }
-  bool dropped_any = false;
   while (!frames_.empty() && bytes_ + frame.size() > options_.limit_bytes) {
     bytes_ -= frames_.front().size();
     frames_.pop_front();
     ++dropped_;
-    dropped_any = true;
-  }
-  if (dropped_any) {
     if (!dropping_since_) dropping_since_ = now;
-  } else {
-    dropping_since_.reset();
   }
   bytes_ += frame.size();
   frames_.push_back(std::move(frame));
@@ -29,6 +23,7 @@ std::optional<std::string> ClientQueue::pop() {
   std::string frame = std::move(frames_.front());
   frames_.pop_front();
   bytes_ -= frame.size();
+  if (frames_.empty()) dropping_since_.reset();  // caught up
   return frame;
 }
 

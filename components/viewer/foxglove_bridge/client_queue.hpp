@@ -31,7 +31,8 @@ class ClientQueue {
   size_t bytes() const { return bytes_; }
   size_t frames() const { return frames_.size(); }
   uint64_t dropped() const { return dropped_; }
-  // True once the queue has been dropping frames for disconnect_after without a push that fit.
+  // True once the client has been behind for disconnect_after: from the first frame dropped
+  // until the queue is next emptied (the client caught up).
   bool should_disconnect(Clock::time_point now) const;
 
  private:

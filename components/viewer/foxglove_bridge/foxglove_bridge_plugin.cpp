@@ -5,6 +5,7 @@
 // slowly loses its oldest messages (client_queue.hpp) and is disconnected if it stays behind:
 // the graph never waits for a viewer.
 #include <unistd.h>
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -18,6 +19,7 @@
 
 #include "client_queue.hpp"
 #include "foxglove_protocol.hpp"
+#include "viewer_assets.hpp"
 #include "websocket_server.hpp"
 
 namespace mocap::foxglove {
@@ -100,14 +102,17 @@ class FoxgloveBridge final : public Component {
       refuse(client, "client publishing is not offered by this server");
     };
     handlers.on_close = [this](ClientId client) { closed(client); };
+    handlers.on_http = [](const std::string& resource) { return serve(resource); };
     try {
       server_ = std::make_unique<WebSocketServer>(options, handlers);
     } catch (const std::runtime_error& e) {
       throw std::invalid_argument(std::string("address/port: ") + e.what());
     }
     create_timer(std::chrono::milliseconds(20), [this] { pump_all(); });
-    log().info("Foxglove WebSocket server on ws://{}:{} offering {} topic(s)", options.address,
-               server_->port(), channels_.size());
+    log().info(
+        "Foxglove WebSocket server on ws://{0}:{1} offering {2} topic(s); the viewer: "
+        "http://{0}:{1}/",
+        options.address, server_->port(), channels_.size());
   }
 
   ~FoxgloveBridge() override {
@@ -127,6 +132,18 @@ class FoxgloveBridge final : public Component {
     std::map<uint32_t, uint32_t> subscription_of_channel;  // channel id -> subscription id
     std::map<uint32_t, Clock::time_point> last_image;      // channel id -> last image sent
   };
+
+  // The built-in viewer's files; "/" is its page.
+  static HttpResponse serve(const std::string& resource) {
+    std::string path = resource.substr(0, resource.find_first_of("?#"));
+    if (path == "/") path = "/index.html";
+    for (const ViewerAsset& asset : viewer_assets()) {
+      if (asset.path == path) {
+        return {200, std::string(asset.content_type), std::string(asset.body)};
+      }
+    }
+    return {};
+  }
 
   void opened(ClientId client) {
     std::string session = std::to_string(getpid());
@@ -199,7 +216,12 @@ class FoxgloveBridge final : public Component {
       if (subscription == state.subscription_of_channel.end()) continue;
       if (image && image_period_.count() > 0) {
         auto last = state.last_image.find(id);
-        if (last != state.last_image.end() && received - last->second < image_period_) continue;
+        // A camera at exactly the limit still gets through: frames come with some jitter.
+        const Clock::duration tolerance =
+            std::min<Clock::duration>(image_period_ / 4, std::chrono::milliseconds(5));
+        if (last != state.last_image.end() && received - last->second < image_period_ - tolerance) {
+          continue;
+        }
         state.last_image[id] = received;
       }
       if (frame.empty()) {
@@ -229,18 +251,25 @@ class FoxgloveBridge final : public Component {
   }
 
   void pump_all() {
-    std::vector<ClientId> too_slow;
+    std::vector<std::pair<ClientId, uint64_t>> too_slow;  // and the messages it lost
     {
       std::lock_guard lock(mutex_);
-      for (auto& [client, state] : clients_) {
-        pump(client, state);
-        if (state.queue.should_disconnect(std::chrono::steady_clock::now())) {
-          too_slow.push_back(client);
+      for (auto it = clients_.begin(); it != clients_.end();) {
+        pump(it->first, it->second);
+        if (it->second.queue.should_disconnect(std::chrono::steady_clock::now())) {
+          // Forgotten at once: nothing more is queued for it while its connection closes.
+          too_slow.emplace_back(it->first, it->second.queue.dropped());
+          dropped_ += it->second.queue.dropped();
+          it = clients_.erase(it);
+        } else {
+          ++it;
         }
       }
     }
-    for (ClientId client : too_slow) {
-      refuse(client, "too slow: messages dropped for 5 s (send_buffer_limit_bytes)");
+    for (auto [client, lost] : too_slow) {
+      refuse(client, fmt::format("too slow: behind for 5 s, {} message(s) dropped "
+                                 "(send_buffer_limit_bytes)",
+                                 lost));
     }
   }
 

@@ -189,6 +189,14 @@ void WebSocketServer::close(ClientId client, const std::string& reason) {
   if (!con) return;
   websocketpp::lib::error_code error;
   con->close(websocketpp::close::status::policy_violation, close_reason(reason), error);
+  Impl& s = *impl_;
+  s.endpoint.set_timer(1000, [&s, client](const websocketpp::lib::error_code&) {
+    auto lingering = s.connection(client);
+    if (!lingering) return;
+    asio::error_code ignored;
+    lingering->get_raw_socket().shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+    lingering->get_raw_socket().close(ignored);
+  });
 }
 
 }  // namespace mocap::foxglove

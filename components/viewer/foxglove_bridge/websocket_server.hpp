@@ -54,7 +54,9 @@ class WebSocketServer {
   bool send_binary(ClientId client, const void* data, size_t size);
   // Bytes queued for a client and not yet handed to the socket (0 when it is gone).
   size_t buffered_bytes(ClientId client) const;
-  // Closes a client's connection with a reason (at most 123 bytes are sent).
+  // Closes a client's connection with a reason (at most 123 bytes are sent). A client that
+  // does not complete the closing handshake within a second (one that reads nothing cannot)
+  // has its TCP connection cut.
   void close(ClientId client, const std::string& reason);
 
  private:

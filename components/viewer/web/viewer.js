@@ -1,0 +1,413 @@
+// The built-in viewer: the Foxglove WebSocket protocol from the page's own host (the bridge
+// serves this file), messages decoded from their advertised schemas (cdr.js), drawn live.
+// window.viewerState exposes what was drawn, for the browser test and for a curious console.
+import { decode, parseSchema } from "./cdr.js";
+
+const SUBPROTOCOL = "foxglove.websocket.v1";
+const IMAGE = "/camera/ir/image_raw";
+const FIDUCIALS = "/mocap/fiducials";
+const CONSTELLATIONS = "/mocap/constellations";
+const POSES = "/mocap/poses";
+const ALERTS = "/alerts";
+const BASE = "/base/pose";
+const ROBOTS = "/pixart/robots";
+// Large and drawn by the overlay component already: not subscribed.
+const SKIPPED = new Set(["/mocap/overlay"]);
+
+const state = (window.viewerState = {
+  connected: false,
+  server: "",
+  images: 0,
+  frameStamp: null,  // stamp of the image on screen
+  fiducialsInFrame: 0,  // the tracker's fiducials for that image
+  circlesDrawn: 0,  // circles drawn on it
+  poseReadout: "",
+  latencyMs: null,
+});
+
+const $ = (id) => document.getElementById(id);
+const statusLine = $("status");
+const camera = $("camera");
+const cameraContext = camera.getContext("2d");
+const offscreen = document.createElement("canvas");
+const offscreenContext = offscreen.getContext("2d");
+
+const stampKey = (header) => `${header.stamp.sec}.${String(header.stamp.nanosec).padStart(9, "0")}`;
+const stampSeconds = (header) => header.stamp.sec + header.stamp.nanosec * 1e-9;
+
+// --- connection ---------------------------------------------------------------------------
+
+let socket = null;
+let channels = new Map();  // channel id -> {topic, schemaName, structs}
+let bySubscription = new Map();
+let topics = new Map();  // topic -> {type, count, bytes, rate, bandwidth}
+let nextSubscription = 1;
+
+function connect() {
+  const url = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/`;
+  socket = new WebSocket(url, [SUBPROTOCOL]);
+  socket.binaryType = "arraybuffer";
+  socket.onopen = () => {
+    state.connected = true;
+    statusLine.textContent = `connected to ${url}`;
+    statusLine.className = "connected";
+  };
+  socket.onclose = () => {
+    const was = state.connected;
+    state.connected = false;
+    channels = new Map();
+    bySubscription = new Map();
+    statusLine.textContent = `disconnected: no bridge at ${url}${was ? " (it went away)" : ""}; retrying every 2 s`;
+    statusLine.className = "disconnected";
+    setTimeout(connect, 2000);
+  };
+  socket.onmessage = (event) => {
+    if (typeof event.data === "string") control(JSON.parse(event.data));
+    else data(new Uint8Array(event.data));
+  };
+}
+
+function control(message) {
+  if (message.op === "serverInfo") {
+    state.server = message.name;
+  } else if (message.op === "advertise") {
+    const subscriptions = [];
+    for (const channel of message.channels) {
+      if (channel.encoding !== "cdr" || channel.schemaEncoding !== "ros2idl") continue;
+      let structs;
+      try {
+        structs = parseSchema(channel.schema);
+      } catch (error) {
+        console.warn(`${channel.topic}: ${error.message}`);
+        continue;
+      }
+      channels.set(channel.id, { topic: channel.topic, schemaName: channel.schemaName, structs });
+      topics.set(channel.topic, { type: channel.schemaName, count: 0, bytes: 0, rate: null, bandwidth: null });
+      if (SKIPPED.has(channel.topic)) continue;
+      const id = nextSubscription++;
+      bySubscription.set(id, channels.get(channel.id));
+      subscriptions.push({ id, channelId: channel.id });
+    }
+    if (subscriptions.length) socket.send(JSON.stringify({ op: "subscribe", subscriptions }));
+    renderTopics();
+  } else if (message.op === "unadvertise") {
+    for (const id of message.channelIds) {
+      const channel = channels.get(id);
+      if (channel) topics.delete(channel.topic);
+      channels.delete(id);
+    }
+    renderTopics();
+  } else if (message.op === "status") {
+    console.info(`bridge: ${message.message}`);
+  }
+}
+
+function data(bytes) {
+  if (bytes[0] !== 0x01 || bytes.length < 13) return;
+  const view = new DataView(bytes.buffer, bytes.byteOffset);
+  const channel = bySubscription.get(view.getUint32(1, true));
+  if (!channel) return;
+  const payload = bytes.subarray(13);
+  const topic = topics.get(channel.topic);
+  if (topic) {
+    topic.count++;
+    topic.bytes += payload.length;
+  }
+  let message;
+  try {
+    message = decode(channel.structs, channel.schemaName, payload);
+  } catch (error) {
+    console.warn(`${channel.topic}: ${error.message}`);
+    return;
+  }
+  const handler = handlers[channel.topic];
+  if (handler) handler(message);
+}
+
+// --- what arrives -------------------------------------------------------------------------
+
+const recentFiducials = new Map();  // stamp -> fiducials, the last few frames
+const recentConstellations = new Map();
+let latestPoses = null;
+const trails = new Map();  // pose name -> [{x, z}]
+let base = null;
+let robots = [];
+const alerts = [];
+let dirty = { camera: false, side: false };
+
+function remember(map, key, value) {
+  map.set(key, value);
+  while (map.size > 60) map.delete(map.keys().next().value);
+}
+
+const handlers = {
+  [IMAGE](image) {
+    if (!toPixels(image)) return;
+    state.images++;
+    state.frameStamp = stampKey(image.header);
+    dirty.camera = true;
+  },
+  [FIDUCIALS](message) {
+    remember(recentFiducials, stampKey(message.header), message.fiducials);
+    dirty.camera = true;
+  },
+  [CONSTELLATIONS](message) {
+    remember(recentConstellations, stampKey(message.header), message.constellations);
+    dirty.camera = true;
+  },
+  [POSES](message) {
+    latestPoses = message;
+    state.latencyMs = Date.now() - stampSeconds(message.header) * 1000;
+    for (const pose of message.poses) {
+      const p = pose.pose.pose.position;
+      const trail = trails.get(pose.name) ?? [];
+      trail.push({ x: p.x, z: p.z });
+      if (trail.length > 150) trail.shift();
+      trails.set(pose.name, trail);
+    }
+    dirty.side = true;
+    renderPoses();
+  },
+  [BASE](message) {
+    base = message.pose;
+    dirty.side = true;
+  },
+  [ROBOTS](message) {
+    robots = message.robots;
+    dirty.side = true;
+  },
+  [ALERTS](alert) {
+    alerts.unshift(alert);
+    alerts.length = Math.min(alerts.length, 8);
+    renderAlerts();
+  },
+};
+
+// An image message into the offscreen canvas; false for encodings this viewer does not draw.
+let imageData = null;
+function toPixels(image) {
+  const { width, height, encoding, step, data: pixels } = image;
+  const channelsOf = { mono8: 1, bgr8: 3, rgb8: 3, bgra8: 4, rgba8: 4 }[encoding];
+  if (!channelsOf || pixels.length < step * height) {
+    $("camera-note").textContent = `cannot draw ${encoding} images`;
+    return false;
+  }
+  if (!imageData || imageData.width !== width || imageData.height !== height) {
+    imageData = new ImageData(width, height);
+    offscreen.width = camera.width = width;
+    offscreen.height = camera.height = height;
+  }
+  const out = imageData.data;
+  const swap = encoding.startsWith("bgr");
+  for (let y = 0; y < height; y++) {
+    let i = y * step;
+    let o = y * width * 4;
+    for (let x = 0; x < width; x++, o += 4, i += channelsOf) {
+      if (channelsOf === 1) {
+        out[o] = out[o + 1] = out[o + 2] = pixels[i];
+      } else {
+        out[o] = pixels[swap ? i + 2 : i];
+        out[o + 1] = pixels[i + 1];
+        out[o + 2] = pixels[swap ? i : i + 2];
+      }
+      out[o + 3] = 255;
+    }
+  }
+  offscreenContext.putImageData(imageData, 0, 0);
+  return true;
+}
+
+// --- drawing ------------------------------------------------------------------------------
+
+function drawCamera() {
+  cameraContext.drawImage(offscreen, 0, 0);
+  const fiducials = recentFiducials.get(state.frameStamp) ?? [];
+  const constellations = recentConstellations.get(state.frameStamp) ?? [];
+  const scale = camera.width / 1280;
+  cameraContext.lineWidth = 2 * scale;
+  cameraContext.strokeStyle = "#ffd54a";
+  let circles = 0;
+  for (const f of fiducials) {
+    cameraContext.beginPath();
+    cameraContext.arc(f.x, f.y, Math.max(6, Math.sqrt(f.size ?? 36)) * scale, 0, 2 * Math.PI);
+    cameraContext.stroke();
+    circles++;
+  }
+  cameraContext.font = `${16 * scale}px system-ui, sans-serif`;
+  for (const c of constellations) {
+    cameraContext.strokeStyle = "#5fd38d";
+    cameraContext.fillStyle = "#5fd38d";
+    let sx = 0;
+    let sy = 0;
+    let n = 0;
+    for (const sub of c.sub_constellations) {
+      const points = sub.fiducial_array.fiducials;
+      if (points.length < 2) continue;
+      cameraContext.beginPath();
+      cameraContext.moveTo(points[0].x, points[0].y);
+      for (const p of points.slice(1)) cameraContext.lineTo(p.x, p.y);
+      cameraContext.stroke();
+      for (const p of points) {
+        sx += p.x;
+        sy += p.y;
+        n++;
+      }
+    }
+    if (n) cameraContext.fillText(c.name, sx / n + 12 * scale, sy / n - 12 * scale);
+  }
+  state.fiducialsInFrame = fiducials.length;
+  state.circlesDrawn = circles;
+}
+
+function grid(context, width, height, pixelsPerMetre, originX, originY) {
+  context.fillStyle = "#000";
+  context.fillRect(0, 0, width, height);
+  context.strokeStyle = "#222a33";
+  context.lineWidth = 1;
+  const step = pixelsPerMetre / 2;
+  for (let x = originX % step; x < width; x += step) {
+    context.beginPath();
+    context.moveTo(x, 0);
+    context.lineTo(x, height);
+    context.stroke();
+  }
+  for (let y = originY % step; y < height; y += step) {
+    context.beginPath();
+    context.moveTo(0, y);
+    context.lineTo(width, y);
+    context.stroke();
+  }
+}
+
+const COLOURS = ["#ffd54a", "#5fd38d", "#6cb6ff", "#ff8f6b", "#d59bff"];
+
+function drawTop() {
+  const canvas = $("top");
+  const context = canvas.getContext("2d");
+  const ppm = 100;  // pixels per metre
+  const ox = canvas.width / 2;
+  const oy = canvas.height - 20;
+  grid(context, canvas.width, canvas.height, ppm, ox, oy);
+  // The camera and its field of view (about 90 degrees).
+  context.strokeStyle = "#7d8794";
+  context.beginPath();
+  context.moveTo(ox - 3 * ppm, oy - 3 * ppm);
+  context.lineTo(ox, oy);
+  context.lineTo(ox + 3 * ppm, oy - 3 * ppm);
+  context.stroke();
+  context.fillStyle = "#d8dee6";
+  context.fillRect(ox - 6, oy - 4, 12, 8);
+  let k = 0;
+  for (const [name, trail] of trails) {
+    const colour = COLOURS[k++ % COLOURS.length];
+    context.strokeStyle = colour;
+    context.globalAlpha = 0.5;
+    context.beginPath();
+    trail.forEach((p, i) => (i ? context.lineTo : context.moveTo).call(context, ox + p.x * ppm, oy - p.z * ppm));
+    context.stroke();
+    context.globalAlpha = 1;
+    const last = trail[trail.length - 1];
+    context.fillStyle = colour;
+    context.beginPath();
+    context.arc(ox + last.x * ppm, oy - last.z * ppm, 5, 0, 2 * Math.PI);
+    context.fill();
+    context.fillText(name, ox + last.x * ppm + 8, oy - last.z * ppm - 8);
+  }
+}
+
+function drawFloor() {
+  const canvas = $("floor");
+  const context = canvas.getContext("2d");
+  const ppm = 60;
+  const ox = canvas.width / 2;
+  const oy = canvas.height / 2;
+  grid(context, canvas.width, canvas.height, ppm, ox, oy);
+  const marker = (x, y, theta, colour, label) => {
+    const px = ox + x * ppm;
+    const py = oy - y * ppm;
+    context.fillStyle = colour;
+    context.strokeStyle = colour;
+    context.beginPath();
+    context.arc(px, py, 7, 0, 2 * Math.PI);
+    context.fill();
+    context.beginPath();
+    context.moveTo(px, py);
+    context.lineTo(px + 18 * Math.cos(theta), py - 18 * Math.sin(theta));
+    context.stroke();
+    context.fillText(label, px + 10, py - 10);
+  };
+  if (base) {
+    const q = base.orientation;
+    const yaw = Math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
+    marker(base.position.x, base.position.y, yaw, "#6cb6ff", "base");
+  }
+  for (const r of robots) marker(r.x, r.y, r.theta, "#ff8f6b", r.name);
+  if (!base && robots.length === 0) {
+    context.fillStyle = "#7d8794";
+    context.fillText(`no ${BASE} or ${ROBOTS} in this graph`, 12, 20);
+  }
+}
+
+function degrees(q) {
+  const roll = Math.atan2(2 * (q.w * q.x + q.y * q.z), 1 - 2 * (q.x * q.x + q.y * q.y));
+  const pitch = Math.asin(Math.max(-1, Math.min(1, 2 * (q.w * q.y - q.z * q.x))));
+  const yaw = Math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
+  return [roll, pitch, yaw].map((a) => ((a * 180) / Math.PI).toFixed(1));
+}
+
+function renderPoses() {
+  const rows = latestPoses.poses.map((pose) => {
+    const p = pose.pose.pose.position;
+    const [roll, pitch, yaw] = degrees(pose.pose.pose.orientation);
+    return `<tr><td>${pose.name}</td><td>${p.x.toFixed(3)}</td><td>${p.y.toFixed(3)}</td>
+      <td>${p.z.toFixed(3)}</td><td>${roll}</td><td>${pitch}</td><td>${yaw}</td>
+      <td>${pose.points_used}</td><td>${pose.reprojection_rms_px.toFixed(2)}</td></tr>`;
+  });
+  const html = rows.join("") || `<tr><td colspan="9" class="note">no constellation identified</td></tr>`;
+  $("poses").tBodies[0].innerHTML = html;
+  state.poseReadout = $("poses").tBodies[0].textContent;
+}
+
+function renderAlerts() {
+  const level = (l) => (l >= 2 ? "error" : "warning");
+  $("alerts").innerHTML = alerts
+    .map((a) => `<li class="${level(a.level)}">${new Date(stampSeconds(a.header) * 1000).toLocaleTimeString()} ${a.source}: ${a.text}</li>`)
+    .join("");
+}
+
+function renderTopics() {
+  const rows = [...topics.entries()].sort().map(([name, t]) =>
+    `<tr><td>${name}</td><td>${t.type}</td><td>${t.rate === null ? "—" : t.rate.toFixed(1)}</td>
+      <td>${t.bandwidth === null ? "—" : (t.bandwidth / 1000).toFixed(1)}</td></tr>`);
+  $("topics").tBodies[0].innerHTML = rows.join("");
+}
+
+// Rates and bandwidth over the last second.
+setInterval(() => {
+  for (const t of topics.values()) {
+    t.rate = t.count;
+    t.bandwidth = t.bytes;
+    t.count = 0;
+    t.bytes = 0;
+  }
+  renderTopics();
+  const images = topics.get(IMAGE)?.rate;
+  $("rates").textContent = state.connected
+    ? `camera ${images ?? 0} Hz shown · poses ${topics.get(POSES)?.rate ?? 0} Hz · latency ${state.latencyMs === null ? "—" : state.latencyMs.toFixed(1) + " ms"}`
+    : "";
+}, 1000);
+
+function frame() {
+  if (dirty.camera && state.frameStamp) drawCamera();
+  if (dirty.side) {
+    drawTop();
+    drawFloor();
+  }
+  dirty = { camera: false, side: false };
+  requestAnimationFrame(frame);
+}
+
+drawTop();
+drawFloor();
+connect();
+requestAnimationFrame(frame);

@@ -1,0 +1,64 @@
+// The built-in viewer in a real browser: Debian's chromium, headless, driven by playwright-core
+// (nothing downloaded). Opens http://HOST:PORT/, waits for camera frames, checks that the
+// overlay draws as many fiducial circles as the tracker found and that the pose readout
+// changes, saves a screenshot. With --outage FLAG_FILE it also checks the disconnected state:
+// it prints "WAITING_FOR_STOP", the test stops the bridge, the page must say it is gone; it
+// prints "WAITING_FOR_START", the test starts the bridge again and creates FLAG_FILE, and the
+// page must reconnect and draw new frames. One line per check; exit 0 when all passed.
+//
+//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE]
+import { chromium } from "playwright-core";
+import { existsSync } from "node:fs";
+
+const [url, screenshot, mode, flagFile] = process.argv.slice(2);
+const browser = await chromium.launch({
+  executablePath: process.env.MOCAP_CHROMIUM ?? "/usr/bin/chromium",
+  args: ["--no-sandbox", "--disable-gpu"],
+});
+let failed = false;
+function check(ok, line) {
+  console.log(`${ok ? "PASS" : "FAIL"} ${line}`);
+  if (!ok) failed = true;
+}
+const state = (page) => page.evaluate(() => ({ ...window.viewerState }));
+
+try {
+  const page = await browser.newPage({ viewport: { width: 1600, height: 1000 } });
+  const errors = [];
+  page.on("pageerror", (error) => errors.push(error.message));
+  await page.goto(url);
+  await page.waitForFunction(() => window.viewerState?.images >= 5 && window.viewerState.fiducialsInFrame > 0,
+    null, { timeout: 30000 });
+  const first = await state(page);
+  check(first.connected, `connected to ${first.server}`);
+  check(first.circlesDrawn === first.fiducialsInFrame && first.circlesDrawn > 0,
+    `${first.circlesDrawn} circles drawn for the ${first.fiducialsInFrame} fiducials of frame ${first.frameStamp}`);
+  await page.waitForTimeout(1500);
+  const later = await state(page);
+  check(later.poseReadout !== "" && later.poseReadout !== first.poseReadout,
+    `the pose readout changes (${JSON.stringify(later.poseReadout.slice(0, 60))}...)`);
+  check(later.circlesDrawn === later.fiducialsInFrame,
+    `${later.circlesDrawn} circles for ${later.fiducialsInFrame} fiducials, ${later.images - first.images} frames later`);
+  check(later.latencyMs !== null && later.latencyMs < 1000, `pose latency at the page ${later.latencyMs?.toFixed(1)} ms`);
+  await page.screenshot({ path: screenshot, fullPage: true });
+  console.log(`screenshot ${screenshot}`);
+
+  if (mode === "--outage") {
+    console.log("WAITING_FOR_STOP");
+    await page.waitForFunction(() => !window.viewerState.connected, null, { timeout: 30000 });
+    const text = await page.textContent("#status");
+    check(/disconnected/.test(text), `the page says: ${text}`);
+    console.log("WAITING_FOR_START");
+    const deadline = Date.now() + 60000;
+    while (!existsSync(flagFile) && Date.now() < deadline) await new Promise((r) => setTimeout(r, 100));
+    const before = (await state(page)).images;
+    await page.waitForFunction((n) => window.viewerState.connected && window.viewerState.images > n + 3,
+      before, { timeout: 30000 });
+    check(true, `reconnected: ${await page.textContent("#status")}`);
+  }
+  check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+} catch (error) {
+  check(false, error.message.split("\n")[0]);
+}
+await browser.close();
+process.exit(failed ? 1 : 0);
