@@ -170,6 +170,21 @@ TEST_F(FoxgloveBridgeTest, ClientsThatBreakTheProtocolAreClosedWithTheReason) {
   EXPECT_EQ(receive(5, {"/mocap/poses"})["/mocap/poses"].size(), 5u);
 }
 
+// The viewer's own CDR decoder (components/viewer/web/cdr.js) reads every topic of the follower
+// demo exactly as Foxglove's @foxglove/rosmsg2-serialization does.
+TEST_F(FoxgloveBridgeTest, TheViewersDecoderAgreesWithFoxglovesOnEveryTopic) {
+  auto [code, output] = test::run_command(
+      {"node", (viewer_tests() / "viewer_decoder_check.mjs").string(), url(), "5"}, {},
+      std::chrono::seconds(90));
+  EXPECT_EQ(code, 0) << output;
+  for (const char* topic : {"/mocap/poses", "/mocap/fiducials", "/mocap/constellations",
+                            "/camera/ir/image_raw", "/turret/joint_states", "/base/pose"}) {
+    EXPECT_NE(output.find(fmt::format("{}: ", topic)), std::string::npos) << topic << output;
+    EXPECT_EQ(output.find(fmt::format("{}: silent", topic)), std::string::npos) << output;
+  }
+  EXPECT_EQ(output.find("disagree"), std::string::npos) << output;
+}
+
 // Twenty clients at once and one that subscribes to everything and never reads: the twenty get
 // their poses, and the stalled one is disconnected by the bridge (it dropped its oldest
 // messages for 5 s), not waited for.
