@@ -201,6 +201,7 @@ struct ComponentHost::Impl {
   std::string write_health_file() const;
 
   std::vector<KnownTopic> known_topics() const;
+  std::vector<KnownTopic> discovered_topics() const;
 };
 
 class ComponentHost::Impl::ComponentContext final : public Context {
@@ -248,6 +249,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
   }
 
   std::vector<KnownTopic> known_topics() const override { return host_.known_topics(); }
+  std::vector<KnownTopic> discovered_topics() const override { return host_.discovered_topics(); }
 
   // This component's declared topics as the launch file sets them (remaps, QoS), for
   // known_topics().
@@ -399,6 +401,27 @@ std::vector<KnownTopic> ComponentHost::Impl::known_topics() const {
   }
   std::vector<KnownTopic> topics;
   for (auto& [name, topic] : known) topics.push_back(std::move(topic));
+  return topics;
+}
+
+std::vector<KnownTopic> ComponentHost::Impl::discovered_topics() const {
+  std::map<std::string, KnownTopic> discovered;
+  for (const auto& transport : transports) {
+    const auto* dds = dynamic_cast<const DdsTransport*>(transport.get());
+    if (dds == nullptr) continue;
+    for (const DiscoveredEndpoint& endpoint : dds->discovered_endpoints()) {
+      if (!endpoint.is_publisher || !valid_topic_name(endpoint.topic)) continue;
+      const MessageType* type = find_message_type(endpoint.type);
+      if (type == nullptr) continue;
+      KnownTopic& topic = discovered[endpoint.topic];
+      if (topic.type != nullptr && topic.type != type) continue;  // one type per topic: the first
+      topic.topic = endpoint.topic;
+      topic.type = type;
+      topic.publishers.push_back(endpoint.qos);
+    }
+  }
+  std::vector<KnownTopic> topics;
+  for (auto& [name, topic] : discovered) topics.push_back(std::move(topic));
   return topics;
 }
 

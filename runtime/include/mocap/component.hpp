@@ -116,6 +116,11 @@ class Context {
                              MessageCallback callback) = 0;
   // The topics the launch file's components declare, in every group, with their types.
   virtual std::vector<KnownTopic> known_topics() const = 0;
+  // The topics other processes on the DDS domain publish right now, with the QoS their
+  // publishers announce, whose types this process knows (shipped and loaded message
+  // libraries): for components that follow the graph as it changes (a viewer). Other
+  // processes' topics disappear once their publishers leave. Empty without DDS.
+  virtual std::vector<KnownTopic> discovered_topics() const = 0;
   virtual void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) = 0;
   // Ends the process's run once the current callbacks return; the process exits with
   // `exit_code` (the largest requested, if several components ask).
@@ -176,7 +181,7 @@ class Component {
 // What a plugin library exports, through MOCAP_REGISTER_COMPONENT.
 struct ComponentFactory {
   // Raised whenever Component, Context or this struct change layout.
-  static constexpr uint32_t kAbiVersion = 3;
+  static constexpr uint32_t kAbiVersion = 4;
   static constexpr const char* kSymbol = "mocap_component_factory";
 
   uint32_t abi_version;
