@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <condition_variable>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -20,6 +22,7 @@
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
 #include "camera_views.hpp"
+#include "led_plane_points.hpp"
 #include "pixart_rig.hpp"
 #include "planar_fit.hpp"
 #include "plugin_loader.hpp"
@@ -290,6 +293,30 @@ TEST(RobotLocalizer, RejectsRigsAndOptionsItCannotWorkWith) {
 
 // ---------------------------------------------------------------------------------------------
 // Localization on the seed's rig.
+
+// The nominal camera (41 degrees across 1024 x 768 square pixels) 2.05 m above the LED plane
+// sees a 1.533 m x 1.150 m rectangle centred under it; camera3 is turned 90 degrees from camera2.
+TEST(LedPlaneFootprint, IsTheRectangleUnderTheCameraTurnedWithIt) {
+  const Rig& rig = seed_rig();
+  std::map<std::string, std::array<Eigen::Vector2d, 4>> footprints;
+  for (const RigCamera& camera : rig.cameras) {
+    auto corners = led_plane_footprint(camera, rig.led_plane_height_m);
+    ASSERT_TRUE(corners.has_value()) << camera.name;
+    footprints[camera.name] = *corners;
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& c : *corners) centre += c / 4;
+    EXPECT_LT((centre - camera.world_from_camera.translation().head<2>()).norm(), 0.005)
+        << camera.name;
+    const double across = 2 * 2.05 * std::tan(20.5 * kDegree);
+    EXPECT_NEAR(((*corners)[1] - (*corners)[0]).norm(), across, 0.01 * across) << camera.name;
+    EXPECT_NEAR(((*corners)[2] - (*corners)[1]).norm(), across * 768 / 1024, 0.01 * across)
+        << camera.name;
+  }
+  const Eigen::Vector2d x2 = (footprints["camera2"][1] - footprints["camera2"][0]).normalized();
+  const Eigen::Vector2d x3 = (footprints["camera3"][1] - footprints["camera3"][0]).normalized();
+  EXPECT_NEAR(x2.dot(x3), 0, 1e-6);
+  EXPECT_NEAR(x2.x() * x3.y() - x2.y() * x3.x(), 1, 1e-6) << "counter-clockwise";
+}
 
 TEST(PixartLocalization, RobotUnderOneCameraWithinMillimetres) {
   RobotLocalizer localizer(seed_rig());

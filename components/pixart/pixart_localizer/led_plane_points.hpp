@@ -4,7 +4,9 @@
 // camera alone places a point: the ray through the pixel meets that plane once.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -24,5 +26,10 @@ struct LedPlanePoints {
 LedPlanePoints project_to_led_plane(const RigCamera& camera,
                                     const std::vector<Eigen::Vector2d>& pixels,
                                     double led_plane_height_m);
+
+// What `camera` sees of the LED plane: its image's corners there, world x, y, in the order
+// (0, 0), (width, 0), (width, height), (0, height); nullopt when a corner's ray misses it.
+std::optional<std::array<Eigen::Vector2d, 4>> led_plane_footprint(const RigCamera& camera,
+                                                                  double led_plane_height_m);
 
 }  // namespace mocap::pixart::localization

@@ -15,20 +15,24 @@
 #include <mocap/component.hpp>
 #include <mocap/config_files.hpp>
 #include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/camera_footprint_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
+#include "led_plane_points.hpp"
 #include "pixart_rig.hpp"
 #include "robot_localizer.hpp"
 
 namespace mocap::pixart::localization {
 namespace {
 
+using mocap_msgs::msg::CameraFootprintArray;
 using mocap_msgs::msg::FiducialArray;
 using mocap_msgs::msg::RobotPoseArray;
 
 constexpr const char* kFiducialFamily = "/pixart/{camera}/fiducials";
 constexpr const char* kOutput = "/pixart/robots";
+constexpr const char* kFootprints = "/pixart/camera_footprints";
 
 double degrees(double radians) { return radians * 180.0 / M_PI; }
 
@@ -72,6 +76,10 @@ class PixartLocalizer final : public Component {
         kOutput, Qos::reliable(),
         "every tracked robot's x, y (m) and theta (rad) in frame 'world', stamped with the "
         "newest sample used");
+    spec.publishes<CameraFootprintArray>(
+        kFootprints, Qos::latched(),
+        "once: what each rig camera sees of the LED plane (its image corners there), frame "
+        "'world', for viewers");
   }
 
   explicit PixartLocalizer(Context& context)
@@ -81,6 +89,7 @@ class PixartLocalizer final : public Component {
       log().warn("{}: not localized", problem);
     }
     publisher_ = create_publisher<RobotPoseArray>(kOutput);
+    publish_footprints(rig);
     for (const RigCamera& camera : rig.cameras) {
       create_subscription<FiducialArray>(
           "/pixart/" + camera.name + "/fiducials",
@@ -110,6 +119,31 @@ class PixartLocalizer final : public Component {
   }
 
  private:
+  void publish_footprints(const Rig& rig) {
+    auto footprints = std::make_shared<CameraFootprintArray>();
+    footprints->header().stamp(to_time_msg(now()));
+    footprints->header().frame_id("world");
+    for (const RigCamera& camera : rig.cameras) {
+      auto corners = led_plane_footprint(camera, rig.led_plane_height_m);
+      if (!corners) {
+        log().warn("{} does not see the LED plane whole; no footprint", camera.name);
+        continue;
+      }
+      mocap_msgs::msg::CameraFootprint footprint;
+      footprint.name(camera.name);
+      for (const Eigen::Vector2d& corner : *corners) {
+        geometry_msgs::msg::Point point;
+        point.x(corner.x());
+        point.y(corner.y());
+        point.z(rig.led_plane_height_m);
+        footprint.corners().push_back(point);
+      }
+      footprints->cameras().push_back(std::move(footprint));
+    }
+    footprints_ = create_publisher<CameraFootprintArray>(kFootprints);
+    footprints_.publish(std::move(footprints));
+  }
+
   LocalizerOptions localizer_options() const {
     LocalizerOptions options;
     options.merging.merge_distance_m = param<double>("merge_distance_m");
@@ -193,6 +227,7 @@ class PixartLocalizer final : public Component {
   }
 
   RobotLocalizer localizer_;
+  Publisher<CameraFootprintArray> footprints_;  // latched: published once
   Publisher<RobotPoseArray> publisher_;
   std::vector<Eigen::Vector2d> pixels_;  // reused between samples
   std::chrono::steady_clock::time_point newest_arrived_ = std::chrono::steady_clock::now();

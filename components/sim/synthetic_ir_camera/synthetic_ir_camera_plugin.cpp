@@ -23,8 +23,10 @@
 #include <mocap/config_files.hpp>
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <sensor_msgs/msg/camera_info.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
+#include "camera_info_message.hpp"
 #include "constellation_database.hpp"
 #include "image_message.hpp"
 #include "ir_renderer.hpp"
@@ -35,6 +37,7 @@ namespace mocap::synthetic {
 namespace {
 
 constexpr const char* kImageTopic = "/camera/ir/image_raw";
+constexpr const char* kCameraInfoTopic = "/camera/ir/camera_info";
 constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
 constexpr const char* kCameraPoseTopic = "/sim/camera_pose";
 // With rate_hz 0 frames follow each other as fast as they render: the timer only has to fire
@@ -90,6 +93,9 @@ class SyntheticIrCamera final : public Component {
         "moving_camera: the camera's optical frame in the world (e.g. from mobile_base_sim)");
     spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
                                             "rendered frames, mono8");
+    spec.publishes<sensor_msgs::msg::CameraInfo>(
+        kCameraInfoTopic, Qos::sensor_data(),
+        "the camera file's lens with each frame, same header (pinhole cameras only)");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
         kTruthTopic, Qos::reliable(),
         "per frame, the true pose of every constellation in front of the camera (camera frame, "
@@ -124,6 +130,10 @@ class SyntheticIrCamera final : public Component {
       camera_from_world_ = Eigen::Isometry3d::Identity();
     }
     images_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
+    if (auto info = camera_info_message(*camera.model)) {
+      camera_info_ = std::move(*info);
+      infos_ = create_publisher<sensor_msgs::msg::CameraInfo>(kCameraInfoTopic);
+    }
     truths_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kTruthTopic);
     std::chrono::nanoseconds period = rate_hz > 0
                                           ? std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -184,9 +194,15 @@ class SyntheticIrCamera final : public Component {
     }
     images_.publish(std::move(image));
     truths_.publish(std::move(truth));
+    if (infos_) {
+      auto info = std::make_shared<sensor_msgs::msg::CameraInfo>(camera_info_);
+      info->header(header);
+      infos_.publish(std::move(info));
+    }
   }
 
   std::unique_ptr<IrRenderer> renderer_;
+  sensor_msgs::msg::CameraInfo camera_info_;  // without header
   std::string frame_id_;
   int64_t max_frames_ = 0;
   bool wait_for_subscriber_ = true;
@@ -200,6 +216,7 @@ class SyntheticIrCamera final : public Component {
   std::optional<Eigen::Isometry3d> camera_from_world_;
   Publisher<sensor_msgs::msg::Image> images_;
   Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
+  Publisher<sensor_msgs::msg::CameraInfo> infos_;  // none for a lens camera_info cannot describe
 };
 
 }  // namespace
