@@ -1,12 +1,14 @@
 // The built-in viewer in a real browser: Debian's chromium, headless, driven by playwright-core
 // (nothing downloaded). Opens http://HOST:PORT/, waits for camera frames, checks that the
-// overlay draws as many fiducial circles as the tracker found and that the pose readout
-// changes, saves a screenshot. With --outage FLAG_FILE it also checks the disconnected state:
+// overlay draws as many fiducial circles as the tracker found, each pose's axes and the
+// turret's angles, and that the pose readout changes, saves a screenshot. With --outage FLAG_FILE it also checks the disconnected state:
 // it prints "WAITING_FOR_STOP", the test stops the bridge, the page must say it is gone; it
 // prints "WAITING_FOR_START", the test starts the bridge again and creates FLAG_FILE, and the
-// page must reconnect and draw new frames. One line per check; exit 0 when all passed.
+// page must reconnect and draw new frames. With --floor (a PixArt graph, no camera) it checks
+// the floor instead: the ceiling cameras' footprints and the robots drawn. One line per check;
+// exit 0 when all passed.
 //
-//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE]
+//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor]
 import { chromium } from "playwright-core";
 import { existsSync } from "node:fs";
 
@@ -27,6 +29,18 @@ try {
   const errors = [];
   page.on("pageerror", (error) => errors.push(error.message));
   await page.goto(url);
+  if (mode === "--floor") {
+    await page.waitForFunction(() => window.viewerState?.footprintsDrawn > 0 && window.viewerState.robotsDrawn > 0,
+      null, { timeout: 30000 });
+    await page.waitForTimeout(1000);
+    const floor = await state(page);
+    check(true, `floor: ${floor.footprintsDrawn} footprints, ${floor.robotsDrawn} robots`);
+    check(/no \/camera\/ir\/image_raw/.test(await page.textContent("#camera-note")), "the page says there is no camera");
+    await page.screenshot({ path: screenshot, fullPage: true });
+    check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+    await browser.close();
+    process.exit(failed ? 1 : 0);
+  }
   await page.waitForFunction(() => window.viewerState?.images >= 5 && window.viewerState.fiducialsInFrame > 0,
     null, { timeout: 30000 });
   const first = await state(page);
@@ -40,6 +54,13 @@ try {
   check(later.circlesDrawn === later.fiducialsInFrame,
     `${later.circlesDrawn} circles for ${later.fiducialsInFrame} fiducials, ${later.images - first.images} frames later`);
   check(later.latencyMs !== null && later.latencyMs < 1000, `pose latency at the page ${later.latencyMs?.toFixed(1)} ms`);
+  await page.waitForFunction(() => window.viewerState.axesDrawn > 0, null, { timeout: 10000 })
+    .catch(() => {});
+  const axes = await state(page);
+  check(axes.axesDrawn > 0 && axes.axesDrawn === axes.posesInFrame,
+    `axes of ${axes.axesDrawn} of the ${axes.posesInFrame} pose(s) of frame ${axes.frameStamp} reprojected with camera_info`);
+  const turret = await page.textContent("#turret");
+  check(/pan -?\d+\.\d°/.test(turret), `the turret readout: ${turret}`);
   await page.screenshot({ path: screenshot, fullPage: true });
   console.log(`screenshot ${screenshot}`);
 

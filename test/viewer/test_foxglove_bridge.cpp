@@ -55,24 +55,40 @@ class FoxgloveBridgeTest : public ::testing::Test {
 
   // launch_yaml/follower_demo.yaml as shipped, its viewer on this test's port; the image rate
   // and queue made small enough to show throttling and a stalled client within seconds.
-  void start_graph() {
+  // `settings`: more --set NAME=VALUE.
+  void start_graph(const std::vector<std::string>& settings = {}) {
     graph_.reset();
     const std::string servos = (dir_ / "servos").string();
-    graph_ = std::make_unique<test::ChildProcess>(
-        std::vector<std::string>{
-            (test::bin_dir() / "mocap_launch").string(),
-            (test::source_dir() / "launch_yaml" / "follower_demo.yaml").string(), "--set",
-            "servos.device_link=" + servos, "--set", "turret.port=" + servos, "--set",
-            "viewer.address=127.0.0.1", "--set", fmt::format("viewer.port={}", port_), "--set",
-            "viewer.max_image_rate_hz=10", "--set", "viewer.send_buffer_limit_bytes=2000000"},
-        std::map<std::string, std::string>{
-            {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(61))}},
-        dir_ / fmt::format("graph{}.log", ++starts_));
+    std::vector<std::string> argv{
+        (test::bin_dir() / "mocap_launch").string(),
+        (test::source_dir() / "launch_yaml" / "follower_demo.yaml").string(),
+        "--set",
+        "servos.device_link=" + servos,
+        "--set",
+        "turret.port=" + servos,
+        "--set",
+        "viewer.address=127.0.0.1",
+        "--set",
+        fmt::format("viewer.port={}", port_),
+        "--set",
+        "viewer.max_image_rate_hz=10",
+        "--set",
+        "viewer.send_buffer_limit_bytes=2000000"};
+    for (const std::string& setting : settings) {
+      argv.push_back("--set");
+      argv.push_back(setting);
+    }
+    graph_ = std::make_unique<test::ChildProcess>(argv, domain(),
+                                                  dir_ / fmt::format("graph{}.log", ++starts_));
     ASSERT_TRUE(graph_->wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
         << graph_->output();
   }
 
   std::string url() const { return fmt::format("ws://127.0.0.1:{}", port_); }
+  static std::map<std::string, std::string> domain() {
+    return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(61))},
+            {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}};
+  }
 
   // foxglove_client.mjs's decoded messages, by topic.
   std::map<std::string, std::vector<json>> receive(int count, std::vector<std::string> topics) {
@@ -160,7 +176,7 @@ TEST_F(FoxgloveBridgeTest, ClientsThatBreakTheProtocolAreClosedWithTheReason) {
   EXPECT_NE(output.find("garbage: closed 1008 malformed JSON"), std::string::npos) << output;
   EXPECT_NE(output.find("unknown_op: closed 1008 unknown op \"explode\""), std::string::npos)
       << output;
-  EXPECT_NE(output.find("binary: closed 1008 client publishing is not offered by this server"),
+  EXPECT_NE(output.find("binary: closed 1008 client publishing is off (client_publish: false)"),
             std::string::npos)
       << output;
   EXPECT_NE(output.find("wrong_subprotocol: HTTP 400"), std::string::npos) << output;
@@ -206,6 +222,83 @@ TEST_F(FoxgloveBridgeTest, ManyClientsAndOneThatNeverReads) {
   EXPECT_EQ(receive(5, {"/mocap/poses"})["/mocap/poses"].size(), 5u);
 }
 
+// A topic that another process starts publishing on the domain is advertised to a client
+// already connected, with its schema, and delivers; when that process dies (SIGKILL: its
+// endpoints leave with the discovery lease), the topic is unadvertised.
+TEST_F(FoxgloveBridgeTest, TopicsThatComeAndGoOnTheDomainAreAdvertisedAndWithdrawn) {
+  test::ChildProcess watch(
+      {"node", (viewer_tests() / "topic_watch.mjs").string(), url(), "/test/sequence"}, {},
+      dir_ / "watch.log");
+  ASSERT_TRUE(watch.wait_for_output("CONNECTED", std::chrono::seconds(30))) << watch.output();
+  EXPECT_EQ(watch.output().find("ADVERTISED"), std::string::npos) << "not published yet";
+
+  test::write_file(dir_ / "source.yaml", R"(groups:
+  - name: source
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {count: 0, batch: 1, period_s: 0.05, subscribers: 0}
+)");
+  test::ChildProcess source(
+      {(test::bin_dir() / "mocap_launch").string(), (dir_ / "source.yaml").string()}, domain(),
+      dir_ / "source.log");
+  ASSERT_TRUE(watch.wait_for_output("MESSAGE /test/sequence", std::chrono::seconds(30)))
+      << watch.output() << "\n--- source ---\n"
+      << source.output() << "\n--- graph ---\n"
+      << graph_->output();
+  EXPECT_NE(watch.output().find("ADVERTISED /test/sequence mocap_msgs/msg/FiducialArray"),
+            std::string::npos)
+      << watch.output();
+  EXPECT_NE(watch.output().find("\"fiducials\":[{"), std::string::npos) << watch.output();
+  EXPECT_TRUE(graph_->wait_for_output("offers /test/sequence now", std::chrono::seconds(5)));
+
+  source.signal(SIGKILL);
+  source.wait(std::chrono::seconds(10));
+  ASSERT_EQ(watch.wait(std::chrono::seconds(60)), 0) << watch.output() << graph_->output();
+  EXPECT_NE(watch.output().find("UNADVERTISED /test/sequence"), std::string::npos);
+  EXPECT_TRUE(graph_->wait_for_output("1 topic(s) gone", std::chrono::seconds(5)))
+      << graph_->output();
+  // The declared topics stay.
+  EXPECT_EQ(receive(3, {"/mocap/poses"})["/mocap/poses"].size(), 3u);
+}
+
+// client_publish on, topics limited: a client publishes Twists on /cmd_vel, which an
+// independent DDS subscriber (mocap_topic echo, another process) receives with the client's
+// numbers; a topic outside `topics` is refused with a status, a message on a channel never
+// advertised closes that client.
+TEST_F(FoxgloveBridgeTest, ClientsPublishOnAllowedTopicsWhenClientPublishIsOn) {
+  start_graph({"viewer.client_publish=true", "viewer.topics=/mocap/.*|/cmd_vel"});
+  test::ChildProcess echo(
+      {(test::bin_dir() / "mocap_topic").string(), "echo", "/cmd_vel", "--count", "400"}, domain(),
+      dir_ / "echo.log");
+  test::ChildProcess client({"node", (viewer_tests() / "publish_client.mjs").string(), url(),
+                             "/cmd_vel", "0.4321", "/not_offered"},
+                            {}, dir_ / "client.log");
+  ASSERT_TRUE(client.wait_for_output("PUBLISHING", std::chrono::seconds(30)))
+      << client.output() << graph_->output();
+  EXPECT_NE(client.output().find("SERVER capabilities=clientPublish encodings=cdr"),
+            std::string::npos)
+      << client.output();
+  EXPECT_TRUE(echo.wait_for_output("x: 0.4321", std::chrono::seconds(30)))
+      << echo.output() << "\n--- client ---\n"
+      << client.output() << "\n--- graph ---\n"
+      << graph_->output();
+  EXPECT_TRUE(client.wait_for_output(
+      "STATUS 2 cannot publish: topic '/not_offered' is not offered (topics)",
+      std::chrono::seconds(10)))
+      << client.output();
+  EXPECT_TRUE(client.wait_for_output(
+      "UNADVERTISED_CHANNEL: closed 1008 message on channel 99, which this client has not "
+      "advertised",
+      std::chrono::seconds(10)))
+      << client.output();
+  EXPECT_TRUE(graph_->wait_for_output("publishes /cmd_vel (geometry_msgs/msg/Twist)",
+                                      std::chrono::seconds(5)))
+      << graph_->output();
+  client.signal(SIGTERM);
+  echo.signal(SIGTERM);
+}
+
 // The built-in viewer in Debian's chromium (headless, playwright-core): frames drawn with one
 // circle per fiducial the tracker found, a changing pose readout, a screenshot
 // (MOCAP_VIEWER_SCREENSHOT, else the test's folder: docs/viewer.png is made this way), and the
@@ -235,6 +328,61 @@ TEST_F(FoxgloveBridgeTest, TheViewerDrawsInARealBrowserAndSurvivesTheBridgeGoing
   EXPECT_NE(output.find("PASS the page says: disconnected"), std::string::npos) << output;
   EXPECT_NE(output.find("PASS reconnected"), std::string::npos) << output;
   EXPECT_GT(std::filesystem::file_size(screenshot), 10000u);
+}
+
+// launch_yaml/pixart_localization.yaml as shipped: the localizer's latched camera footprints
+// reach a client that subscribes long after they were published, with each camera's view of the
+// LED plane centred under it, and the built-in page draws them with the robots.
+TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
+  test::TempDir dir;
+  const int port = free_port();
+  const std::string adaptor = (dir / "adaptor").string();
+  test::ChildProcess graph(
+      {(test::bin_dir() / "mocap_launch").string(),
+       (test::source_dir() / "launch_yaml" / "pixart_localization.yaml").string(), "--set",
+       "box.device_link=" + adaptor, "--set", "bridge.device=" + adaptor, "--set",
+       "viewer.address=127.0.0.1", "--set", fmt::format("viewer.port={}", port)},
+      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(62))}}, dir / "graph.log");
+  ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+      << graph.output();
+  ::usleep(2'000'000);  // the footprints were published two seconds before anyone subscribed
+
+  auto [code, output] = test::run_command(
+      {"node", (viewer_tests() / "foxglove_client.mjs").string(),
+       fmt::format("ws://127.0.0.1:{}", port), "1", "/pixart/camera_footprints", "/pixart/robots"},
+      {}, std::chrono::seconds(90));
+  ASSERT_EQ(code, 0) << output << graph.output();
+  std::map<std::string, std::pair<double, double>> under = {{"camera0", {0.5, 0.5}},
+                                                            {"camera1", {-0.5, 0.5}},
+                                                            {"camera2", {-0.5, -0.5}},
+                                                            {"camera3", {0.5, -0.5}}};
+  std::istringstream lines(output);
+  int footprints = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] != '{') continue;
+    json item = json::parse(line);
+    if (item["topic"] != "/pixart/camera_footprints") continue;
+    for (const json& camera : item["message"]["cameras"]) {
+      ASSERT_EQ(camera["corners"].size(), 4u) << camera;
+      double x = 0, y = 0;
+      for (const json& corner : camera["corners"]) {
+        x += corner["x"].get<double>() / 4;
+        y += corner["y"].get<double>() / 4;
+      }
+      auto expected = under.at(camera["name"]);
+      EXPECT_NEAR(x, expected.first, 0.005) << camera;
+      EXPECT_NEAR(y, expected.second, 0.005) << camera;
+      ++footprints;
+    }
+  }
+  EXPECT_EQ(footprints, 4) << output;
+
+  auto [page_code, page] = test::run_command(
+      {"node", (viewer_tests() / "browser_check.mjs").string(),
+       fmt::format("http://127.0.0.1:{}/", port), (dir / "floor.png").string(), "--floor"},
+      {}, std::chrono::seconds(90));
+  EXPECT_EQ(page_code, 0) << page;
+  EXPECT_NE(page.find("PASS floor: 4 footprints, 2 robots"), std::string::npos) << page;
 }
 
 }  // namespace

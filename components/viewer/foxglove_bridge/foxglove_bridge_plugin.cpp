@@ -1,12 +1,15 @@
 // foxglove_bridge: the graph's topics over the Foxglove WebSocket protocol, for Foxglove,
 // Lichtblick and any client of the protocol (foxglove_protocol.hpp). Every topic the launch
-// file's components declare is advertised with encoding "cdr" and its "ros2idl" schema from
-// idl/; a client's subscription receives the CDR as it travels on DDS. A client that reads
-// slowly loses its oldest messages (client_queue.hpp) and is disconnected if it stays behind:
-// the graph never waits for a viewer.
+// file's components declare, and every topic other processes on the DDS domain publish with
+// a type this process knows, is advertised with encoding "cdr" and its "ros2idl" schema from
+// idl/; topics that come and go are advertised and unadvertised while clients are connected.
+// A client's subscription receives the CDR as it travels on DDS. A client that reads slowly
+// loses its oldest messages (client_queue.hpp) and is disconnected if it stays behind: the
+// graph never waits for a viewer. With client_publish, clients publish on allowed topics.
 #include <unistd.h>
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -29,6 +32,13 @@ namespace {
 // busy, little enough that the client queue, which drops oldest first, holds the backlog.
 constexpr size_t kInFlightBytes = 1 << 20;
 constexpr const char* kImageType = "sensor_msgs/msg/Image";
+// Best effort, never waited for; deep enough for the bursts of many-camera topics while the
+// bridge's strand is busy serializing an image.
+const Qos kForwardQos{Reliability::BestEffort, Durability::Volatile, History::KeepLast, 100};
+// How often the bridge looks for topics that appeared or disappeared on the domain.
+constexpr std::chrono::seconds kDiscoveryPeriod{1};
+// Client-published messages waiting for the bridge's next turn; beyond, the oldest go.
+constexpr size_t kInboxLimit = 1000;
 
 uint64_t nanoseconds(Clock::time_point time) {
   return static_cast<uint64_t>(
@@ -55,14 +65,17 @@ class FoxgloveBridge final : public Component {
                    "bytes a client may have queued; beyond, its oldest messages are dropped, "
                    "and after 5 s of dropping it is disconnected")
         .range(1'000'000, 1'000'000'000);
-    spec.subscribes_any("the offered topics, with their declared types");
+    spec.parameter("client_publish", false,
+                   "let clients publish (Foxglove's clientPublish) on topics that `topics` "
+                   "allows, in CDR of a type this process knows");
+    spec.subscribes_any("the offered topics, with their declared or discovered types");
+    spec.publishes_any("what clients publish, when client_publish is on");
   }
 
   explicit FoxgloveBridge(Context& context) : Component(context) {
     const std::string pattern = param<std::string>("topics");
-    std::regex allowed;
     try {
-      allowed = std::regex(pattern, std::regex::ECMAScript);
+      allowed_ = std::regex(pattern, std::regex::ECMAScript);
     } catch (const std::regex_error& e) {
       throw std::invalid_argument("topics: '" + pattern +
                                   "' is not a regular expression: " + e.what());
@@ -74,22 +87,11 @@ class FoxgloveBridge final : public Component {
     }
     queue_options_.limit_bytes = static_cast<size_t>(param<int64_t>("send_buffer_limit_bytes"));
 
+    client_publish_ = param<bool>("client_publish");
     for (const KnownTopic& topic : context.known_topics()) {
-      if (topic.type == nullptr || topic.topic.find('{') != std::string::npos) continue;
-      if (!std::regex_match(topic.topic, allowed)) continue;
-      Channel channel{static_cast<uint32_t>(channels_.size() + 1),
-                      topic.topic,
-                      "cdr",
-                      topic.type->name(),
-                      ros2idl_schema(topic.type->name(), full_definition(*topic.type)),
-                      "ros2idl"};
-      channels_.emplace(channel.id, ChannelState{channel, topic.type});
+      if (offered(topic)) declared_.insert(topic.topic);
     }
-    for (auto& [id, state] : channels_) {
-      context.subscribe_any(
-          state.channel.topic, *state.type, Qos::sensor_data(),
-          [this, id = id](const std::shared_ptr<const void>& message) { forward(id, message); });
-    }
+    update_topics(context.known_topics());
 
     WebSocketServerOptions options;
     options.address = param<std::string>("address");
@@ -98,8 +100,8 @@ class FoxgloveBridge final : public Component {
     WebSocketHandlers handlers;
     handlers.on_open = [this](ClientId client, const std::string&) { opened(client); };
     handlers.on_text = [this](ClientId client, const std::string& text) { received(client, text); };
-    handlers.on_binary = [this](ClientId client, const std::string&) {
-      refuse(client, "client publishing is not offered by this server");
+    handlers.on_binary = [this](ClientId client, const std::string& frame) {
+      received_binary(client, frame);
     };
     handlers.on_close = [this](ClientId client) { closed(client); };
     handlers.on_http = [](const std::string& resource) { return serve(resource); };
@@ -108,22 +110,47 @@ class FoxgloveBridge final : public Component {
     } catch (const std::runtime_error& e) {
       throw std::invalid_argument(std::string("address/port: ") + e.what());
     }
-    create_timer(std::chrono::milliseconds(20), [this] { pump_all(); });
+    create_timer(std::chrono::milliseconds(20), [this] {
+      pump_all();
+      publish_inbox();
+    });
+    create_timer(kDiscoveryPeriod, [this] {
+      std::vector<KnownTopic> present = this->context().discovered_topics();
+      for (const std::string& name : declared_) present.push_back({name, nullptr, {}});
+      update_topics(present);
+    });
     log().info(
-        "Foxglove WebSocket server on ws://{0}:{1} offering {2} topic(s); the viewer: "
+        "Foxglove WebSocket server on ws://{0}:{1} offering {2} topic(s){3}; the viewer: "
         "http://{0}:{1}/",
-        options.address, server_->port(), channels_.size());
+        options.address, server_->port(), channels_.size(),
+        client_publish_ ? ", clients may publish" : "");
   }
 
   ~FoxgloveBridge() override {
     server_.reset();  // joins the server's thread: no handler runs after this
-    log().info("foxglove bridge: {} client(s) served, {} message(s) sent, {} dropped",
-               clients_served_, sent_, dropped_);
+    log().info(
+        "foxglove bridge: {} client(s) served, {} message(s) sent, {} dropped; {} received "
+        "from clients, {} dropped",
+        clients_served_, sent_, dropped_, client_messages_, client_messages_dropped_);
   }
 
  private:
+  // A topic the bridge subscribes to; advertised while it has a channel.
+  struct TopicState {
+    const MessageType* type = nullptr;
+    bool latched = false;
+    uint32_t channel_id = 0;  // 0: not advertised now
+  };
   struct ChannelState {
     Channel channel;
+    const MessageType* type;
+    bool latched;
+    // A latched topic's last message as a Message Data frame, for clients subscribing later.
+    std::string last_frame;
+  };
+  // A channel a client advertised to publish on.
+  struct ClientChannelState {
+    std::string topic;
     const MessageType* type;
   };
   struct ClientState {
@@ -131,6 +158,12 @@ class FoxgloveBridge final : public Component {
     ClientQueue queue;
     std::map<uint32_t, uint32_t> subscription_of_channel;  // channel id -> subscription id
     std::map<uint32_t, Clock::time_point> last_image;      // channel id -> last image sent
+    std::map<uint32_t, ClientChannelState> published;      // client channel id -> topic
+  };
+  struct ClientMessageToPublish {
+    std::string topic;
+    const MessageType* type;
+    std::shared_ptr<void> message;
   };
 
   // The built-in viewer's files; "/" is its page.
@@ -145,14 +178,89 @@ class FoxgloveBridge final : public Component {
     return {};
   }
 
+  bool offered(const KnownTopic& topic) const {
+    return topic.type != nullptr && topic.topic.find('{') == std::string::npos &&
+           std::regex_match(topic.topic, allowed_);
+  }
+
+  // Subscribes to topics seen for the first time, advertises those present and not
+  // advertised, unadvertises those advertised and gone. `present` holds the declared topics
+  // (their type may be left out once subscribed) and the discovered ones.
+  void update_topics(const std::vector<KnownTopic>& present) {
+    std::set<std::string> names;
+    std::vector<std::pair<std::string, TopicState>> new_topics;
+    {
+      std::lock_guard lock(mutex_);
+      for (const KnownTopic& topic : present) {
+        names.insert(topic.topic);
+        if (topic.type == nullptr || !offered(topic)) continue;
+        // Latched when every publisher keeps its last sample: then so does the bridge.
+        const bool latched =
+            !topic.publishers.empty() &&
+            std::all_of(topic.publishers.begin(), topic.publishers.end(), [](const Qos& qos) {
+              return qos.durability == Durability::TransientLocal;
+            });
+        auto [known, added] = topics_.emplace(topic.topic, TopicState{topic.type, latched, 0});
+        if (added) {
+          new_topics.emplace_back(topic.topic, known->second);
+        } else if (known->second.type != topic.type && warned_types_.insert(topic.topic).second) {
+          log().warn("{} is published as {} and as {}; offered as {}", topic.topic,
+                     known->second.type->name(), topic.type->name(), known->second.type->name());
+        }
+      }
+    }
+    for (const auto& [name, topic] : new_topics) {
+      context().subscribe_any(name, *topic.type, topic.latched ? Qos::latched() : kForwardQos,
+                              [this, topic = name](const std::shared_ptr<const void>& message) {
+                                forward(topic, message);
+                              });
+    }
+    std::vector<Channel> appeared;
+    std::vector<uint32_t> gone;
+    std::lock_guard lock(mutex_);
+    for (auto& [name, topic] : topics_) {
+      const bool is_present = names.contains(name);
+      if (is_present && topic.channel_id == 0) {
+        topic.channel_id = next_channel_id_++;
+        Channel channel{topic.channel_id,
+                        name,
+                        "cdr",
+                        topic.type->name(),
+                        ros2idl_schema(topic.type->name(), full_definition(*topic.type)),
+                        "ros2idl"};
+        channels_.emplace(channel.id, ChannelState{channel, topic.type, topic.latched, {}});
+        appeared.push_back(std::move(channel));
+      } else if (!is_present && topic.channel_id != 0) {
+        gone.push_back(topic.channel_id);
+        channels_.erase(topic.channel_id);
+        for (auto& [client, state] : clients_) {
+          state.subscription_of_channel.erase(topic.channel_id);
+          state.last_image.erase(topic.channel_id);
+        }
+        topic.channel_id = 0;
+      }
+    }
+    if (appeared.empty() && gone.empty()) return;
+    if (server_) {
+      for (const Channel& channel : appeared) log().info("offers {} now", channel.topic);
+      if (!gone.empty()) log().info("{} topic(s) gone", gone.size());
+    }
+    for (const auto& [client, state] : clients_) {
+      if (!gone.empty()) server_->send_text(client, unadvertise(gone));
+      if (!appeared.empty()) server_->send_text(client, advertise(appeared));
+    }
+  }
+
   void opened(ClientId client) {
     std::string session = std::to_string(getpid());
-    server_->send_text(client,
-                       server_info("mocap-graph", {}, {}, {{"graph", context().name()}}, session));
+    std::vector<std::string> capabilities;
+    if (client_publish_) capabilities.push_back("clientPublish");
+    std::lock_guard lock(mutex_);
+    server_->send_text(client, server_info("mocap-graph", capabilities, {"cdr"},
+                                           {{"graph", context().name()}}, session));
     std::vector<Channel> list;
     for (const auto& [id, state] : channels_) list.push_back(state.channel);
     server_->send_text(client, advertise(list));
-    std::lock_guard lock(mutex_);
     clients_.emplace(client, ClientState(queue_options_));
     ++clients_served_;
   }
@@ -190,7 +298,10 @@ class FoxgloveBridge final : public Component {
           continue;
         }
         state->second.subscription_of_channel[s.channel_id] = s.id;
+        const std::string& latched = channels_.at(s.channel_id).last_frame;
+        if (!latched.empty()) queue_frame(state->second, latched, s.id);
       }
+      pump(client, state->second);
     } else if (auto* unsubscribe = std::get_if<Unsubscribe>(&*request)) {
       std::lock_guard lock(mutex_);
       auto state = clients_.find(client);
@@ -199,18 +310,130 @@ class FoxgloveBridge final : public Component {
                              unsubscribe->subscription_ids.end());
       std::erase_if(state->second.subscription_of_channel,
                     [&](const auto& entry) { return ids.contains(entry.second); });
-    } else {
-      refuse(client, "client publishing is not offered by this server");
+    } else if (!client_publish_) {
+      refuse(client, "client publishing is off (client_publish: false)");
+    } else if (auto* advertised = std::get_if<ClientAdvertise>(&*request)) {
+      client_advertised(client, *advertised);
+    } else if (auto* unadvertised = std::get_if<ClientUnadvertise>(&*request)) {
+      std::lock_guard lock(mutex_);
+      auto state = clients_.find(client);
+      if (state == clients_.end()) return;
+      for (uint32_t id : unadvertised->channel_ids) state->second.published.erase(id);
     }
   }
 
-  // A message of channel `id`: serialized once if any client wants it, then queued for each.
-  void forward(uint32_t id, const std::shared_ptr<const void>& message) {
+  // A client's channels to publish on: accepted when the topic is offered (`topics`), the
+  // encoding is CDR and the type is one this process knows; each refused one gets a status.
+  void client_advertised(ClientId client, const ClientAdvertise& advertised) {
+    std::lock_guard lock(mutex_);
+    auto state = clients_.find(client);
+    if (state == clients_.end()) return;
+    for (const ClientChannel& channel : advertised.channels) {
+      const MessageType* type = find_message_type(channel.schema_name);
+      std::string refusal;
+      if (!valid_topic(channel.topic) || !std::regex_match(channel.topic, allowed_)) {
+        refusal = "topic '" + channel.topic + "' is not offered (topics)";
+      } else if (channel.encoding != "cdr") {
+        refusal = "encoding '" + channel.encoding + "' of " + channel.topic + ": only cdr";
+      } else if (type == nullptr) {
+        refusal = "type '" + channel.schema_name + "' of " + channel.topic + " is unknown here";
+      } else if (auto topic = topics_.find(channel.topic);
+                 topic != topics_.end() && topic->second.type != type) {
+        refusal = channel.topic + " has type " + topic->second.type->name() + ", not " +
+                  channel.schema_name;
+      }
+      if (!refusal.empty()) {
+        log().warn("foxglove client {}: cannot publish: {}", client, refusal);
+        server_->send_text(client, status(StatusLevel::Error, "cannot publish: " + refusal));
+        continue;
+      }
+      state->second.published[channel.id] = {channel.topic, type};
+      log().info("foxglove client {} publishes {} ({})", client, channel.topic, type->name());
+    }
+  }
+
+  static bool valid_topic(const std::string& topic) {
+    static const std::regex name("(/[A-Za-z_][A-Za-z0-9_]*)+");
+    return std::regex_match(topic, name);
+  }
+
+  // A client's Message Data: decoded here, so that a malformed payload closes that client,
+  // and published on the bridge's next turn.
+  void received_binary(ClientId client, const std::string& frame) {
+    if (!client_publish_) {
+      refuse(client, "client publishing is off (client_publish: false)");
+      return;
+    }
+    ClientMessage message;
+    try {
+      message = parse_client_binary(
+          std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(frame.data()), frame.size()));
+    } catch (const ProtocolError& e) {
+      refuse(client, e.what());
+      return;
+    }
+    std::string refusal;
+    {
+      std::lock_guard lock(mutex_);
+      auto state = clients_.find(client);
+      if (state == clients_.end()) return;
+      auto channel = state->second.published.find(message.channel_id);
+      if (channel == state->second.published.end()) {
+        refusal = fmt::format("message on channel {}, which this client has not advertised",
+                              message.channel_id);
+      } else {
+        const MessageType& type = *channel->second.type;
+        std::shared_ptr<void> decoded = type.create();
+        try {
+          type.deserialize(message.payload, decoded.get());
+          inbox_.push_back({channel->second.topic, &type, std::move(decoded)});
+          ++client_messages_;
+          if (inbox_.size() > kInboxLimit) {
+            inbox_.pop_front();
+            ++client_messages_dropped_;
+          }
+        } catch (const SerializationError& e) {
+          refusal = fmt::format("message on {} is not CDR of {}: {}", channel->second.topic,
+                                type.name(), e.what());
+        }
+      }
+    }
+    if (!refusal.empty()) refuse(client, refusal);
+  }
+
+  // Publishes what clients sent, on this component's strand like every other publication.
+  void publish_inbox() {
+    std::deque<ClientMessageToPublish> inbox;
+    {
+      std::lock_guard lock(mutex_);
+      inbox.swap(inbox_);
+    }
+    for (ClientMessageToPublish& message : inbox) {
+      auto publisher = publishers_.find(message.topic);
+      if (publisher == publishers_.end()) {
+        // Reliable, volatile, keep last: matches every subscriber and never waits.
+        Qos qos = Qos::sensor_data();
+        qos.reliability = Reliability::Reliable;
+        publisher =
+            publishers_
+                .emplace(message.topic, context().advertise_any(message.topic, *message.type, qos))
+                .first;
+      }
+      publisher->second->publish(std::move(message.message));
+    }
+  }
+
+  // A message of `topic`: serialized once if any client wants it, then queued for each.
+  void forward(const std::string& topic, const std::shared_ptr<const void>& message) {
     const Clock::time_point received = now();
     std::lock_guard lock(mutex_);
-    const ChannelState& channel = channels_.at(id);
+    const uint32_t id = topics_.at(topic).channel_id;
+    if (id == 0) return;  // unadvertised
+    ChannelState& channel = channels_.at(id);
     const bool image = channel.channel.schema_name == kImageType;
     std::string frame;
+    if (channel.latched)
+      channel.last_frame = frame = message_data(channel, message.get(), received);
     for (auto& [client, state] : clients_) {
       auto subscription = state.subscription_of_channel.find(id);
       if (subscription == state.subscription_of_channel.end()) continue;
@@ -224,22 +447,34 @@ class FoxgloveBridge final : public Component {
         }
         state.last_image[id] = received;
       }
-      if (frame.empty()) {
-        const size_t size = channel.type->serialized_size(message.get());
-        frame.resize(kMessageDataHeaderSize + size);
-        channel.type->serialize(
-            message.get(),
-            std::span<uint8_t>(reinterpret_cast<uint8_t*>(frame.data()) + kMessageDataHeaderSize,
-                               size));
-      }
-      std::string copy = frame;
-      write_message_data_header(
-          subscription->second, nanoseconds(received),
-          std::span<uint8_t, kMessageDataHeaderSize>(reinterpret_cast<uint8_t*>(copy.data()),
-                                                     kMessageDataHeaderSize));
-      state.queue.push(std::move(copy), std::chrono::steady_clock::now());
+      if (frame.empty()) frame = message_data(channel, message.get(), received);
+      queue_frame(state, frame, subscription->second);
       pump(client, state);
     }
+  }
+
+  // A Message Data frame of `message`, its subscription id left for queue_frame to write.
+  static std::string message_data(const ChannelState& channel, const void* message,
+                                  Clock::time_point received) {
+    const size_t size = channel.type->serialized_size(message);
+    std::string frame(kMessageDataHeaderSize + size, '\0');
+    channel.type->serialize(
+        message, std::span<uint8_t>(
+                     reinterpret_cast<uint8_t*>(frame.data()) + kMessageDataHeaderSize, size));
+    write_message_data_header(
+        0, nanoseconds(received),
+        std::span<uint8_t, kMessageDataHeaderSize>(reinterpret_cast<uint8_t*>(frame.data()),
+                                                   kMessageDataHeaderSize));
+    return frame;
+  }
+
+  // A copy of `frame` for one client's subscription. Requires mutex_.
+  static void queue_frame(ClientState& state, const std::string& frame, uint32_t subscription) {
+    std::string copy = frame;
+    // The subscription id: bytes 1 to 4, little-endian.
+    for (size_t i = 0; i < 4; ++i)
+      copy[1 + i] = static_cast<char>((subscription >> (8 * i)) & 0xff);
+    state.queue.push(std::move(copy), std::chrono::steady_clock::now());
   }
 
   // Hands queued frames to the socket while little is in flight. Requires mutex_.
@@ -273,14 +508,24 @@ class FoxgloveBridge final : public Component {
     }
   }
 
-  std::map<uint32_t, ChannelState> channels_;  // fixed after construction
+  std::regex allowed_;
+  bool client_publish_ = false;
+  std::set<std::string> declared_;      // offered topics of the launch file: always present
+  std::set<std::string> warned_types_;  // topics published with two types, warned about once
   Clock::duration image_period_{};
   ClientQueueOptions queue_options_;
-  std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<PublisherPort>> publishers_;  // for clients, by topic
+  std::mutex mutex_;                                                  // guards what follows
+  std::map<std::string, TopicState> topics_;
+  std::map<uint32_t, ChannelState> channels_;
+  uint32_t next_channel_id_ = 1;
   std::map<ClientId, ClientState> clients_;
+  std::deque<ClientMessageToPublish> inbox_;
   uint64_t clients_served_ = 0;
   uint64_t sent_ = 0;
   uint64_t dropped_ = 0;
+  uint64_t client_messages_ = 0;
+  uint64_t client_messages_dropped_ = 0;
   std::unique_ptr<WebSocketServer> server_;  // last: stopped first
 };
 

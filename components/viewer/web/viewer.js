@@ -5,12 +5,15 @@ import { decode, parseSchema } from "./cdr.js";
 
 const SUBPROTOCOL = "foxglove.websocket.v1";
 const IMAGE = "/camera/ir/image_raw";
+const CAMERA_INFO = "/camera/ir/camera_info";
 const FIDUCIALS = "/mocap/fiducials";
 const CONSTELLATIONS = "/mocap/constellations";
 const POSES = "/mocap/poses";
 const ALERTS = "/alerts";
 const BASE = "/base/pose";
 const ROBOTS = "/pixart/robots";
+const TURRET = "/turret/joint_states";
+const FOOTPRINTS = "/pixart/camera_footprints";
 // Large and drawn by the overlay component already: not subscribed.
 const SKIPPED = new Set(["/mocap/overlay"]);
 
@@ -21,8 +24,14 @@ const state = (window.viewerState = {
   frameStamp: null,  // stamp of the image on screen
   fiducialsInFrame: 0,  // the tracker's fiducials for that image
   circlesDrawn: 0,  // circles drawn on it
+  axesDrawn: 0,  // poses whose axes were drawn on it (needs camera_info)
+  posesInFrame: 0,  // the poses estimated from it
+  footprintsDrawn: 0,  // on the floor
+  robotsDrawn: 0,
   poseReadout: "",
   latencyMs: null,
+  // Each drawn image's age when drawn (ms, page clock minus capture stamp): the last 1000.
+  drawLatenciesMs: [],
 });
 
 const $ = (id) => document.getElementById(id);
@@ -89,6 +98,7 @@ function control(message) {
       subscriptions.push({ id, channelId: channel.id });
     }
     if (subscriptions.length) socket.send(JSON.stringify({ op: "subscribe", subscriptions }));
+    $("camera-note").textContent = topics.has(IMAGE) ? "" : `no ${IMAGE} in this graph`;
     renderTopics();
   } else if (message.op === "unadvertise") {
     for (const id of message.channelIds) {
@@ -128,7 +138,11 @@ function data(bytes) {
 
 const recentFiducials = new Map();  // stamp -> fiducials, the last few frames
 const recentConstellations = new Map();
+const recentPoses = new Map();
+let cameraInfo = null;
 let latestPoses = null;
+let turret = null;  // {pan, tilt} in radians
+let footprints = [];
 const trails = new Map();  // pose name -> [{x, z}]
 let base = null;
 let robots = [];
@@ -155,8 +169,13 @@ const handlers = {
     remember(recentConstellations, stampKey(message.header), message.constellations);
     dirty.camera = true;
   },
+  [CAMERA_INFO](info) {
+    cameraInfo = info;
+  },
   [POSES](message) {
     latestPoses = message;
+    remember(recentPoses, stampKey(message.header), message.poses);
+    dirty.camera = true;
     state.latencyMs = Date.now() - stampSeconds(message.header) * 1000;
     for (const pose of message.poses) {
       const p = pose.pose.pose.position;
@@ -174,6 +193,20 @@ const handlers = {
   },
   [ROBOTS](message) {
     robots = message.robots;
+    dirty.side = true;
+  },
+  [TURRET](message) {
+    const joint = (name, index) => {
+      const i = message.name.indexOf(name);
+      return message.position[i >= 0 ? i : index];
+    };
+    turret = { pan: joint("pan", 0), tilt: joint("tilt", 1) };
+    const deg = (a) => ((a * 180) / Math.PI).toFixed(1);
+    $("turret").textContent = `turret: pan ${deg(turret.pan)}°, tilt ${deg(turret.tilt)}°`;
+    dirty.side = true;
+  },
+  [FOOTPRINTS](message) {
+    footprints = message.cameras;
     dirty.side = true;
   },
   [ALERTS](alert) {
@@ -219,8 +252,14 @@ function toPixels(image) {
 
 // --- drawing ------------------------------------------------------------------------------
 
+let drawnStamp = null;
 function drawCamera() {
   cameraContext.drawImage(offscreen, 0, 0);
+  if (state.frameStamp !== drawnStamp) {
+    drawnStamp = state.frameStamp;
+    state.drawLatenciesMs.push(Date.now() - Number(drawnStamp) * 1000);
+    if (state.drawLatenciesMs.length > 1000) state.drawLatenciesMs.shift();
+  }
   const fiducials = recentFiducials.get(state.frameStamp) ?? [];
   const constellations = recentConstellations.get(state.frameStamp) ?? [];
   const scale = camera.width / 1280;
@@ -257,6 +296,70 @@ function drawCamera() {
   }
   state.fiducialsInFrame = fiducials.length;
   state.circlesDrawn = circles;
+  const poses = recentPoses.get(state.frameStamp) ?? [];
+  state.posesInFrame = poses.length;
+  state.axesDrawn = drawAxes(poses, scale);
+}
+
+// A camera-frame point into the image with camera_info's pinhole and plumb_bob distortion;
+// null behind the camera.
+function project(info, p) {
+  if (p.z <= 1e-6) return null;
+  const x = p.x / p.z;
+  const y = p.y / p.z;
+  const [k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0] = info.distortion_model === "plumb_bob" ? info.d : [];
+  const r2 = x * x + y * y;
+  const radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+  const yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+  const k = info.k;
+  return { u: k[0] * xd + k[1] * yd + k[2], v: k[4] * yd + k[5] };
+}
+
+function rotate(q, v) {
+  // v + 2 w (u x v) + 2 u x (u x v), u = (q.x, q.y, q.z)
+  const tx = 2 * (q.y * v.z - q.z * v.y);
+  const ty = 2 * (q.z * v.x - q.x * v.z);
+  const tz = 2 * (q.x * v.y - q.y * v.x);
+  return {
+    x: v.x + q.w * tx + (q.y * tz - q.z * ty),
+    y: v.y + q.w * ty + (q.z * tx - q.x * tz),
+    z: v.z + q.w * tz + (q.x * ty - q.y * tx),
+  };
+}
+
+const AXIS_LENGTH_M = 0.1;
+const AXIS_COLOURS = ["#ff5252", "#5fd38d", "#6cb6ff"];  // x, y, z
+
+// Each pose's axes, 10 cm long, reprojected into the image; returns how many poses were drawn.
+function drawAxes(poses, scale) {
+  if (!cameraInfo) return 0;
+  let drawn = 0;
+  cameraContext.lineWidth = 3 * scale;
+  for (const pose of poses) {
+    const { position: t, orientation: q } = pose.pose.pose;
+    const at = (v) => {
+      const r = rotate(q, v);
+      return project(cameraInfo, { x: t.x + r.x, y: t.y + r.y, z: t.z + r.z });
+    };
+    const origin = at({ x: 0, y: 0, z: 0 });
+    if (!origin) continue;
+    const ends = [
+      at({ x: AXIS_LENGTH_M, y: 0, z: 0 }),
+      at({ x: 0, y: AXIS_LENGTH_M, z: 0 }),
+      at({ x: 0, y: 0, z: AXIS_LENGTH_M }),
+    ];
+    ends.forEach((end, i) => {
+      if (!end) return;
+      cameraContext.strokeStyle = AXIS_COLOURS[i];
+      cameraContext.beginPath();
+      cameraContext.moveTo(origin.u, origin.v);
+      cameraContext.lineTo(end.u, end.v);
+      cameraContext.stroke();
+    });
+    drawn++;
+  }
+  return drawn;
 }
 
 function grid(context, width, height, pixelsPerMetre, originX, originY) {
@@ -336,12 +439,38 @@ function drawFloor() {
     context.stroke();
     context.fillText(label, px + 10, py - 10);
   };
+  // Each ceiling camera's view of the robots' plane.
+  context.strokeStyle = "#7d8794";
+  context.fillStyle = "#7d8794";
+  for (const f of footprints) {
+    context.beginPath();
+    f.corners.forEach((c, i) => (i ? context.lineTo : context.moveTo).call(context, ox + c.x * ppm, oy - c.y * ppm));
+    context.closePath();
+    context.stroke();
+    context.fillText(f.name, ox + f.corners[0].x * ppm + 4, oy - f.corners[0].y * ppm + 12);
+  }
   if (base) {
     const q = base.orientation;
     const yaw = Math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
     marker(base.position.x, base.position.y, yaw, "#6cb6ff", "base");
+    if (turret) {
+      // Where the turret's camera looks: the base's heading turned by the pan joint.
+      const heading = yaw + turret.pan;
+      const half = cameraInfo ? Math.atan(cameraInfo.width / 2 / cameraInfo.k[0]) : 0.6;
+      const px = ox + base.position.x * ppm;
+      const py = oy - base.position.y * ppm;
+      context.strokeStyle = "#ffd54a";
+      context.beginPath();
+      context.moveTo(px, py);
+      context.lineTo(px + 40 * Math.cos(heading - half), py - 40 * Math.sin(heading - half));
+      context.moveTo(px, py);
+      context.lineTo(px + 40 * Math.cos(heading + half), py - 40 * Math.sin(heading + half));
+      context.stroke();
+    }
   }
   for (const r of robots) marker(r.x, r.y, r.theta, "#ff8f6b", r.name);
+  state.footprintsDrawn = footprints.length;
+  state.robotsDrawn = robots.length;
   if (!base && robots.length === 0) {
     context.fillStyle = "#7d8794";
     context.fillText(`no ${BASE} or ${ROBOTS} in this graph`, 12, 20);
