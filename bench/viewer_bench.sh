@@ -9,8 +9,8 @@
 #   viewer in chromium    the built-in page in headless chromium (also: each image's age when
 #                         the page drew it, capture stamp to draw, one clock)
 # Per run: poses/s (evaluator frames over the run), latency median/p99 (image stamp -> the
-# evaluator), frames lost, and the demo process's CPU (user + system over the run's steady
-# part; 100 % = one core). Prints a markdown table. Needs test/viewer/node_modules (npm ci).
+# evaluator), frames lost, the demo process's CPU (user + system over the run's steady
+# part; 100 % = one core) and its peak resident memory. Prints a markdown table. Needs test/viewer/node_modules (npm ci).
 #
 #   bench/viewer_bench.sh [--duration S]   (default 20 s a run: about 2.5 min)
 set -uo pipefail
@@ -59,6 +59,8 @@ run() {  # NAME FILE CLIENT_COMMAND...
   sleep $((duration - 5))
   t1=$(date +%s.%N)
   c1=$(cpu_ticks $pid)
+  local peak
+  peak=$(awk '/^VmHWM/ { printf "%.0f", $2 / 1024 }' "/proc/$pid/status" 2>/dev/null)
   wait $pid
   [ -n "$client" ] && { kill $client 2>/dev/null; wait $client 2>/dev/null; }
   grep -q "^frames" "$work/client.log" 2>/dev/null && note="drawn: $(cat "$work/client.log")"
@@ -71,7 +73,7 @@ run() {  # NAME FILE CLIENT_COMMAND...
   cpu=$(awk -v c="$((c1 - c0))" -v t0="$t0" -v t1="$t1" -v hz="$(getconf CLK_TCK)" \
     'BEGIN { printf "%.0f", 100 * c / hz / (t1 - t0) }')
   rate=$(awk -v f="${frames:-0}" -v d="$duration" 'BEGIN { printf "%.1f", f / d }')
-  rows+=("| $name | $rate | ${latency:--} | ${lost:--} | $cpu % | $note |")
+  rows+=("| $name | $rate | ${latency:--} | ${lost:--} | $cpu % | ${peak:--} MB | $note |")
   echo "$name: done" >&2
 }
 
@@ -83,6 +85,6 @@ run "1 stalled client" "$work/with_bridge.yaml" node "$viewer/load_clients.mjs" 
 run "viewer in chromium" "$work/with_bridge.yaml" node "$viewer/browser_latency.mjs" "http://127.0.0.1:$port/" "$((duration - 6))"
 
 echo
-echo "| run ($duration s, camera 30 Hz) | poses/s | latency ms (median, p99) | frames lost | demo process CPU | image to page (ms) |"
-echo "|---|---|---|---|---|---|"
+echo "| run ($duration s, camera 30 Hz) | poses/s | latency ms (median, p99) | frames lost | demo process CPU | peak RSS | image to page (ms) |"
+echo "|---|---|---|---|---|---|---|"
 printf '%s\n' "${rows[@]}"

@@ -33,6 +33,8 @@ const results = await Promise.all([
   attempt("unknown_op", [subprotocol], (ws) => ws.send(JSON.stringify({ op: "explode" }))),
   attempt("binary", [subprotocol], (ws) => ws.send(Buffer.from([1, 0, 0, 0, 0, 42]))),
   attempt("wrong_subprotocol", ["chat"], () => {}),
+  // Larger than the bridge takes from a client (1 MiB).
+  attempt("oversize", [subprotocol], (ws) => ws.send("x".repeat((1 << 20) + 1024))),
   // Half a frame, then the connection is gone.
   attempt("half_message", [subprotocol], (ws) => {
     ws._socket.write(Buffer.from([0x81, 0x7e, 0x01]));  // a text frame header, cut short

@@ -103,7 +103,12 @@ class FoxgloveBridge final : public Component {
     handlers.on_binary = [this](ClientId client, const std::string& frame) {
       received_binary(client, frame);
     };
-    handlers.on_close = [this](ClientId client) { closed(client); };
+    handlers.on_close = [this](ClientId client, const std::string& protocol_error) {
+      if (!protocol_error.empty()) {
+        log().warn("foxglove client {}: closed for a broken frame: {}", client, protocol_error);
+      }
+      closed(client);
+    };
     handlers.on_http = [](const std::string& resource) { return serve(resource); };
     try {
       server_ = std::make_unique<WebSocketServer>(options, handlers);

@@ -118,7 +118,19 @@ WebSocketServer::WebSocketServer(WebSocketServerOptions options, WebSocketHandle
       s.ids.erase(found);
       s.clients.erase(id);
     }
-    if (s.handlers.on_close) s.handlers.on_close(id);
+    // Closes websocketpp made for a broken frame (too large, not UTF-8, bad framing): the
+    // client may never see the reason, its connection being cut while it still sends.
+    std::string protocol_error;
+    websocketpp::lib::error_code error;
+    if (auto con = s.endpoint.get_con_from_hdl(handle, error); !error) {
+      const auto code = con->get_local_close_code();
+      if (code == websocketpp::close::status::protocol_error ||
+          code == websocketpp::close::status::invalid_payload ||
+          code == websocketpp::close::status::message_too_big) {
+        protocol_error = std::to_string(code) + " " + con->get_local_close_reason();
+      }
+    }
+    if (s.handlers.on_close) s.handlers.on_close(id, protocol_error);
   };
   s.endpoint.set_close_handler(closed);
   s.endpoint.set_fail_handler(closed);

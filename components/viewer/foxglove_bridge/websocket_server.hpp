@@ -32,7 +32,9 @@ struct WebSocketHandlers {
   std::function<void(ClientId, const std::string& subprotocol)> on_open;
   std::function<void(ClientId, const std::string& text)> on_text;
   std::function<void(ClientId, const std::string& bytes)> on_binary;
-  std::function<void(ClientId)> on_close;
+  // `protocol_error`: the close code and reason when the server closed the connection for a
+  // frame the WebSocket protocol forbids (e.g. "1009 A message was too large"), else empty.
+  std::function<void(ClientId, const std::string& protocol_error)> on_close;
   // GET requests that are not WebSocket upgrades: the resource ("/index.html?x") -> response.
   std::function<HttpResponse(const std::string& resource)> on_http;
 };
