@@ -89,5 +89,34 @@ TEST(Graph, TwoHostsOverANetwork) {
   EXPECT_GT(hosts.bytes_received_by_a() - received_before, kCount * 40);
 }
 
+// `timeout` stops a graph as many supervisors do (docker stop, process-group kills): SIGTERM to
+// mocap_launch and, in the same instant, to its whole process group, the groups' processes
+// included. That is one stop request: every group stops gracefully, the sink (in its own
+// process) writes its summary, and the exit status is 0, not the forced exit's 130.
+TEST(Graph, ASignalToTheWholeProcessGroupIsOneStopRequest) {
+  test::TempDir dir;
+  test::write_file(dir / "graph.yaml", fmt::format(R"(groups:
+  - name: source
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {{count: 0, batch: 10, period_s: 0.01}}
+  - name: sink
+    components:
+      - plugin: sequence_sink
+        name: sink
+        parameters: {{expect: 1000000000, summary_file: "{}", timeout_s: 300}}
+)",
+                                                   (dir / "summary.yaml").string()));
+  auto [code, output] = test::run_command({"timeout", "--preserve-status", "-s", "TERM", "6",
+                                           launcher(), (dir / "graph.yaml").string()},
+                                          environment(4), std::chrono::seconds(60));
+  EXPECT_EQ(code, 0) << output;
+  EXPECT_EQ(output.find("forcing the exit"), std::string::npos) << output;
+  auto summary = test::read_summary(dir / "summary.yaml");
+  EXPECT_GT(summary.at("received"), 0) << output;
+  EXPECT_EQ(summary.at("missing"), 0);
+}
+
 }  // namespace
 }  // namespace mocap

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <optional>
 
 #include <fmt/format.h>
@@ -101,8 +102,11 @@ struct BagWriter::State {
   sqlite::Statement insert;
 
   // Everything write() accepted, and the part of it that is committed: a failed transaction
-  // takes the counts back to `committed`.
+  // takes the counts back to `committed` (changed under committed_mutex, which
+  // write_committed_metadata() takes from other threads).
   BagMetadata metadata, committed;
+  mutable std::mutex committed_mutex;
+  mutable std::mutex yaml_mutex;  // one metadata.yaml writer at a time
   uint64_t bytes = 0, committed_bytes = 0;
 
   size_t transaction_messages = 0;
@@ -179,7 +183,16 @@ struct BagWriter::State {
     }
   }
 
-  void write_yaml(const std::string& text) { write_file_atomically(yaml_path, text); }
+  void write_yaml(const std::string& text) const {
+    std::lock_guard lock(yaml_mutex);
+    write_file_atomically(yaml_path, text);
+  }
+
+  void set_committed() {
+    std::lock_guard lock(committed_mutex);
+    committed = metadata;
+    committed_bytes = bytes;
+  }
 
   void begin() {
     db.exec("BEGIN", "begin");
@@ -196,8 +209,7 @@ struct BagWriter::State {
     } catch (const sqlite::SqliteError& e) {
       fail(e, accepted);
     }
-    committed = metadata;
-    committed_bytes = bytes;
+    set_committed();
     transaction_messages = 0;
     measure_room();
   }
@@ -214,8 +226,7 @@ struct BagWriter::State {
       // holds is worth a commit. If that fails too, it is rolled back.
       try {
         db.exec("COMMIT", "commit");
-        committed = metadata;
-        committed_bytes = bytes;
+        set_committed();
       } catch (const sqlite::SqliteError&) {
         try {
           db.exec("ROLLBACK", "rollback");
@@ -413,6 +424,16 @@ void BagWriter::commit() {
   State& s = *state_;
   if (s.closed || s.failed) return;
   s.commit_now();
+}
+
+void BagWriter::write_committed_metadata() const {
+  const State& s = *state_;
+  BagMetadata committed;
+  {
+    std::lock_guard lock(s.committed_mutex);
+    committed = s.committed;
+  }
+  s.write_yaml(format_metadata_yaml(committed));
 }
 
 void BagWriter::close() {

@@ -192,6 +192,8 @@ std::optional<std::string> Recorder::close() {
   return state_->first_error;
 }
 
+void Recorder::write_committed_metadata() const { state_->writer.write_committed_metadata(); }
+
 std::optional<std::string> Recorder::error() const {
   std::lock_guard guard(state_->mutex);
   return state_->first_error;

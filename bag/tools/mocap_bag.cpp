@@ -85,6 +85,15 @@ int record(const std::string& directory, const std::set<std::string>& wanted, bo
   auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_bag");
   mocap::DdsTransport& transport = *dds;
   mocap::bag::Recorder recorder(directory);
+  // A second stop request well after the first (the graceful stop hangs) still leaves
+  // metadata.yaml agreeing with what the database holds.
+  mocap::ShutdownSignal::ForcedExitHook metadata_first([&recorder] {
+    try {
+      recorder.write_committed_metadata();
+    } catch (const mocap::bag::BagError& e) {
+      fmt::print(stderr, "mocap_bag: {}\n", e.what());
+    }
+  });
   fmt::print("recording to {}\n", recorder.directory());
   std::fflush(stdout);
 

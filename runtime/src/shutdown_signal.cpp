@@ -3,40 +3,88 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdint>
+#include <map>
 #include <mutex>
+#include <thread>
 
 namespace mocap {
 namespace {
 
-// A self-pipe: the handler may only call async-signal-safe functions, and write() is one.
-int pipe_fds[2] = {-1, -1};
-std::atomic<int> signals_received{0};
+// Self-pipes: the handler may only call async-signal-safe functions, and write() is one.
+int pipe_fds[2] = {-1, -1};    // a stop request (or a wake-up) for wait()
+int forced_fds[2] = {-1, -1};  // the forced exit, for its thread
+// CLOCK_MONOTONIC nanoseconds of the first signal; 0 before it.
+std::atomic<int64_t> first_signal_ns{0};
+std::atomic<bool> forcing{false};
+static_assert(std::atomic<int64_t>::is_always_lock_free, "read in a signal handler");
+
+std::mutex hooks_mutex;
+std::map<uint64_t, std::function<void()>> hooks;
+uint64_t next_hook_id = 1;
+
+int64_t monotonic_ns() {
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe
+  return static_cast<int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
 
 void handle(int) {
-  if (signals_received.fetch_add(1) >= 1) _exit(130);
   int saved_errno = errno;  // the interrupted code may be about to read it
-  char byte = 's';
-  [[maybe_unused]] ssize_t ignored = write(pipe_fds[1], &byte, 1);
+  const int64_t now = std::max<int64_t>(monotonic_ns(), 1);
+  int64_t first = 0;
+  if (first_signal_ns.compare_exchange_strong(first, now)) {
+    char byte = 's';
+    [[maybe_unused]] ssize_t ignored = write(pipe_fds[1], &byte, 1);
+  } else if (now - first >= std::chrono::nanoseconds(ShutdownSignal::kEscalationDelay).count() &&
+             !forcing.exchange(true)) {
+    alarm(ShutdownSignal::kForcedExitSeconds);  // should a hook hang
+    char byte = 'f';
+    [[maybe_unused]] ssize_t ignored = write(forced_fds[1], &byte, 1);
+  }
   errno = saved_errno;
 }
 
-void open_pipe() {
+void open_pipes() {
   static std::once_flag once;
   std::call_once(once, [] {
     if (pipe2(pipe_fds, O_CLOEXEC | O_NONBLOCK) != 0) pipe_fds[0] = pipe_fds[1] = -1;
+    if (pipe2(forced_fds, O_CLOEXEC) != 0) forced_fds[0] = forced_fds[1] = -1;
   });
+}
+
+// Waits for the forced exit, runs the hooks and ends the process.
+void forced_exit_thread() {
+  char byte = 0;
+  while (read(forced_fds[0], &byte, 1) < 0 && errno == EINTR) {
+  }
+  constexpr char kMessage[] = "second stop request: forcing the exit\n";
+  [[maybe_unused]] ssize_t ignored = write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  {
+    std::lock_guard lock(hooks_mutex);
+    for (auto& [id, hook] : hooks) {
+      try {
+        hook();
+      } catch (...) {
+      }
+    }
+  }
+  _exit(130);
 }
 
 }  // namespace
 
 void ShutdownSignal::install() {
-  open_pipe();
+  open_pipes();
   static std::once_flag once;
   std::call_once(once, [] {
+    // Started before the handlers: a signal's forced exit always has its thread.
+    std::thread(forced_exit_thread).detach();
     struct sigaction action = {};
     action.sa_handler = handle;
     sigemptyset(&action.sa_mask);
@@ -46,10 +94,10 @@ void ShutdownSignal::install() {
   });
 }
 
-bool ShutdownSignal::received() { return signals_received.load() > 0; }
+bool ShutdownSignal::received() { return first_signal_ns.load() != 0; }
 
 bool ShutdownSignal::wait(std::optional<std::chrono::steady_clock::duration> timeout) {
-  open_pipe();
+  open_pipes();
   auto deadline = timeout ? std::chrono::steady_clock::now() + *timeout
                           : std::chrono::steady_clock::time_point::max();
   for (;;) {
@@ -78,9 +126,20 @@ bool ShutdownSignal::wait(std::optional<std::chrono::steady_clock::duration> tim
 }
 
 void ShutdownSignal::wake() {
-  open_pipe();
+  open_pipes();
   char byte = 'w';
   [[maybe_unused]] ssize_t ignored = write(pipe_fds[1], &byte, 1);
+}
+
+ShutdownSignal::ForcedExitHook::ForcedExitHook(std::function<void()> hook) {
+  std::lock_guard lock(hooks_mutex);
+  id_ = next_hook_id++;
+  hooks.emplace(id_, std::move(hook));
+}
+
+ShutdownSignal::ForcedExitHook::~ForcedExitHook() {
+  std::lock_guard lock(hooks_mutex);
+  hooks.erase(id_);
 }
 
 }  // namespace mocap

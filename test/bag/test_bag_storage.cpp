@@ -847,6 +847,36 @@ TEST(BagCrash, SigkillLosesAtMostTheOpenTransaction) {
   EXPECT_TRUE(copied.problems().empty()) << ::testing::PrintToString(copied.problems());
 }
 
+// What a forced exit writes first: metadata.yaml with the committed messages, from another
+// thread while the writer holds an open transaction; the database, read after the writer
+// is gone without close(), holds exactly those.
+TEST(BagCrash, CommittedMetadataIsWhatTheDatabaseHolds) {
+  TempDir dir;
+  const fs::path bag = dir / "forced";
+  BagWriterOptions options;
+  options.commit_interval = std::chrono::hours(1);
+  options.commit_messages = 1'000'000;
+  auto writer = std::make_unique<BagWriter>(bag.string(), options);
+  uint32_t topic = writer->add_topic({"/seq", "std_msgs/msg/ByteMultiArray", "cdr", {}});
+  for (uint32_t i = 1; i <= 10; ++i) writer->write(topic, kEpoch + i, sequence_payload(i, 10));
+  writer->commit();
+  for (uint32_t i = 11; i <= 15; ++i) writer->write(topic, kEpoch + i, sequence_payload(i, 10));
+  std::thread([&] { writer->write_committed_metadata(); }).join();
+  BagMetadata yaml = parse_metadata_yaml(read_file(bag / "metadata.yaml"), "metadata.yaml");
+  EXPECT_EQ(yaml.message_count, 10u);
+  ASSERT_EQ(yaml.topics.size(), 1u);
+  EXPECT_EQ(yaml.topics[0].message_count, 10u);
+  EXPECT_EQ(writer->metadata().message_count, 15u) << "accepted, 5 of them not committed";
+  // As a forced exit leaves it: the open transaction never committed.
+  const fs::path copy = dir / "copy";
+  fs::create_directories(copy);
+  for (const auto& entry : fs::directory_iterator(bag)) {
+    fs::copy_file(entry.path(), copy / entry.path().filename());
+  }
+  BagReader reader(copy.string());
+  EXPECT_EQ(read_sequences(reader).sequences.size(), 10u);
+}
+
 TEST(BagCrash, ReaderWithoutWriteAccessFallsBackToTheDatabaseFile) {
   // A killed writer's log needs its -shm index, which SQLite creates next to the database;
   // a reader that may not write there cannot use the log, whether opened read-only or

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <csignal>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <thread>
@@ -249,6 +250,78 @@ TEST(MocapBag, AKilledRecordingLeavesABagThatOpens) {
   }
   EXPECT_GE(expected, kMessages / 2);
 }
+
+// Stop requests as supervisors send them: one SIGTERM; two in the same instant (`timeout`,
+// process-group kills, `docker stop`); Ctrl-C twice, 200 ms apart. Each is one request: the
+// recording ends with its closing line, metadata.yaml counts exactly what the database holds,
+// and no -wal file is left beside it.
+enum class StopPattern { OneSigterm, TwoSigtermsAtOnce, CtrlCTwice };
+
+class MocapBagStops : public ::testing::TestWithParam<StopPattern> {};
+
+TEST_P(MocapBagStops, LeaveABagWhoseMetadataAgreesWithItsDatabase) {
+  const int slot = 44 + static_cast<int>(GetParam());
+  join_domain(slot);
+  test::TempDir dir;
+  const std::filesystem::path bag = dir / "stopped";
+  test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "--all"},
+                              domain_environment(slot), dir / "record.log");
+  ComponentHost host(dds_host("bag_source"));
+  host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
+  host.start();
+  ASSERT_TRUE(wait_for([&] { return committed(bag, "/numbers") >= kMessages / 2; },
+                       std::chrono::seconds(60)))
+      << recorder.output();
+  switch (GetParam()) {
+    case StopPattern::OneSigterm:
+      recorder.signal(SIGTERM);
+      break;
+    case StopPattern::TwoSigtermsAtOnce:
+      recorder.signal(SIGTERM);
+      recorder.signal(SIGTERM);
+      break;
+    case StopPattern::CtrlCTwice:
+      recorder.signal(SIGINT);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      recorder.signal(SIGINT);
+      break;
+  }
+  ASSERT_EQ(recorder.wait(std::chrono::seconds(30)), 0) << recorder.output();
+  host.stop();
+  EXPECT_NE(recorder.output().find("recorded "), std::string::npos) << recorder.output();
+
+  for (const auto& entry : std::filesystem::directory_iterator(bag)) {
+    EXPECT_FALSE(entry.path().string().ends_with("-wal")) << entry.path();
+  }
+  const BagMetadata metadata =
+      parse_metadata_yaml(test::read_file(bag / "metadata.yaml"), "metadata.yaml");
+  std::map<std::string, uint64_t> in_database;
+  BagReader reader(bag.string());
+  BagMessage message;
+  while (reader.next(message)) ++in_database[message.topic->name];
+  uint64_t total = 0;
+  for (const BagTopic& topic : metadata.topics) {
+    EXPECT_EQ(topic.message_count, in_database[topic.name]) << topic.name;
+    total += topic.message_count;
+  }
+  EXPECT_EQ(metadata.message_count, total);
+  EXPECT_GE(in_database["/numbers"], static_cast<uint64_t>(kMessages / 2));
+}
+
+INSTANTIATE_TEST_SUITE_P(Patterns, MocapBagStops,
+                         ::testing::Values(StopPattern::OneSigterm, StopPattern::TwoSigtermsAtOnce,
+                                           StopPattern::CtrlCTwice),
+                         [](const ::testing::TestParamInfo<StopPattern>& info) {
+                           switch (info.param) {
+                             case StopPattern::OneSigterm:
+                               return "OneSigterm";
+                             case StopPattern::TwoSigtermsAtOnce:
+                               return "TwoSigtermsAtOnce";
+                             case StopPattern::CtrlCTwice:
+                               return "CtrlCTwice";
+                           }
+                           return "Unknown";
+                         });
 
 // A bag cut short (a full disk, a copy interrupted): info says what is lost and play plays the
 // rest, both with exit status 0.

@@ -58,6 +58,9 @@ class BagWriter {
   // Commits, records the metadata in the database and metadata.yaml, and closes the file.
   // Idempotent. Throws BagError.
   void close();
+  // Thread-safe, also while another thread writes: metadata.yaml with the messages committed
+  // so far, for a process forced to exit before close(). Throws BagError.
+  void write_committed_metadata() const;
 
   const std::string& directory() const;
   const BagMetadata& metadata() const;  // as written so far, counts included

@@ -51,6 +51,8 @@ class Recorder {
   // error (disk full, a message that would not serialize is only counted), if any.
   std::optional<std::string> close();
 
+  // Thread-safe: BagWriter::write_committed_metadata(), for a forced exit.
+  void write_committed_metadata() const;
   // The first write error so far ("…: the disk is full …"); after it nothing more is written.
   std::optional<std::string> error() const;
   RecorderStats stats() const;
