@@ -23,6 +23,18 @@ function check(ok, line) {
   if (!ok) failed = true;
 }
 const state = (page) => page.evaluate(() => ({ ...window.viewerState }));
+// Waits until `condition(viewerState)` holds and returns the state of that very moment.
+const snapshot = async (page, condition, timeout) => {
+  const handle = await page.waitForFunction(
+    (source) => {
+      const s = window.viewerState;
+      return new Function("s", `return (${source})(s)`)(s) ? { ...s } : null;
+    },
+    condition.toString(),
+    { timeout },
+  );
+  return handle.jsonValue();
+};
 
 try {
   const page = await browser.newPage({ viewport: { width: 1600, height: 1000 } });
@@ -41,9 +53,8 @@ try {
     await browser.close();
     process.exit(failed ? 1 : 0);
   }
-  await page.waitForFunction(() => window.viewerState?.images >= 5 && window.viewerState.fiducialsInFrame > 0,
-    null, { timeout: 30000 });
-  const first = await state(page);
+  // The state as the condition saw it: a new frame may be drawn before its fiducials arrive.
+  const first = await snapshot(page, (s) => s?.images >= 5 && s.fiducialsInFrame > 0, 30000);
   check(first.connected, `connected to ${first.server}`);
   check(first.circlesDrawn === first.fiducialsInFrame && first.circlesDrawn > 0,
     `${first.circlesDrawn} circles drawn for the ${first.fiducialsInFrame} fiducials of frame ${first.frameStamp}`);
@@ -54,9 +65,7 @@ try {
   check(later.circlesDrawn === later.fiducialsInFrame,
     `${later.circlesDrawn} circles for ${later.fiducialsInFrame} fiducials, ${later.images - first.images} frames later`);
   check(later.latencyMs !== null && later.latencyMs < 1000, `pose latency at the page ${later.latencyMs?.toFixed(1)} ms`);
-  await page.waitForFunction(() => window.viewerState.axesDrawn > 0, null, { timeout: 10000 })
-    .catch(() => {});
-  const axes = await state(page);
+  const axes = await snapshot(page, (s) => s.axesDrawn > 0, 10000).catch(() => state(page));
   check(axes.axesDrawn > 0 && axes.axesDrawn === axes.posesInFrame,
     `axes of ${axes.axesDrawn} of the ${axes.posesInFrame} pose(s) of frame ${axes.frameStamp} reprojected with camera_info`);
   const turret = await page.textContent("#turret");
