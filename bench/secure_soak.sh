@@ -79,7 +79,7 @@ for name in shared_memory udp; do
   dir="$work/$name"
   s=$(cat "$dir/sender.status"); r=$(cat "$dir/receiver.status")
   field() { sed -n "s/^$1: //p" "$dir/summary.yaml" 2>/dev/null; }
-  images=$(sed -n 's/.*\] \([0-9]*\) images in all.*/\1/p' "$dir/receiver.log" | tail -n 1)
+  images=$(sed -n 's/.*\[tracker\]: \([0-9]*\) images in all.*/\1/p' "$dir/receiver.log" | tail -n 1)
   aborts=$(grep -c "Assertion\|Aborted\|terminate called" "$dir/sender.log" "$dir/receiver.log" | awk -F: '{ n += $2 } END { print n + 0 }')
   echo "| $name | $s | $r | $(field received) | $(field missing) | $(field out_of_order) | ${images:-0} | $aborts |"
   if [ "$s" != 0 ] || [ "$r" != 0 ] || [ "$(field received)" != "$count" ] || [ "$(field missing)" != 0 ] ||

@@ -321,11 +321,13 @@ TEST_F(Security, AuthenticatedIdentitiesExchangeTheStream) {
   }
 }
 
-// Encrypted messages of every size around the 64 KiB datagram limit, where Fast DDS 2.9.1's
-// statistics submessage lacked room once a whole RTPS message was encrypted (rtps_protection
-// in the governance: the abort `add_statistics_submessage: Assertion 'msg->max_size >=
-// msg->length + statistics_submessage_length' failed`). Two participants in this process,
-// over UDP and over shared memory: every size arrives, whole and once.
+// Encrypted messages of every size around the 64 KiB datagram limit, between two processes,
+// over UDP and over shared memory: every size arrives, whole and once. This is where the
+// governance matters: Fast DDS 2.9.1 keeps room for its statistics submessage only in the plain
+// RTPS message, so wrapping whole messages (rtps_protection_kind ENCRYPT) could overflow it and
+// abort (`add_statistics_submessage: Assertion 'msg->max_size >= msg->length + ...' failed`);
+// scripts/make_security.sh's governance protects each submessage instead. (Sizes alone did not
+// make the old governance abort here; that needs a message filled by grouped submessages.)
 constexpr uint32_t kFirstSize = 64'000;
 constexpr uint32_t kLastSize = 65'600;
 

@@ -88,10 +88,11 @@ class FoxgloveBridge final : public Component {
     queue_options_.limit_bytes = static_cast<size_t>(param<int64_t>("send_buffer_limit_bytes"));
 
     client_publish_ = param<bool>("client_publish");
-    for (const KnownTopic& topic : context.known_topics()) {
+    const std::vector<KnownTopic> declared = context.known_topics();
+    for (const KnownTopic& topic : declared) {
       if (offered(topic)) declared_.insert(topic.topic);
     }
-    update_topics(context.known_topics());
+    update_topics(declared);
 
     WebSocketServerOptions options;
     options.address = param<std::string>("address");
