@@ -218,23 +218,40 @@ TEST(MocapBag, RecordsDescribesAndPlaysTopicsOfAnotherProcess) {
   }
 }
 
+// `mocap_bag record --all` into DIR/NAME while NumberedSource publishes from this process, on
+// the DDS domain of `slot`.
+struct RecordingUnderWay {
+  RecordingUnderWay(int slot, const test::TempDir& dir, const std::string& name)
+      : bag(dir / name),
+        recorder({bag_tool(), "record", "-o", bag.string(), "--all"}, domain_environment(slot),
+                 dir / "record.log"),
+        host(dds_host("bag_source")) {
+    host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
+    host.start();
+  }
+  // Half of /numbers committed to the bag.
+  bool half_committed() const {
+    return wait_for([&] { return committed(bag, "/numbers") >= kMessages / 2; },
+                    std::chrono::seconds(60));
+  }
+
+  std::filesystem::path bag;
+  test::ChildProcess recorder;
+  ComponentHost host;
+};
+
 // kill -9 in the middle of a recording of everything published: the bag opens and holds the
 // messages up to the last commit, in order and without holes.
 TEST(MocapBag, AKilledRecordingLeavesABagThatOpens) {
   join_domain(42);
   test::TempDir dir;
-  const std::filesystem::path bag = dir / "killed";
-  test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "--all"},
-                              domain_environment(42), dir / "record.log");
-  ComponentHost host(dds_host("bag_source"));
-  host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
-  host.start();
-  ASSERT_TRUE(wait_for([&] { return committed(bag, "/numbers") >= kMessages / 2; },
-                       std::chrono::seconds(60)))
-      << recorder.output();
+  RecordingUnderWay recording(42, dir, "killed");
+  test::ChildProcess& recorder = recording.recorder;
+  const std::filesystem::path& bag = recording.bag;
+  ASSERT_TRUE(recording.half_committed()) << recorder.output();
   recorder.signal(SIGKILL);
   EXPECT_EQ(recorder.wait(std::chrono::seconds(30)), 128 + SIGKILL);
-  host.stop();
+  recording.host.stop();
 
   auto [code, info] = test::run_command({bag_tool(), "info", bag.string()});
   EXPECT_EQ(code, 0) << info;
@@ -263,15 +280,10 @@ TEST_P(MocapBagStops, LeaveABagWhoseMetadataAgreesWithItsDatabase) {
   const int slot = 44 + static_cast<int>(GetParam());
   join_domain(slot);
   test::TempDir dir;
-  const std::filesystem::path bag = dir / "stopped";
-  test::ChildProcess recorder({bag_tool(), "record", "-o", bag.string(), "--all"},
-                              domain_environment(slot), dir / "record.log");
-  ComponentHost host(dds_host("bag_source"));
-  host.add(make_component_factory<NumberedSource>("numbered_source"), {.name = "source"});
-  host.start();
-  ASSERT_TRUE(wait_for([&] { return committed(bag, "/numbers") >= kMessages / 2; },
-                       std::chrono::seconds(60)))
-      << recorder.output();
+  RecordingUnderWay recording(slot, dir, "stopped");
+  test::ChildProcess& recorder = recording.recorder;
+  const std::filesystem::path& bag = recording.bag;
+  ASSERT_TRUE(recording.half_committed()) << recorder.output();
   switch (GetParam()) {
     case StopPattern::OneSigterm:
       recorder.signal(SIGTERM);
@@ -287,7 +299,7 @@ TEST_P(MocapBagStops, LeaveABagWhoseMetadataAgreesWithItsDatabase) {
       break;
   }
   ASSERT_EQ(recorder.wait(std::chrono::seconds(30)), 0) << recorder.output();
-  host.stop();
+  recording.host.stop();
   EXPECT_NE(recorder.output().find("recorded "), std::string::npos) << recorder.output();
 
   for (const auto& entry : std::filesystem::directory_iterator(bag)) {

@@ -477,9 +477,9 @@ class FoxgloveBridge final : public Component {
   // A copy of `frame` for one client's subscription. Requires mutex_.
   static void queue_frame(ClientState& state, const std::string& frame, uint32_t subscription) {
     std::string copy = frame;
-    // The subscription id: bytes 1 to 4, little-endian.
-    for (size_t i = 0; i < 4; ++i)
-      copy[1 + i] = static_cast<char>((subscription >> (8 * i)) & 0xff);
+    set_message_data_subscription(
+        subscription, std::span<uint8_t, kMessageDataHeaderSize>(
+                          reinterpret_cast<uint8_t*>(copy.data()), kMessageDataHeaderSize));
     state.queue.push(std::move(copy), std::chrono::steady_clock::now());
   }
 

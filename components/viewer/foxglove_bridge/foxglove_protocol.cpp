@@ -121,6 +121,11 @@ void write_message_data_header(uint32_t subscription_id, uint64_t receive_time_n
   for (int i = 0; i < 8; ++i) out[5 + i] = static_cast<uint8_t>(receive_time_ns >> (8 * i));
 }
 
+void set_message_data_subscription(uint32_t subscription_id,
+                                   std::span<uint8_t, kMessageDataHeaderSize> header) {
+  put_u32(header.data() + 1, subscription_id);
+}
+
 std::optional<ClientRequest> parse_client_text(std::string_view text) {
   json frame = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (frame.is_discarded()) throw ProtocolError("malformed JSON");

@@ -56,6 +56,10 @@ inline constexpr size_t kMessageDataHeaderSize = 1 + 4 + 8;
 // Writes the 13-byte header in front of a payload the caller places after it.
 void write_message_data_header(uint32_t subscription_id, uint64_t receive_time_ns,
                                std::span<uint8_t, kMessageDataHeaderSize> out);
+// Rewrites the subscription id of a header write_message_data_header wrote: one serialized
+// message, copied for each subscriber.
+void set_message_data_subscription(uint32_t subscription_id,
+                                   std::span<uint8_t, kMessageDataHeaderSize> header);
 
 // --- client -> server ----------------------------------------------------------------------
 
