@@ -65,7 +65,8 @@ try {
   check(later.circlesDrawn === later.fiducialsInFrame,
     `${later.circlesDrawn} circles for ${later.fiducialsInFrame} fiducials, ${later.images - first.images} frames later`);
   check(later.latencyMs !== null && later.latencyMs < 1000, `pose latency at the page ${later.latencyMs?.toFixed(1)} ms`);
-  const axes = await snapshot(page, (s) => s.axesDrawn > 0, 10000).catch(() => state(page));
+  // The walking board may be out of view for a while: wait for a frame that shows it.
+  const axes = await snapshot(page, (s) => s.axesDrawn > 0, 60000).catch(() => state(page));
   check(axes.axesDrawn > 0 && axes.axesDrawn === axes.posesInFrame,
     `axes of ${axes.axesDrawn} of the ${axes.posesInFrame} pose(s) of frame ${axes.frameStamp} reprojected with camera_info`);
   const turret = await page.textContent("#turret");
