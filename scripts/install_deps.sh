@@ -23,6 +23,9 @@ packages=(
   libwebsocketpp-dev libasio-dev chromium
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
+  # sanitizer builds and fuzzing (scripts/sanitize.sh, scripts/fuzz.sh): clang with its
+  # sanitizer runtimes and libFuzzer
+  clang libclang-rt-14-dev libfuzzer-14-dev
   # the Debian package (cpack: dpkg-shlibdeps, file) and its test in a clean Debian 12 root
   dpkg-dev file debootstrap
   # benchmarks: instruction counts

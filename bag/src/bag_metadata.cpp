@@ -2,7 +2,10 @@
 #include <mocap/bag/bag_metadata.hpp>
 
 #include <algorithm>
+#include <initializer_list>
 #include <optional>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -124,6 +127,19 @@ std::optional<int64_t> int_at(const YAML::Node& map, const char* key) {
   return std::nullopt;
 }
 
+// A QoS policy as rosbag2 writes it: a number up to metadata version 8, its name from
+// version 9 on ("keep_last", "reliable", "transient_local"). Names map to the same numbers.
+std::optional<int64_t> policy_at(const YAML::Node& map, const char* key,
+                                 std::initializer_list<std::pair<std::string_view, int>> names) {
+  if (auto number = int_at(map, key)) return number;
+  const YAML::Node node = map[key];
+  if (!node || !node.IsScalar()) return std::nullopt;
+  for (const auto& [name, value] : names) {
+    if (node.Scalar() == name) return value;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::string format_offered_qos_profiles(const std::vector<Qos>& offered) {
@@ -166,7 +182,8 @@ std::vector<Qos> parse_offered_qos_profiles(const std::string& yaml) {
   for (const YAML::Node& entry : root) {
     if (!entry.IsMap()) continue;
     Qos qos;
-    auto history = int_at(entry, "history");
+    auto history = policy_at(entry, "history",
+                             {{"keep_last", kHistoryKeepLast}, {"keep_all", kHistoryKeepAll}});
     auto depth = int_at(entry, "depth");
     if (history == kHistoryKeepLast) {
       qos.history = History::KeepLast;
@@ -174,10 +191,12 @@ std::vector<Qos> parse_offered_qos_profiles(const std::string& yaml) {
     } else if (history == kHistoryKeepAll) {
       qos.history = History::KeepAll;
     }
-    auto reliability = int_at(entry, "reliability");
+    auto reliability =
+        policy_at(entry, "reliability", {{"reliable", kReliable}, {"best_effort", kBestEffort}});
     if (reliability == kReliable) qos.reliability = Reliability::Reliable;
     if (reliability == kBestEffort) qos.reliability = Reliability::BestEffort;
-    auto durability = int_at(entry, "durability");
+    auto durability = policy_at(entry, "durability",
+                                {{"transient_local", kTransientLocal}, {"volatile", kVolatile}});
     if (durability == kTransientLocal) qos.durability = Durability::TransientLocal;
     if (durability == kVolatile) qos.durability = Durability::Volatile;
     profiles.push_back(qos);

@@ -21,6 +21,19 @@
 namespace mocap::bag {
 namespace {
 
+// Stamps and row ids come from the file and may be anything: sums and differences of them
+// saturate rather than overflow.
+int64_t clamped_sum(int64_t a, int64_t b) {
+  int64_t sum = 0;
+  if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? INT64_MAX : INT64_MIN;
+  return sum;
+}
+int64_t clamped_difference(int64_t a, int64_t b) {
+  int64_t difference = 0;
+  if (__builtin_sub_overflow(a, b, &difference)) return b < 0 ? INT64_MAX : INT64_MIN;
+  return difference;
+}
+
 namespace fs = std::filesystem;
 
 // Salvage: ids are probed one by one past a damaged stretch, up to the highest id known plus
@@ -354,11 +367,11 @@ struct BagReader::State {
       per_topic[topic->second] += n;
       if (summary.message_count == 0) {
         summary.start_ns = first;
-        summary.duration_ns = last - first;
+        summary.duration_ns = clamped_difference(last, first);
       } else {
-        const int64_t end = std::max(summary.start_ns + summary.duration_ns, last);
+        const int64_t end = std::max(clamped_sum(summary.start_ns, summary.duration_ns), last);
         summary.start_ns = std::min(summary.start_ns, first);
-        summary.duration_ns = end - summary.start_ns;
+        summary.duration_ns = clamped_difference(end, summary.start_ns);
       }
       summary.message_count += n;
     };
@@ -461,12 +474,14 @@ struct BagReader::State {
       range->reset();
 
       // Slow: single ids past the damage, until one reads again.
-      int64_t upper = std::max({cursor, max_id.value_or(0),
-                                static_cast<int64_t>(file.expected_count.value_or(0))}) +
-                      kProbeMargin;
+      const int64_t upper =
+          clamped_sum(std::max({cursor, max_id.value_or(0),
+                                static_cast<int64_t>(file.expected_count.value_or(0))}),
+                      kProbeMargin);
       int64_t lost = 0, first_lost = 0;
       bool found = false;
-      for (int64_t id = cursor + 1; id <= upper; ++id) {
+      for (int64_t id = cursor; id < upper;) {
+        ++id;  // incremented first, so that an upper bound of INT64_MAX cannot overflow it
         if (++probes > kProbeBudget) {
           budget_spent = true;
           break;
@@ -653,13 +668,13 @@ BagReader::BagReader(const std::string& path) : state_(std::make_unique<State>()
   for (const auto& file : s.files) {
     m.files.push_back(file->summary);
     if (file->summary.message_count == 0) continue;
-    const int64_t file_end = file->summary.start_ns + file->summary.duration_ns;
+    const int64_t file_end = clamped_sum(file->summary.start_ns, file->summary.duration_ns);
     m.start_ns = any ? std::min(m.start_ns, file->summary.start_ns) : file->summary.start_ns;
     end = any ? std::max(end, file_end) : file_end;
     m.message_count += file->summary.message_count;
     any = true;
   }
-  m.duration_ns = any ? end - m.start_ns : 0;
+  m.duration_ns = any ? clamped_difference(end, m.start_ns) : 0;
 }
 
 BagReader::~BagReader() = default;

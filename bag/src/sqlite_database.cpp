@@ -62,6 +62,10 @@ Database::Database(const std::string& path, int flags, std::string name) : name_
     throw SqliteError(code, fmt::format("{}: cannot open: {}", name_, message));
   }
   sqlite3_extended_result_codes(db_, 1);
+  // Another connection to the same file (a reader of a bag being recorded, `mocap_bag info`,
+  // the sqlite3 shell) holds its locks for moments: wait them out instead of failing with
+  // "database is locked", which would end a recording.
+  sqlite3_busy_timeout(db_, 5000);
 }
 
 Database::~Database() {

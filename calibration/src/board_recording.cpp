@@ -116,7 +116,10 @@ std::vector<BoardShot> group_shots(std::span<const Blink> blinks, const ShotOpti
   for (const Blink& blink : blinks) by_camera[blink.camera_id].push_back(&blink);
   ShotStats counts;
   std::vector<BoardShot> shots;
-  for (auto& [camera, list] : by_camera) {
+  for (auto& entry : by_camera) {
+    // Named, not a structured binding: clang 14 cannot capture those in the lambda below.
+    const int camera = entry.first;
+    std::vector<const Blink*>& list = entry.second;
     std::stable_sort(list.begin(), list.end(),
                      [](const Blink* a, const Blink* b) { return a->start_ns < b->start_ns; });
     // A run: blinks 1 to 3 periods apart, at most one cycle's worth (3 periods) in all.

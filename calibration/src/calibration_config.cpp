@@ -129,6 +129,13 @@ Json parse_json(const std::string& text, const std::string& source) {
   };
   try {
     return Json::parse(text, track);
+  } catch (const Json::out_of_range& e) {
+    // A number beyond double's range ("1e400"): nlohmann reports it without a position.
+    // "[json.exception.out_of_range.406] number overflow parsing '1e400'"
+    const std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    throw CalibrationConfigError(source + ": invalid JSON: " +
+                                 (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   } catch (const Json::parse_error& e) {
     // "[json.exception.parse_error.101] parse error at line 3, column 2: why"
     std::string what = e.what();
@@ -608,6 +615,10 @@ Eigen::Isometry3d transform_from_values(std::span<const double> values) {
     transform.translation() = Eigen::Vector3d(values[0], values[1], values[2]);
     const Eigen::Vector3d rotation(values[3], values[4], values[5]);
     const double angle = rotation.norm();
+    if (!std::isfinite(angle)) {
+      throw std::invalid_argument("the rotation vector's length " + number_text(angle) +
+                                  " is not a finite angle");
+    }
     if (angle > 0) {
       transform.linear() = Eigen::AngleAxisd(angle, rotation / angle).toRotationMatrix();
     }
@@ -624,7 +635,8 @@ Eigen::Isometry3d transform_from_values(std::span<const double> values) {
     r << values[0], values[1], values[2], values[4], values[5], values[6], values[8], values[9],
         values[10];
     const double error = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm();
-    if (error > kRotationTolerance || r.determinant() < 0) {
+    // Negated so that NaN (from overflowing products) is refused too.
+    if (!(error <= kRotationTolerance) || !(r.determinant() > 0)) {
       throw std::invalid_argument(
           "the 3x3 part is not a rotation (|R'R - I| = " + number_text(error) +
           ", det R = " + number_text(r.determinant()) + ")");

@@ -116,7 +116,8 @@ std::shared_ptr<const CameraModel> read_pinhole(const Reader& reader, const YAML
   std::vector<double> k = reader.matrix("camera_matrix", 9);
   PinholeIntrinsics intrinsics{k[0], k[4], k[2], k[5]};
   if (root["distortion_coefficients"]) {
-    YAML::Node data = root["distortion_coefficients"]["data"];
+    const YAML::Node coefficients = root["distortion_coefficients"];
+    const YAML::Node data = coefficients.IsMap() ? coefficients["data"] : YAML::Node();
     size_t count = data && data.IsSequence() ? data.size() : 0;
     if (count != 4 && count != 5) count = 5;  // the error then names the expected count
     std::vector<double> d = reader.matrix("distortion_coefficients", count);

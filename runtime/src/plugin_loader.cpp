@@ -89,7 +89,10 @@ const LoadedPlugin& PluginLoader::load(std::string_view plugin) {
   if (auto it = loaded_.find(plugin); it != loaded_.end()) return *it->second;
   if (plugin.find('/') != std::string_view::npos) {
     fs::path library(plugin);
-    if (!fs::exists(library)) {
+    // The error_code forms: a name too long for the file system is "does not exist" too,
+    // not an exception out of the launch file's checks.
+    std::error_code error;
+    if (!fs::exists(library, error)) {
       throw PluginError(fmt::format("plugin library {} does not exist", library.string()));
     }
     return load_library(library, {});
@@ -97,7 +100,8 @@ const LoadedPlugin& PluginLoader::load(std::string_view plugin) {
   std::string file = fmt::format("{}{}.so", kPrefix, plugin);
   for (const fs::path& directory : search_path_) {
     fs::path library = directory / file;
-    if (fs::exists(library)) return load_library(library, plugin);
+    std::error_code error;
+    if (fs::exists(library, error)) return load_library(library, plugin);
   }
   throw PluginError(fmt::format("plugin '{}' not found: no {} in {}{}", plugin, file,
                                 join_paths(search_path_),

@@ -609,6 +609,24 @@ TEST(RosBags, HumbleBagWithMetadataYaml) {
   EXPECT_EQ(back.sequences, (std::vector<uint64_t>{1, 2, 3, 4, 5}));  // stamp, then id order
 }
 
+// rosbag2 writes QoS policies by name from metadata version 9 on (Jazzy's rosbag2 qos.cpp);
+// Humble's numbers are read as before. A latched topic must play back latched.
+TEST(RosBags, QosPoliciesByNameAsJazzyWritesThem) {
+  const std::string jazzy =
+      "- history: keep_last\n  depth: 1\n  reliability: reliable\n  durability: "
+      "transient_local\n  deadline:\n    sec: 9223372036\n    nsec: 854775807\n  liveliness: "
+      "automatic\n  avoid_ros_namespace_conventions: false\n- history: keep_all\n  depth: 0\n  "
+      "reliability: best_effort\n  durability: volatile\n";
+  EXPECT_EQ(parse_offered_qos_profiles(jazzy),
+            (std::vector<Qos>{
+                {Reliability::Reliable, Durability::TransientLocal, History::KeepLast, 1},
+                {Reliability::BestEffort, Durability::Volatile, History::KeepAll, Qos{}.depth}}));
+  EXPECT_EQ(parse_offered_qos_profiles("- history: 1\n  depth: 1\n  reliability: 1\n  "
+                                       "durability: 1\n"),
+            (std::vector<Qos>{
+                {Reliability::Reliable, Durability::TransientLocal, History::KeepLast, 1}}));
+}
+
 TEST(RosBags, JazzySchema4WithVersion9MetadataYaml) {
   TempDir dir;
   const fs::path bag = dir / "jazzy_bag";

@@ -43,7 +43,7 @@ try {
   await page.goto(url);
   if (mode === "--floor") {
     await page.waitForFunction(() => window.viewerState?.footprintsDrawn > 0 && window.viewerState.robotsDrawn > 0,
-      null, { timeout: 30000 });
+      null, { timeout: 90000 });
     await page.waitForTimeout(1000);
     const floor = await state(page);
     check(true, `floor: ${floor.footprintsDrawn} footprints, ${floor.robotsDrawn} robots`);
@@ -54,7 +54,7 @@ try {
     process.exit(failed ? 1 : 0);
   }
   // The state as the condition saw it: a new frame may be drawn before its fiducials arrive.
-  const first = await snapshot(page, (s) => s?.images >= 5 && s.fiducialsInFrame > 0, 30000);
+  const first = await snapshot(page, (s) => s?.images >= 5 && s.fiducialsInFrame > 0, 90000);
   check(first.connected, `connected to ${first.server}`);
   check(first.circlesDrawn === first.fiducialsInFrame && first.circlesDrawn > 0,
     `${first.circlesDrawn} circles drawn for the ${first.fiducialsInFrame} fiducials of frame ${first.frameStamp}`);
@@ -76,7 +76,7 @@ try {
 
   if (mode === "--outage") {
     console.log("WAITING_FOR_STOP");
-    await page.waitForFunction(() => !window.viewerState.connected, null, { timeout: 30000 });
+    await page.waitForFunction(() => !window.viewerState.connected, null, { timeout: 90000 });
     const text = await page.textContent("#status");
     check(/disconnected/.test(text), `the page says: ${text}`);
     console.log("WAITING_FOR_START");
@@ -84,7 +84,7 @@ try {
     while (!existsSync(flagFile) && Date.now() < deadline) await new Promise((r) => setTimeout(r, 100));
     const before = (await state(page)).images;
     await page.waitForFunction((n) => window.viewerState.connected && window.viewerState.images > n + 3,
-      before, { timeout: 30000 });
+      before, { timeout: 90000 });
     check(true, `reconnected: ${await page.textContent("#status")}`);
   }
   check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);

@@ -164,8 +164,17 @@ TEST_F(FoxgloveBridgeTest, AnIndependentClientDecodesPosesFiducialsAndImages) {
     return m["header"]["stamp"]["sec"].get<double>() +
            m["header"]["stamp"]["nsec"].get<double>() * 1e-9;
   };
+  // The bridge throttles by the time images arrive, which jitters with the load, while the
+  // stamps are the camera's (30 Hz): no two of the camera's neighbouring frames are both sent,
+  // and on average 10 a second at most.
   for (size_t i = 1; i < images.size(); ++i) {
-    EXPECT_GE(seconds(images[i]) - seconds(images[i - 1]), 0.09) << "max_image_rate_hz: 10";
+    EXPECT_GE(seconds(images[i]) - seconds(images[i - 1]), 0.06) << "max_image_rate_hz: 10";
+  }
+  if (images.size() > 1) {
+    EXPECT_GE(
+        (seconds(images.back()) - seconds(images.front())) / static_cast<double>(images.size() - 1),
+        0.09)
+        << "max_image_rate_hz: 10";
   }
 }
 
@@ -319,7 +328,7 @@ TEST_F(FoxgloveBridgeTest, TheViewerDrawsInARealBrowserAndSurvivesTheBridgeGoing
       {"node", (viewer_tests() / "browser_check.mjs").string(),
        fmt::format("http://127.0.0.1:{}/", port_), screenshot, "--outage", flag.string()},
       {}, dir_ / "browser.log");
-  ASSERT_TRUE(browser.wait_for_output("WAITING_FOR_STOP", std::chrono::seconds(90)))
+  ASSERT_TRUE(browser.wait_for_output("WAITING_FOR_STOP", std::chrono::seconds(300)))
       << browser.output();
   graph_->signal(SIGTERM);
   ASSERT_EQ(graph_->wait(std::chrono::seconds(30)), 0) << graph_->output();
@@ -327,7 +336,7 @@ TEST_F(FoxgloveBridgeTest, TheViewerDrawsInARealBrowserAndSurvivesTheBridgeGoing
       << browser.output();
   start_graph();
   test::write_file(flag, "");
-  ASSERT_EQ(browser.wait(std::chrono::seconds(90)), 0) << browser.output();
+  ASSERT_EQ(browser.wait(std::chrono::seconds(300)), 0) << browser.output();
   std::string output = browser.output();
   EXPECT_EQ(output.find("FAIL"), std::string::npos) << output;
   EXPECT_NE(output.find("circles drawn for the"), std::string::npos) << output;

@@ -63,6 +63,7 @@ Joint read_joint(const Reader& reader, const YAML::Node& root, const char* name)
   const YAML::Node axis = reader.required(node, "axis", what);
   joint.axis = reader.vector<3>(axis, "axis");
   if (joint.axis.norm() < 1e-9) reader.fail(axis, "'axis' must not be zero");
+  if (!std::isfinite(joint.axis.norm())) reader.fail(axis, "'axis' is too long to normalize");
   joint.axis.normalize();
   if (YAML::Node limits = node["limits_deg"]) {
     const Eigen::Vector2d range = reader.vector<2>(limits, "limits_deg", -360, 360);

@@ -104,6 +104,12 @@ std::array<double, 4> checked_positions(std::array<double, 4> positions, const s
   }
   double first = positions[0];
   for (double& p : positions) p -= first;
+  // Spacings too small or too large for double precision give no usable cross-ratio.
+  if (!std::isfinite(cross_ratio(positions[0], positions[1], positions[2], positions[3]))) {
+    fail(source, line,
+         fmt::format("line '{}': the distances {} give no finite cross-ratio", name,
+                     fmt::join(positions, ", ")));
+  }
   return positions;
 }
 
@@ -374,7 +380,8 @@ std::vector<ConstellationModel> parse_constellation_csv(std::string_view text,
   return models;
 }
 
-ConstellationDatabase parse_database_yaml(const std::string& text, const std::string& source) {
+ConstellationDatabase parse_database_yaml(const std::string& text, const std::string& source,
+                                          std::vector<LinePattern> more_patterns) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -394,6 +401,7 @@ ConstellationDatabase parse_database_yaml(const std::string& text, const std::st
     if (!list.IsSequence()) fail(source, list.Mark().line + 1, "'line_patterns' must be a list");
     for (const YAML::Node& node : list) {
       int line = node.Mark().line + 1;
+      if (!node.IsMap()) fail(source, line, "a line pattern is a map with 'name' and 'positions'");
       LinePattern pattern;
       pattern.name = yaml_name(node["name"], source, line, "a line pattern");
       YAML::Node positions = node["positions"];
@@ -415,6 +423,7 @@ ConstellationDatabase parse_database_yaml(const std::string& text, const std::st
   std::vector<ConstellationModel> models;
   for (const YAML::Node& node : list) {
     int line = node.Mark().line + 1;
+    if (!node.IsMap()) fail(source, line, "a constellation is a map with 'name' and 'lines'");
     ConstellationModel model;
     model.name = yaml_name(node["name"], source, line, "a constellation");
     YAML::Node lines = node["lines"];
@@ -423,6 +432,7 @@ ConstellationDatabase parse_database_yaml(const std::string& text, const std::st
     }
     for (const YAML::Node& line_node : lines) {
       int at = line_node.Mark().line + 1;
+      if (!line_node.IsMap()) fail(source, at, "a line is a map with 'name' and 'points'");
       std::string name = yaml_name(line_node["name"], source, at, "a line");
       YAML::Node points = line_node["points"];
       if (!points || !points.IsSequence() || points.size() != 4) {
@@ -441,6 +451,7 @@ ConstellationDatabase parse_database_yaml(const std::string& text, const std::st
     }
     models.push_back(std::move(model));
   }
+  patterns.insert(patterns.end(), more_patterns.begin(), more_patterns.end());
   return ConstellationDatabase(std::move(patterns), std::move(models), source);
 }
 
@@ -454,13 +465,7 @@ ConstellationDatabase load_database(const std::string& constellations_file,
   std::string text = read_text(constellations_file, "constellation database");
   std::string extension = constellations_file.substr(constellations_file.find_last_of('.') + 1);
   if (extension == "yaml" || extension == "yml") {
-    ConstellationDatabase yaml = parse_database_yaml(text, constellations_file);
-    if (patterns.empty()) return yaml;
-    std::vector<LinePattern> all = yaml.line_patterns();
-    all.insert(all.end(), patterns.begin(), patterns.end());
-    // Completing a model again is harmless: its points are already merged.
-    std::vector<ConstellationModel> models = yaml.constellations();
-    return ConstellationDatabase(std::move(all), std::move(models), constellations_file);
+    return parse_database_yaml(text, constellations_file, std::move(patterns));
   }
   return ConstellationDatabase(
       std::move(patterns), parse_constellation_csv(text, constellations_file), constellations_file);

@@ -92,6 +92,9 @@ std::vector<LinePattern> parse_sub_constellation_csv(std::string_view text,
                                                      const std::string& source);
 std::vector<ConstellationModel> parse_constellation_csv(std::string_view text,
                                                         const std::string& source);
-ConstellationDatabase parse_database_yaml(const std::string& text, const std::string& source);
+// `more_patterns` (a sub-constellation table's) join the file's own line patterns before the
+// constellations are checked and completed.
+ConstellationDatabase parse_database_yaml(const std::string& text, const std::string& source,
+                                          std::vector<LinePattern> more_patterns = {});
 
 }  // namespace mocap::constellations

@@ -59,16 +59,22 @@ class OverlayComponent final : public Component {
     publisher_ = create_publisher<sensor_msgs::msg::Image>(kOverlay);
     create_subscription<sensor_msgs::msg::Image>(
         kImage, [this](const std::shared_ptr<const sensor_msgs::msg::Image>& image) {
-          keep(frames_[to_nanoseconds(image->header().stamp())]).image = image;
+          if (Pending* pending = frame(to_nanoseconds(image->header().stamp()))) {
+            pending->image = image;
+          }
         });
     create_subscription<mocap_msgs::msg::FiducialArray>(
         kFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
-          auto& fiducials = keep(frames_[to_nanoseconds(array.header().stamp())]).content.fiducials;
-          for (const auto& f : array.fiducials()) fiducials.emplace_back(f.x(), f.y());
+          Pending* pending = frame(to_nanoseconds(array.header().stamp()));
+          if (pending == nullptr) return;
+          for (const auto& f : array.fiducials()) {
+            pending->content.fiducials.emplace_back(f.x(), f.y());
+          }
         });
     create_subscription<mocap_msgs::msg::ConstellationArray>(
         kConstellations, [this](const mocap_msgs::msg::ConstellationArray& array) {
-          auto& frame = keep(frames_[to_nanoseconds(array.header().stamp())]).content;
+          Pending* pending = frame(to_nanoseconds(array.header().stamp()));
+          if (pending == nullptr) return;
           for (const auto& c : array.constellations()) {
             OverlayConstellation constellation{c.name(), {}};
             for (const auto& sub : c.sub_constellations()) {
@@ -78,7 +84,7 @@ class OverlayComponent final : public Component {
               for (int k = 0; k < 4; ++k) line.pixels[k] = {f[k].x(), f[k].y()};
               constellation.lines.push_back(line);
             }
-            frame.constellations.push_back(std::move(constellation));
+            pending->content.constellations.push_back(std::move(constellation));
           }
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
@@ -91,9 +97,15 @@ class OverlayComponent final : public Component {
     OverlayFrame content;
   };
 
-  Pending& keep(Pending& pending) {
+  // The frame stamped `stamp`, created if new; the oldest are forgotten beyond
+  // kPendingFrames. Null for a stamp older than all of a full set: that frame was forgotten
+  // already (its part came late), and creating it would only forget it again at once.
+  Pending* frame(int64_t stamp) {
+    if (auto found = frames_.find(stamp); found != frames_.end()) return &found->second;
+    if (frames_.size() >= kPendingFrames && stamp < frames_.begin()->first) return nullptr;
+    Pending& pending = frames_[stamp];
     while (frames_.size() > kPendingFrames) frames_.erase(frames_.begin());
-    return pending;
+    return &pending;
   }
 
   void draw(const mocap_msgs::msg::ConstellationPoseArray& poses) {

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# Runs every fuzzer of fuzz/ for SECONDS each (default 60), two at a time, under
+# AddressSanitizer and UndefinedBehaviorSanitizer, and prints a table: executions, coverage
+# (libFuzzer's edges "cov" and features "ft"), corpus size and the verdict.
+#
+#   scripts/fuzz.sh [SECONDS] [NAME...]
+#
+# The fuzzers come from build-asan/ (scripts/sanitize.sh address builds it; this script builds
+# just the fuzzers if it is missing). Each starts from its seed corpus, fuzz/corpus/NAME/, and
+# the inputs that once broke it, fuzz/regressions/NAME/; what it finds goes to
+# build-asan/fuzz/work/NAME/ and never into the repository. An input that crashes, leaks, hangs
+# (over 10 s) or runs out of memory (over 2 GB) is kept in build-asan/fuzz/found/NAME/ and fails
+# the run: reproduce it with `build-asan/fuzz/fuzz_NAME FILE`, fix it, and keep the file in
+# fuzz/regressions/NAME/ (ctest replays it in every build).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+seconds=60
+if [ $# -gt 0 ] && [[ "$1" =~ ^[0-9]+$ ]]; then
+  seconds=$1
+  shift
+fi
+build=build-asan
+source scripts/sanitizer_env.sh
+
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  scripts/sanitize.sh address --build-only
+else
+  cmake --build "$build" --parallel "$(nproc)" --target mocap_fuzzers
+fi
+
+names=("$@")
+if [ ${#names[@]} -eq 0 ]; then
+  for fuzzer in "$build"/fuzz/fuzz_*; do
+    names+=("$(basename "$fuzzer" | sed 's/^fuzz_//')")
+  done
+fi
+for name in "${names[@]}"; do
+  if [ ! -x "$build/fuzz/fuzz_$name" ]; then
+    echo "fuzz.sh: no fuzzer '$name' (fuzz/fuzz_$name.cpp)" >&2
+    exit 2
+  fi
+done
+
+run_one() {
+  local name=$1 seconds=$2 build=$3
+  local work=$build/fuzz/work/$name found=$build/fuzz/found/$name log=$build/fuzz/logs/$name.log
+  mkdir -p "$work" "$found" "$(dirname "$log")"
+  local inputs=(fuzz/corpus/"$name")
+  [ -d fuzz/regressions/"$name" ] && inputs+=(fuzz/regressions/"$name")
+  set +e
+  "$build/fuzz/fuzz_$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$found/" "$work" "${inputs[@]}" > "$log" 2>&1
+  echo $? > "$log.status"
+  set -e
+}
+export -f run_one
+printf '%s\n' "${names[@]}" | xargs -P "$(nproc)" -I{} bash -c "run_one {} $seconds $build"
+
+failed=0
+echo
+echo "| fuzzer | seconds | executions | exec/s | cov (edges) | ft (features) | corpus | verdict |"
+echo "|---|---|---|---|---|---|---|---|"
+for name in "${names[@]}"; do
+  log=$build/fuzz/logs/$name.log
+  status=$(cat "$log.status")
+  executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  # The last status line ("#N DONE cov: C ft: F corp: K/...") or, after a crash, the last one
+  # printed before it.
+  last=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1)
+  cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<< "$last")
+  ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<< "$last")
+  corpus=$(sed -n 's/.* corp: \([0-9]*\)\/.*/\1/p' <<< "$last")
+  verdict=PASS
+  if [ "$status" != 0 ] || ls "$build/fuzz/found/$name"/* > /dev/null 2>&1; then
+    verdict="FAIL (exit $status, see $log)"
+    failed=1
+  fi
+  echo "| $name | $seconds | ${executions:-?} | ${rate:-?} | ${cov:-?} | ${ft:-?} | ${corpus:-?} | $verdict |"
+done
+if [ $failed -ne 0 ]; then
+  for name in "${names[@]}"; do
+    log=$build/fuzz/logs/$name.log
+    if [ "$(cat "$log.status")" != 0 ]; then
+      echo
+      echo "== $name: $(ls "$build/fuzz/found/$name" | head -3 | tr '\n' ' ')"
+      grep -E -A25 '^==[0-9]+==ERROR|runtime error|deadly signal|Timeout|out-of-memory|uncaught' "$log" | head -60
+    fi
+  done
+  exit 1
+fi

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Builds the tests under sanitizers with clang and runs them; any report fails the run.
+#
+#   scripts/sanitize.sh address [CTEST ARGS]  AddressSanitizer, LeakSanitizer and
+#       UndefinedBehaviorSanitizer in build-asan/: every test, and the fuzzers
+#       (scripts/fuzz.sh runs them from this build).
+#   scripts/sanitize.sh thread [CTEST ARGS]   ThreadSanitizer in build-tsan/: the runtime,
+#       transports, executor, bag recorder and the tests that run components in threads.
+#   scripts/sanitize.sh MODE --build-only     builds, runs nothing.
+#
+# Both build at -O1 with line tables only: stack traces name file and line, and the build
+# takes about half the time of -O2 with full debug information.
+# Reports that are not ours are suppressed in test/sanitizers/*.supp, one line each with why.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+mode=${1:-}
+shift || true
+build_only=false
+if [ "${1:-}" = --build-only ]; then
+  build_only=true
+  shift
+fi
+case "$mode" in
+  address) build=build-asan ;;
+  thread)
+    build=build-tsan
+    # The runtime's unit tests (executor, timers, component host, intra-process and shared
+    # memory transports, shutdown), the graph and DDS tests on both implementations (each
+    # process a multi-threaded executor), the bag tools' record, play and stop tests and
+    # the bag recorder and player components in a running pipeline.
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops)|Launcher|BagPipeline)'
+    ;;
+  *)
+    echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2
+    exit 2
+    ;;
+esac
+source scripts/sanitizer_env.sh
+scripts/install_deps.sh
+
+cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Sanitize \
+  -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -gline-tables-only" -DMOCAP_SANITIZE="$mode" \
+  -DMOCAP_WERROR=ON -DMOCAP_BUILD_TESTS=ON -DMOCAP_BUILD_BENCHMARKS=OFF > /dev/null
+if [ "$mode" = address ]; then
+  cmake --build "$build" --parallel "$(nproc)"
+  # All but the two packaging tests (label install): they check what the plain build installs
+  # and packages, and a sanitized build is never installed or packaged. And all but the tests
+  # whose expected figures hold for g++'s build only, until they are made independent of it:
+  # - seeded synthetic data drawn as `Vector2d(noise(random), noise(random))`: C++ leaves the
+  #   order of a call's arguments open, clang draws them in the other order than g++, and the
+  #   tests' bounds were set on g++'s draws (the identifier's random scenes, the calibration
+  #   problems and the board tour);
+  # - the follower demo's pointing bounds, which assume the pipeline keeps up with the camera's
+  #   30 Hz; AddressSanitizer makes it several times slower.
+  filter=(-LE install -E '^(Identifier\.RandomPointsAreNotABoard|CalibrationProblem\.(WithNoise|TwoCameras|ABadShot).*|CalibrationPipeline\.BoardTour.*|FollowerDemo\.TurretCentresBase.*)$')
+else
+  # The threaded parts: the runtime and both transports with their tests, the bag library
+  # and tools, and the components the graph tests start in threads.
+  cmake --build "$build" --parallel "$(nproc)" --target mocap_unit_tests \
+    mocap_integration_tests mocap_test_bag_tools mocap_test_bag_pipeline
+  filter=(-R "$tsan_tests")
+fi
+$build_only && exit 0
+# The viewer tests' independent clients (pinned in test/viewer/package-lock.json).
+npm ci --prefix test/viewer --no-audit --no-fund --loglevel=error
+cd "$build"
+ctest --output-on-failure --parallel "$(nproc)" "${filter[@]}" "$@"
