@@ -14,7 +14,6 @@
 # fuzz/regressions/NAME/ (ctest replays it in every build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-root=$PWD
 seconds=60
 if [ $# -gt 0 ] && [[ "$1" =~ ^[0-9]+$ ]]; then
   seconds=$1
