@@ -164,16 +164,14 @@ TEST_F(FoxgloveBridgeTest, AnIndependentClientDecodesPosesFiducialsAndImages) {
     return m["header"]["stamp"]["sec"].get<double>() +
            m["header"]["stamp"]["nsec"].get<double>() * 1e-9;
   };
-  // The bridge throttles by the time images arrive, which jitters with the load, while the
-  // stamps are the camera's (30 Hz): no two of the camera's neighbouring frames are both sent,
-  // and on average 10 a second at most.
-  for (size_t i = 1; i < images.size(); ++i) {
-    EXPECT_GE(seconds(images[i]) - seconds(images[i - 1]), 0.06) << "max_image_rate_hz: 10";
-  }
+  // The bridge throttles by the time images arrive, which jitters with the load (two of the
+  // camera's neighbouring frames may both pass when the first came late), while the stamps
+  // are the camera's: on average 10 a second, 12.5 at most with the first and last images'
+  // latencies apart.
   if (images.size() > 1) {
     EXPECT_GE(
         (seconds(images.back()) - seconds(images.front())) / static_cast<double>(images.size() - 1),
-        0.09)
+        0.08)
         << "max_image_rate_hz: 10";
   }
 }

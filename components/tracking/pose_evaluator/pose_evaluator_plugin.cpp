@@ -60,12 +60,16 @@ class PoseEvaluatorComponent final : public Component {
     period_s_ = param<double>("report_period_s");
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
+          // Once stopping, frames still in flight are not counted: the summary covers
+          // stop_after_frames frames however long the stop takes.
+          if (stopping_) return;
           ++truth_arrays_;
           evaluator_.add_truth(to_nanoseconds(truth.header().stamp()), objects(truth));
           check_done();
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
+          if (stopping_) return;
           latencies_s_.push_back(
               std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());
           evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses));
