@@ -47,14 +47,16 @@ if [ "$mode" = address ]; then
   # and packages, and a sanitized build is never installed or packaged. And all but the tests
   # whose expected figures hold for g++'s build only, until they are made independent of it:
   # - tests on seeded synthetic data whose figures differ under clang (the identifier's random
-  #   scenes, the calibration problems, the board tour); the likely cause: the data are drawn
+  #   scenes, the calibration problems, the board tour, the ceiling rig's chosen noise draw,
+  #   which does not converge in 500 iterations under clang); the likely cause: the data are drawn
   #   as `Vector2d(noise(random), noise(random))`, C++ leaves the order of a call's arguments
   #   open, and clang and g++ take them in opposite orders;
   # - the follower demo's pointing bounds, the browser's frame drawn with its fiducials and the
   #   independent client's poses with their truth: they assume the pipeline keeps up with the
   #   camera's 30 Hz, and AddressSanitizer makes it several times slower.
   left_out='Identifier\.RandomPointsAreNotABoard|CalibrationProblem\.(WithNoise|TwoCameras|ABadShot).*'
-  left_out+='|CalibrationPipeline\.BoardTour.*|FollowerDemo\.TurretCentresBase.*'
+  left_out+='|CalibrationPipeline\.BoardTour.*|CalibrationRig\.CeilingRigAtATenthOfAPixel'
+  left_out+='|FollowerDemo\.TurretCentresBase.*'
   left_out+='|FoxgloveBridgeTest\.(TheViewerDraws|AnIndependentClient).*'
   filter=(-LE install -E "^($left_out)\$")
 else
