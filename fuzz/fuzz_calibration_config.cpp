@@ -13,18 +13,14 @@
 
 #include <mocap/calibration/calibration_config.hpp>
 
+#include "rigid_transform.hpp"
 #include "scratch_files.hpp"
 
 namespace {
 
 using namespace mocap::calibration;
 
-// What a transform value or init must give: a rotation and a translation, all finite.
-bool is_rigid(const Eigen::Isometry3d& transform) {
-  const Eigen::Matrix3d r = transform.linear();
-  return transform.matrix().allFinite() &&
-         (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-9 && r.determinant() > 0;
-}
+using fuzz::is_rigid;
 
 }  // namespace
 

@@ -9,10 +9,10 @@
 #include <span>
 #include <vector>
 
-#include "cdr_format.hpp"
-#include "idl_schema.hpp"
 #include <mocap/generated_message_types.hpp>
 #include <mocap/message_type.hpp>
+#include "cdr_format.hpp"
+#include "idl_schema.hpp"
 
 namespace {
 

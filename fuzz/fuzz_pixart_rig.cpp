@@ -13,17 +13,14 @@
 #include <vector>
 
 #include "pixart_rig.hpp"
+#include "rigid_transform.hpp"
 #include "scratch_files.hpp"
 
 namespace {
 
 using namespace mocap::pixart;
 
-bool is_rigid(const Eigen::Isometry3d& transform) {
-  const Eigen::Matrix3d r = transform.linear();
-  return transform.matrix().allFinite() &&
-         (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-9 && r.determinant() > 0;
-}
+using fuzz::is_rigid;
 
 }  // namespace
 

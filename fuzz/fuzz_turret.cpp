@@ -9,17 +9,14 @@
 #include <string>
 #include <string_view>
 
+#include "rigid_transform.hpp"
 #include "turret_model.hpp"
 
 namespace {
 
 using namespace mocap::turret;
 
-bool is_rigid(const Eigen::Isometry3d& transform) {
-  const Eigen::Matrix3d r = transform.linear();
-  return transform.matrix().allFinite() &&
-         (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-9 && r.determinant() > 0;
-}
+using fuzz::is_rigid;
 
 bool is_usable(const Joint& joint) {
   return std::abs(joint.axis.norm() - 1) < 1e-9 && joint.min_rad < joint.max_rad &&
