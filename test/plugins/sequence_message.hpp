@@ -5,6 +5,10 @@
 #include <cstdint>
 #include <string>
 
+#include <unistd.h>
+
+#include <fmt/format.h>
+
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 namespace mocap::test {
@@ -26,8 +30,16 @@ inline mocap_msgs::msg::FiducialArray make_sequence_message(int32_t sequence) {
   return message;
 }
 
+// Names one object in one process: what the sender writes as the frame id, so that an in-process
+// subscriber can tell it received the publisher's object. The process id is part of it because
+// an address alone is not unique across processes (under AddressSanitizer, whose allocator maps
+// fixed regions, a remote copy often lands at the very same address).
+inline std::string object_identity(const void* object) {
+  return fmt::format("{}:{}", ::getpid(), reinterpret_cast<uintptr_t>(object));
+}
+
 // The content of `message` is what make_sequence_message() makes for its sequence number
-// (the frame id is ignored: the sender writes the message's address there).
+// (the frame id is ignored: the sender writes object_identity() there).
 inline bool is_intact(const mocap_msgs::msg::FiducialArray& message) {
   mocap_msgs::msg::FiducialArray expected = make_sequence_message(message.header().stamp().sec());
   return message.fiducials() == expected.fiducials() && message.header().stamp().nanosec() == 0;

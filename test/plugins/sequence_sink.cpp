@@ -71,10 +71,7 @@ class SequenceSink final : public Component {
     }
     last_ = std::max(last_, sequence);
     if (!is_intact(*message)) ++corrupt_;
-    if (message->header().frame_id() ==
-        fmt::format("{}", reinterpret_cast<uintptr_t>(message.get()))) {
-      ++same_object_;
-    }
+    if (message->header().frame_id() == object_identity(message.get())) ++same_object_;
     ++received_;
     if (log_every_ > 0 && received_ % log_every_ == 0) log().info("received {}", received_);
     if ((expect_ > 0 && received_ == expect_) || (finish_at_ >= 0 && sequence == finish_at_)) {

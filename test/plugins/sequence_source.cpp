@@ -48,8 +48,8 @@ class SequenceSource final : public Component {
     for (int i = 0; i < batch_ && (count_ == 0 || next_ < count_); ++i) {
       auto message =
           std::make_shared<mocap_msgs::msg::FiducialArray>(make_sequence_message(next_++));
-      // In-process subscribers receive this very object; they check its address.
-      message->header().frame_id(fmt::format("{}", reinterpret_cast<uintptr_t>(message.get())));
+      // In-process subscribers receive this very object; they check its identity.
+      message->header().frame_id(object_identity(message.get()));
       publisher_.publish(std::move(message));
     }
     if (count_ != 0 && next_ == count_ && !reported_) {
