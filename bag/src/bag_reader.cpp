@@ -121,6 +121,9 @@ struct FileState {
   std::vector<Row> rows;      // index mode, in reading order
   size_t next_row = 0;        // index mode
   sqlite::Statement payload;  // index mode: SELECT data ... WHERE id = ?
+  // Rows with a NULL timestamp (our writer's schema refuses them; another's may not): they
+  // cannot be placed in time, so they are skipped and counted, in both modes.
+  uint64_t untimed = 0;
 
   // The last message returned from this file (both modes), where a switch to salvage resumes.
   std::optional<std::pair<int64_t, int64_t>> position;
@@ -380,11 +383,14 @@ struct BagReader::State {
     } else {
       // Aggregates read the rows' first columns only, never the payloads' overflow pages.
       sqlite::Statement counts(file.db,
-                               "SELECT topic_id, COUNT(*), MIN(timestamp), MAX(timestamp) "
-                               "FROM messages GROUP BY topic_id");
+                               "SELECT topic_id, COUNT(timestamp), MIN(timestamp), MAX(timestamp), "
+                               "COUNT(*) - COUNT(timestamp) FROM messages GROUP BY topic_id");
+      file.untimed = 0;
       while (counts.step()) {
-        add(counts.column_int64(0), static_cast<uint64_t>(counts.column_int64(1)),
-            counts.column_int64(2), counts.column_int64(3));
+        const auto timed = static_cast<uint64_t>(counts.column_int64(1));
+        if (timed > 0)
+          add(counts.column_int64(0), timed, counts.column_int64(2), counts.column_int64(3));
+        file.untimed += static_cast<uint64_t>(counts.column_int64(4));
       }
     }
     for (size_t i = 0; i < per_topic.size(); ++i) metadata.topics[i].message_count += per_topic[i];
@@ -392,6 +398,9 @@ struct BagReader::State {
     for (const auto& [topic_id, n] : unknown) {
       problem(fmt::format("{}: {} messages of topic id {}, which the topics table lacks, skipped",
                           file.name, n, topic_id));
+    }
+    if (file.untimed > 0) {
+      problem(fmt::format("{}: {} messages without a timestamp, skipped", file.name, file.untimed));
     }
   }
 
@@ -414,8 +423,14 @@ struct BagReader::State {
   void build_index(FileState& file) {
     std::vector<Row> rows;
     sqlite::Statement all(file.db, "SELECT id, topic_id, timestamp FROM messages");
-    while (all.step())
+    file.untimed = 0;
+    while (all.step()) {
+      if (all.column_is_null(2)) {
+        ++file.untimed;
+        continue;
+      }
       rows.push_back({all.column_int64(2), all.column_int64(0), all.column_int64(1)});
+    }
     std::sort(rows.begin(), rows.end(),
               [](const Row& a, const Row& b) { return a.key() < b.key(); });
     file.rows = std::move(rows);
@@ -430,6 +445,7 @@ struct BagReader::State {
     file.next_row = 0;
     std::string reason = sqlite_reason(first_error);
     std::vector<Row> rows;
+    file.untimed = 0;
 
     std::optional<int64_t> max_id;
     try {
@@ -461,10 +477,13 @@ struct BagReader::State {
           range->bind(1, cursor);
           int n = 0;
           while (range->step()) {
-            rows.push_back(
-                {range->column_int64(2), range->column_int64(0), range->column_int64(1)});
-            cursor = rows.back().id;
+            cursor = range->column_int64(0);
             ++n;
+            if (range->column_is_null(2)) {
+              ++file.untimed;
+              continue;
+            }
+            rows.push_back({range->column_int64(2), cursor, range->column_int64(1)});
           }
           if (n < kRangeBatch) break;
         }

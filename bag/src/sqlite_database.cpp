@@ -66,6 +66,9 @@ Database::Database(const std::string& path, int flags, std::string name) : name_
   // the sqlite3 shell) holds its locks for moments: wait them out instead of failing with
   // "database is locked", which would end a recording.
   sqlite3_busy_timeout(db_, 5000);
+  // A bag may come from anywhere: its schema's views, triggers and defaults are not allowed to
+  // call functions with side effects (SQLite's advice for files of unknown origin).
+  sqlite3_db_config(db_, SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, nullptr);
 }
 
 Database::~Database() {

@@ -760,6 +760,36 @@ TEST(RosBags, OldSchemaDatabaseWithoutMetadataYamlOrIndex) {
   }
 }
 
+// Another writer's schema may let a row's timestamp be NULL: such a row cannot be placed in time.
+// It is skipped and said, the same with the timestamp index (streamed) and without (ordered in
+// memory), and the counts are of the messages that play.
+TEST(RosBags, RowsWithoutATimestampAreSkippedAndSaid) {
+  for (const bool with_index : {true, false}) {
+    SCOPED_TRACE(with_index ? "streamed" : "ordered in memory");
+    TempDir dir;
+    const fs::path file = dir / "untimed_0.db3";
+    {
+      RawDb db(file);
+      db.exec(
+          "CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT "
+          "NULL,serialization_format TEXT NOT NULL);"
+          "CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,timestamp "
+          "INTEGER, data BLOB NOT NULL);"
+          "INSERT INTO topics VALUES (7, '/scan', 'sensor_msgs/msg/LaserScan', 'cdr');");
+      if (with_index) db.exec("CREATE INDEX timestamp_idx ON messages (timestamp ASC);");
+      for (uint64_t seq : {1, 2, 3})
+        db.insert_message(7, kEpoch + 10 * seq, sequence_payload(seq, 100));
+      db.exec("UPDATE messages SET timestamp = NULL WHERE id = 2;");
+    }
+    BagReader reader(file.string());
+    ASSERT_EQ(reader.problems().size(), 1u) << ::testing::PrintToString(reader.problems());
+    EXPECT_EQ(reader.problems()[0], file.string() + ": 1 messages without a timestamp, skipped");
+    ASSERT_EQ(reader.metadata().topics.size(), 1u);
+    EXPECT_EQ(reader.metadata().topics[0].message_count, 2u);
+    EXPECT_EQ(read_sequences(reader).sequences, (std::vector<uint64_t>{1, 3}));
+  }
+}
+
 TEST(RosBags, SplitBagIsReadFileByFile) {
   // rosbag2 splits a recording into <name>_0.db3, _1.db3, ...: names sort by number.
   TempDir dir;

@@ -294,6 +294,7 @@ TEST(SlcanParser, RejectsMalformedMessagesWithTheReason) {
       {"t1231\r", "DLC 1 needs 2 characters after it (or 6 with a timestamp), got 0"},
       {"t1232DEZZ\r", "bad hex digit in data byte 1"},
       {"t1232DEAD12G4\r", "bad hex digit in the timestamp"},
+      {"t1232DEADEA60\r", "timestamp 0xEA60 is past a minute's last millisecond (0xEA5F)"},
       {"r12311\r", "DLC 1 needs 0 characters after it (or 4 with a timestamp), got 1"},
       {"t1\x01\xff\r", "too few"},
       {"t12\a", "message cut off by a BELL"},

@@ -77,6 +77,10 @@ TEST(PixartDecoder, DropsEmptyAndInvalidPointsAndCountsBadFrames) {
   EXPECT_EQ(decoder.stats().frames, 2u);
   EXPECT_TRUE(points.empty());
   EXPECT_THROW(PixartDecoder({0x7F0, 8}), std::invalid_argument);
+  // 8 · 2^29 boxes wraps to 0 in 32 bits: refused, not taken as "no IDs".
+  EXPECT_THROW(PixartDecoder({1, 1 << 29}), std::invalid_argument);
+  EXPECT_NO_THROW(PixartDecoder({0, 256}));
+  EXPECT_THROW(PixartDecoder({0, 257}), std::invalid_argument);
 }
 
 TEST(PixartDecoder, EncodeDecodeRoundTrip) {

@@ -6,7 +6,8 @@
 namespace mocap::pixart {
 
 PixartDecoder::PixartDecoder(PixartDecoderOptions options) : options_(options) {
-  if (options_.boxes < 1 || options_.base_id > 0x7FF ||
+  // At most 256 boxes of 8 IDs fit the 11-bit range; checked first so that 8·boxes cannot wrap.
+  if (options_.boxes < 1 || options_.boxes > 256 || options_.base_id > 0x7FF ||
       options_.base_id + 8u * static_cast<uint32_t>(options_.boxes) - 1 > 0x7FF) {
     throw std::invalid_argument("PixArt decoder: base_id " + std::to_string(options_.base_id) +
                                 " with " + std::to_string(options_.boxes) +

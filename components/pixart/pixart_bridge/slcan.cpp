@@ -15,6 +15,8 @@ constexpr char kBell = '\a';
 constexpr size_t kStandardIdDigits = 3;
 constexpr size_t kExtendedIdDigits = 8;
 constexpr size_t kTimestampDigits = 4;
+// The adaptor counts milliseconds within a minute: 0 .. 59,999.
+constexpr uint32_t kLastTimestamp = 0xEA5F;
 
 // Lawicel's "S<n>" bitrate codes.
 constexpr std::array<std::pair<int, char>, 9> kBitrateCodes{{{10000, '0'},
@@ -99,6 +101,10 @@ std::string decode_frame(std::string_view message, CanFrame& frame) {
   uint32_t timestamp = 0;
   if (rest > data_digits && !parse_hex(message.substr(header_length + data_digits), timestamp)) {
     return "bad hex digit in the timestamp";
+  }
+  if (timestamp > kLastTimestamp) {
+    return fmt::format("timestamp 0x{:04X} is past a minute's last millisecond (0x{:04X})",
+                       timestamp, kLastTimestamp);
   }
   return "";
 }
