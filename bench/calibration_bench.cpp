@@ -191,12 +191,13 @@ std::vector<std::vector<Eigen::Vector2d>> chessboard_views(int count, std::mt199
   std::vector<std::vector<Eigen::Vector2d>> views;
   while (static_cast<int>(views.size()) < count) {
     const double d = depth(random);
-    const Eigen::Vector3d at((u(random) - kChessCamera[2]) / kChessCamera[0] * d,
-                             (v(random) - kChessCamera[3]) / kChessCamera[1] * d, d);
+    const Eigen::Vector3d at{(u(random) - kChessCamera[2]) / kChessCamera[0] * d,
+                             (v(random) - kChessCamera[3]) / kChessCamera[1] * d, d};
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = (Eigen::AngleAxisd(spin(random), Eigen::Vector3d::UnitZ()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
+    const double about_z = spin(random), about_x = tilt(random), about_y = tilt(random);
+    pose.linear() = (Eigen::AngleAxisd(about_z, Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(about_x, Eigen::Vector3d::UnitX()) *
+                     Eigen::AngleAxisd(about_y, Eigen::Vector3d::UnitY()))
                         .toRotationMatrix();
     pose.translation() = at - pose.linear() * centre;
     std::vector<Eigen::Vector2d> view;
@@ -271,7 +272,7 @@ void chessboard_table(bool quick) {
       std::vector<cv::Point3f> object;
       for (size_t i = 0; i < board.size(); ++i) {
         const Eigen::Vector2d pixel =
-            views[frame][i] + Eigen::Vector2d(noise(random), noise(random));
+            views[frame][i] + Eigen::Vector2d{noise(random), noise(random)};
         shot.points.push_back(pixel);
         image.emplace_back(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()));
         object.emplace_back(static_cast<float>(board[i].x()), static_cast<float>(board[i].y()),

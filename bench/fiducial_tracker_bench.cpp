@@ -77,8 +77,8 @@ Frame render_frame(int count, std::mt19937& random) {
   for (int i = 0; i < count; ++i) {
     const double radius = 2.5 + 2.5 * unit(random);
     const double jitter = std::min(cell_width, cell_height) / 2 - radius - 8;
-    cv::Point2d centre(20 + cell_width * (i % columns + 0.5) + jitter * (2 * unit(random) - 1),
-                       20 + cell_height * (i / columns + 0.5) + jitter * (2 * unit(random) - 1));
+    cv::Point2d centre{20 + cell_width * (i % columns + 0.5) + jitter * (2 * unit(random) - 1),
+                       20 + cell_height * (i / columns + 0.5) + jitter * (2 * unit(random) - 1)};
     add_disc(image, centre, radius, 200 + 40 * unit(random));
     frame.centres.push_back(centre);
   }

@@ -41,11 +41,11 @@ Rig mounted(Rig rig, double shift_m, double turn_deg, uint64_t seed) {
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> unit(-1, 1);
   for (RigCamera& camera : rig.cameras) {
-    Eigen::Vector3d axis(unit(random), unit(random), unit(random));
+    Eigen::Vector3d axis{unit(random), unit(random), unit(random)};
     Eigen::AngleAxisd turn(turn_deg * M_PI / 180 * std::abs(unit(random)), axis.normalized());
     camera.world_from_camera.linear() = turn.toRotationMatrix() * camera.world_from_camera.linear();
     camera.world_from_camera.translation() +=
-        shift_m * Eigen::Vector3d(unit(random), unit(random), unit(random)) / std::sqrt(3.0);
+        shift_m * Eigen::Vector3d{unit(random), unit(random), unit(random)} / std::sqrt(3.0);
   }
   return rig;
 }

@@ -117,8 +117,8 @@ int main(int argc, char** argv) {
           // Keep the board's centre within the middle of the view, its whole extent inside.
           double half_width = 0.5 * 1280 / 914 * distance - 0.2;
           double half_height = 0.5 * 720 / 914 * distance - 0.2;
-          Eigen::Vector3d position((unit(random) - 0.5) * std::max(0.0, half_width),
-                                   (unit(random) - 0.5) * std::max(0.0, half_height), distance);
+          Eigen::Vector3d position{(unit(random) - 0.5) * std::max(0.0, half_width),
+                                   (unit(random) - 0.5) * std::max(0.0, half_height), distance};
           synthetic::Scene scene;
           scene.source = "sweep";
           scene.seed = ++frame_number;
@@ -194,8 +194,8 @@ int main(int argc, char** argv) {
       scene.distractors.blobs.push_back(dot);
     }
     if (i % 2 == 0) {
-      Eigen::Vector3d position((unit(random) - 0.5) * 1.0, (unit(random) - 0.5) * 0.5,
-                               1.0 + unit(random) * 2);
+      Eigen::Vector3d position{(unit(random) - 0.5) * 1.0, (unit(random) - 0.5) * 0.5,
+                               1.0 + unit(random) * 2};
       scene.objects.push_back(bench::static_board(
           database.constellations()[i % 8], position,
           {unit(random) * 360, unit(random) * 40 - 20, unit(random) * 40 - 20}));
@@ -230,8 +230,8 @@ int main(int argc, char** argv) {
     scene.source = "eight";
     scene.seed = ++frame_number;
     for (int b = 0; b < 8; ++b) {
-      Eigen::Vector3d position(-1.05 + 0.7 * (b % 4) + (unit(random) - 0.5) * 0.1,
-                               (b < 4 ? -0.3 : 0.3) + (unit(random) - 0.5) * 0.1, 2.5);
+      Eigen::Vector3d position{-1.05 + 0.7 * (b % 4) + (unit(random) - 0.5) * 0.1,
+                               (b < 4 ? -0.3 : 0.3) + (unit(random) - 0.5) * 0.1, 2.5};
       scene.objects.push_back(bench::static_board(
           database.constellations()[b], position,
           {unit(random) * 360, unit(random) * 30 - 15, unit(random) * 30 - 15}));

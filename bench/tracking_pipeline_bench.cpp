@@ -43,7 +43,7 @@ void add_loose_markers(cv::Mat& image, int count, std::mt19937& random) {
   std::uniform_real_distribution<double> x(40, image.cols - 40), y(40, image.rows - 40);
   int added = 0;
   for (int attempt = 0; attempt < 10000 && added < count; ++attempt) {
-    cv::Point2d centre(x(random), y(random));
+    cv::Point2d centre{x(random), y(random)};
     cv::Rect around(static_cast<int>(centre.x) - 12, static_cast<int>(centre.y) - 12, 25, 25);
     double max = 0;
     cv::minMaxLoc(image(around), nullptr, &max);

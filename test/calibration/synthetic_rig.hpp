@@ -19,6 +19,7 @@
 #include <mocap/calibration/calibration_problem.hpp>
 #include <mocap/calibration/lens_models.hpp>
 
+#include "../draw_order.hpp"
 #include "pixart_rig.hpp"
 
 namespace mocap::calibration::synthetic {
@@ -62,13 +63,15 @@ inline std::vector<Eigen::Isometry3d> spread_board_poses(int count, std::mt19937
   while (static_cast<int>(poses.size()) < count) {
     const double d = depth(random);
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = (Eigen::AngleAxisd(yaw(random), Eigen::Vector3d::UnitZ()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
-                     Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
+    // Last first (draw_order.hpp).
+    const double about_y = tilt(random), about_x = tilt(random), about_z = yaw(random);
+    pose.linear() = (Eigen::AngleAxisd(about_z, Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(about_x, Eigen::Vector3d::UnitX()) *
+                     Eigen::AngleAxisd(about_y, Eigen::Vector3d::UnitY()))
                         .toRotationMatrix();
     // The board's centre at the chosen place.
-    pose.translation() = Eigen::Vector3d(across(random) * d, down(random) * d, d) -
-                         pose.linear() * Eigen::Vector3d(0.131, 0.06, 0);
+    const double y = down(random) * d, x = across(random) * d;
+    pose.translation() = Eigen::Vector3d(x, y, d) - pose.linear() * Eigen::Vector3d(0.131, 0.06, 0);
     poses.push_back(pose);
   }
   return poses;
@@ -119,8 +122,8 @@ inline std::vector<RigCameraTruth> ceiling_cameras(uint32_t seed = 7) {
   std::uniform_real_distribution<double> unit(-1, 1);
   for (size_t i = 0; i < cameras.size(); ++i) {
     cameras[i].nominal = pixart::downward_camera_pose(positions[i], yaws_deg[i]);
-    const Eigen::Vector3d axis(unit(random), unit(random), unit(random));
-    const Eigen::Vector3d shift(unit(random), unit(random), unit(random));
+    const Eigen::Vector3d axis = mocap::test::draw_last_first<3>(unit, random);
+    const Eigen::Vector3d shift = mocap::test::draw_last_first<3>(unit, random);
     cameras[i].mounted = cameras[i].nominal;
     cameras[i].mounted.linear() =
         Eigen::AngleAxisd(1.0 * kDegree * std::abs(unit(random)), axis.normalized()) *
@@ -140,8 +143,9 @@ inline RigScenario ceiling_rig(const RigShotOptions& options = {}) {
   std::mt19937 random(options.seed);
   std::uniform_real_distribution<double> across(-1.35, 1.35), unit(-1, 1), angle(-M_PI, M_PI);
   for (int i = 0; i < options.frames; ++i) {
-    const Eigen::Vector3d centre(across(random), across(random),
-                                 options.height_m + options.height_spread_m * unit(random));
+    const double height = options.height_m + options.height_spread_m * unit(random);
+    const Eigen::Vector2d place = mocap::test::draw_last_first<2>(across, random);
+    const Eigen::Vector3d centre(place.x(), place.y(), height);
     const double heading = angle(random), tilt_axis = angle(random);
     const double tilt = options.max_tilt_deg * kDegree * std::sqrt(std::abs(unit(random)));
     Eigen::Isometry3d board = Eigen::Isometry3d::Identity();
@@ -196,7 +200,7 @@ inline CalibrationConfig rig_config(const RigScenario& scenario, double sigma_px
       Shot shot;
       shot.frame = frame;
       for (const Eigen::Vector2d& pixel : *pixels) {
-        shot.points.push_back(pixel + sigma_px * Eigen::Vector2d(noise(random), noise(random)));
+        shot.points.push_back(pixel + sigma_px * mocap::test::draw_last_first<2>(noise, random));
       }
       data.shots.push_back(std::move(shot));
     }

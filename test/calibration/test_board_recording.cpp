@@ -45,7 +45,7 @@ void light(std::vector<RawPoint>& points, int camera, const Eigen::Vector2d& pix
            int count, std::mt19937& random, double sigma_px = 0.5) {
   std::normal_distribution<double> noise(0, sigma_px);
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector2d measured = pixel + Eigen::Vector2d(noise(random), noise(random));
+    const Eigen::Vector2d measured = pixel + Eigen::Vector2d{noise(random), noise(random)};
     points.push_back({at(start_s + i / kRate_hz), camera,
                       Eigen::Vector2d(std::round(measured.x()), std::round(measured.y()))});
   }

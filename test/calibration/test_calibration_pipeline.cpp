@@ -34,6 +34,7 @@
 #include <mocap/calibration/pinhole_camera.hpp>
 
 #include "candump_recording.hpp"
+#include "draw_order.hpp"
 #include "pixart_box_simulator.hpp"
 #include "pixart_rig.hpp"
 #include "pixart_scene.hpp"
@@ -61,11 +62,11 @@ Rig mounted(Rig rig, double shift_m, double turn_deg, uint64_t seed) {
   std::uniform_real_distribution<double> unit(-1, 1);
   for (size_t i = 1; i < rig.cameras.size(); ++i) {
     RigCamera& camera = rig.cameras[i];
-    Eigen::Vector3d axis(unit(random), unit(random), unit(random));
+    const Eigen::Vector3d axis = test::draw_last_first<3>(unit, random);
     Eigen::AngleAxisd turn(turn_deg * kDegree * std::abs(unit(random)), axis.normalized());
     camera.world_from_camera.linear() = turn.toRotationMatrix() * camera.world_from_camera.linear();
     camera.world_from_camera.translation() +=
-        shift_m * Eigen::Vector3d(unit(random), unit(random), unit(random)) / std::sqrt(3.0);
+        shift_m * test::draw_last_first<3>(unit, random) / std::sqrt(3.0);
   }
   return rig;
 }

@@ -54,7 +54,7 @@ DataSpec shots_of(const std::string& camera, const std::vector<double>& intrinsi
     for (const Eigen::Vector3d& led : kBoard) {
       auto pixel = project(intrinsics, camera_from_reference * boards[frame] * led);
       if (!pixel) break;
-      shot.points.push_back(*pixel + Eigen::Vector2d(noise(random), noise(random)));
+      shot.points.push_back(*pixel + test::draw_last_first<2>(noise, random));
     }
     if (shot.points.size() == kBoard.size()) data.shots.push_back(std::move(shot));
   }
@@ -212,8 +212,10 @@ TEST(CalibrationProblem, UndeterminedParametersGetNoStandardDeviations) {
   data.object_points = kBoard;
   data.corners = {0, 1, 2, 3};
   for (size_t frame = 0; frame < 12; ++frame) {
-    const Eigen::Isometry3d board = Eigen::Translation3d(across(random), across(random), 1.5) *
-                                    Eigen::AngleAxisd(spin(random), Eigen::Vector3d::UnitZ());
+    const double heading = spin(random);  // last first (draw_order.hpp)
+    const Eigen::Vector2d centre = test::draw_last_first<2>(across, random);
+    const Eigen::Isometry3d board = Eigen::Translation3d(centre.x(), centre.y(), 1.5) *
+                                    Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ());
     Shot shot;
     shot.frame = frame;
     for (const Eigen::Vector3d& led : kBoard) {

@@ -91,13 +91,13 @@ std::vector<std::pair<cv::Vec3d, cv::Vec3d>> board_poses(int count, std::mt19937
                                             {-2 * kSquare, (kRows + 1) * kSquare, 0}};
   std::vector<std::pair<cv::Vec3d, cv::Vec3d>> poses;
   while (static_cast<int>(poses.size()) < count) {
-    const cv::Vec3d rvec(tilt(random), tilt(random), spin(random));
+    const cv::Vec3d rvec{tilt(random), tilt(random), spin(random)};
     cv::Matx33d r;
     cv::Rodrigues(rvec, r);
     const cv::Vec3d centre((kColumns - 1) * kSquare / 2, (kRows - 1) * kSquare / 2, 0);
     const double d = depth(random);
-    const cv::Vec3d at((u(random) - kCamera(0, 2)) / kCamera(0, 0) * d,
-                       (v(random) - kCamera(1, 2)) / kCamera(1, 1) * d, d);
+    const cv::Vec3d at{(u(random) - kCamera(0, 2)) / kCamera(0, 0) * d,
+                       (v(random) - kCamera(1, 2)) / kCamera(1, 1) * d, d};
     const cv::Vec3d tvec = at - r * centre;
     std::vector<cv::Point2d> corners;
     cv::projectPoints(outline, rvec, tvec, kCamera, kDistortion, corners);

@@ -38,8 +38,8 @@ void write_inputs(const test::TempDir& dir, int shots, const std::string& camera
           pixel.x() > 1023 || pixel.y() > 767) {
         break;
       }
-      points.push_back(
-          fmt::format("[{:.4f}, {:.4f}]", pixel.x() + noise(random), pixel.y() + noise(random)));
+      const Eigen::Vector2d measured = pixel + Eigen::Vector2d{noise(random), noise(random)};
+      points.push_back(fmt::format("[{:.4f}, {:.4f}]", measured.x(), measured.y()));
     }
     if (points.size() != board.size()) continue;
     frames += fmt::format("{}[{{\"camera\": \"cam0\", \"points\": [{}]}}]\n", made ? "," : "",

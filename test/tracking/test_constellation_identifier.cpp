@@ -10,6 +10,7 @@
 
 #include "constellation_identifier.hpp"
 #include "constellation_pose.hpp"
+#include "draw_order.hpp"
 #include "line_search.hpp"
 #include "planar_pose.hpp"
 #include "test_support.hpp"
@@ -68,7 +69,7 @@ Projected project(const calibration::CameraModel& camera, const ConstellationMod
       continue;
     }
     out.truth.push_back(static_cast<int>(out.pixels.size()));
-    out.pixels.push_back(*pixel + Eigen::Vector2d(noise(random), noise(random)));
+    out.pixels.push_back(*pixel + test::draw_last_first<2>(noise, random));
   }
   return out;
 }
@@ -126,10 +127,11 @@ TEST(LineSearch, NoiseAndManyPoints) {
   std::uniform_real_distribution<double> uniform(0, 1000);
   std::normal_distribution<double> noise(0, 0.2);
   std::vector<Eigen::Vector2d> points;
-  for (int i = 0; i < 100; ++i) points.emplace_back(uniform(random), uniform(random));
+  for (int i = 0; i < 100; ++i) points.push_back(test::draw_last_first<2>(uniform, random));
   // A planted line of 4 with 0.2 px noise.
   for (double t : {0.0, 0.3, 0.55, 1.0}) {
-    points.emplace_back(200 + 300 * t + noise(random), 700 - 150 * t + noise(random));
+    const Eigen::Vector2d error = test::draw_last_first<2>(noise, random);
+    points.push_back(Eigen::Vector2d(200 + 300 * t, 700 - 150 * t) + error);
   }
   auto groups = find_collinear_groups(points, {});
   bool planted = false;
@@ -166,7 +168,10 @@ TEST(Identifier, SeveralBoardsDistractorsAndAnOccludedSide) {
   std::mt19937 random(3);
   std::uniform_real_distribution<double> x(0, 1280), y(0, 720);
   std::vector<Eigen::Vector2d> pixels;
-  for (int i = 0; i < 10; ++i) pixels.emplace_back(x(random), y(random));  // distractors
+  for (int i = 0; i < 10; ++i) {
+    const double v = y(random), u = x(random);  // last first (draw_order.hpp)
+    pixels.emplace_back(u, v);
+  }  // distractors
   std::vector<std::vector<int>> truth;
   const auto& models = database.constellations();
   for (int b = 0; b < 8; ++b) {
@@ -235,10 +240,16 @@ TEST(Identifier, RandomPointsAreNotABoard) {
   size_t matched_lines = 0;
   for (int frame = 0; frame < 1000; ++frame) {
     std::vector<Eigen::Vector2d> points;
-    for (int i = 0; i < 40; ++i) points.emplace_back(x(random), y(random));
+    for (int i = 0; i < 40; ++i) {
+      const double v = y(random), u = x(random);  // last first (draw_order.hpp)
+      points.emplace_back(u, v);
+    }
     // Distractor lines: many collinear points at random spacings.
     for (int l = 0; l < 4; ++l) {
-      Eigen::Vector2d start(x(random), y(random)), direction(x(random) - 640, y(random) - 360);
+      const double direction_v = y(random) - 360, direction_u = x(random) - 640;
+      const double start_v = y(random), start_u = x(random);
+      const Eigen::Vector2d start(start_u, start_v);
+      Eigen::Vector2d direction(direction_u, direction_v);
       direction = direction.normalized() * 25;
       double t = 0;
       for (int k = 0; k < 5; ++k) {

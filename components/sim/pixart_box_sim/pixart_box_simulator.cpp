@@ -60,8 +60,10 @@ std::vector<CameraView> PixartBoxSimulator::views_at(double time_s) {
       if (!pixel) continue;
       Eigen::Vector2d measured = *pixel;
       if (options_.noise_px > 0) {
-        measured +=
-            options_.noise_px * Eigen::Vector2d(standard_normal(random_), standard_normal(random_));
+        // y before x, written out: a call's arguments are drawn in an order each compiler
+        // picks, and this keeps the one the recorded figures were made with (g++'s).
+        const double noise_y = standard_normal(random_), noise_x = standard_normal(random_);
+        measured += options_.noise_px * Eigen::Vector2d(noise_x, noise_y);
       }
       // The sensor reports whole pixels; x = 1023 is its "no point" value, so the last column
       // cannot be reported.
