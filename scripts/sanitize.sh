@@ -44,27 +44,24 @@ cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=
 if [ "$mode" = address ]; then
   cmake --build "$build" --parallel "$(nproc)"
   # All but the two packaging tests (label install): they check what the plain build installs
-  # and packages, and a sanitized build is never installed or packaged. And all but the tests
-  # whose expected figures hold for g++'s build only, until they are made independent of it:
-  # - tests on seeded synthetic data whose figures differ under clang (the identifier's random
-  #   scenes, the calibration problems, the board tour, the ceiling rig's chosen noise draw,
-  #   which does not converge in 500 iterations under clang); the likely cause: the data are drawn
-  #   as `Vector2d(noise(random), noise(random))`, C++ leaves the order of a call's arguments
-  #   open, and clang and g++ take them in opposite orders;
-  # - the follower demo's pointing bounds, the browser's frame drawn with its fiducials and the
-  #   independent client's poses with their truth: they assume the pipeline keeps up with the
-  #   camera's 30 Hz, and AddressSanitizer makes it several times slower.
-  left_out='Identifier\.RandomPointsAreNotABoard|CalibrationProblem\.(WithNoise|TwoCameras|ABadShot).*'
-  left_out+='|CalibrationPipeline\.BoardTour.*|CalibrationRig\.CeilingRigAtATenthOfAPixel'
-  left_out+='|FollowerDemo\.TurretCentresBase.*'
-  left_out+='|FoxgloveBridgeTest\.(TheViewerDraws|AnIndependentClient).*'
+  # and packages, and a sanitized build is never installed or packaged. And all but four tests
+  # that assume real-time speed, which AddressSanitizer takes several times from: the follower
+  # demo's pointing bounds, the browser's frame drawn with its fiducials and the independent
+  # client's poses with their truth (the pipeline keeping up with the camera's 30 Hz), and the
+  # calibration recorder's Ctrl-C in the third LED cycle (the simulated CAN adaptor skips the
+  # samples it is late for; under load a camera missed a whole cycle in 1 of 8 runs).
+  left_out='FollowerDemo\.TurretCentresBase.*|FoxgloveBridgeTest\.(TheViewerDraws|AnIndependentClient).*'
+  left_out+='|CalibrationRecordTool\.CtrlCStopsTheLiveRecording.*'
   filter=(-LE install -E "^($left_out)\$")
 else
   # The threaded parts: the runtime and both transports with their tests, the bag library
   # and tools, and the components the graph tests start in threads.
   cmake --build "$build" --parallel "$(nproc)" --target mocap_unit_tests \
-    mocap_integration_tests mocap_test_bag_tools mocap_test_bag_pipeline
-  filter=(-R "$tsan_tests")
+    mocap_integration_tests mocap_test_bag_tools mocap_test_bag_pipeline \
+    mocap_plugin_bag_recorder mocap_plugin_bag_player
+  # Not the two slow-subscriber loads (about a minute each, per implementation): their
+  # publisher blocks and wakes as under the stalling subscriber, which runs.
+  filter=(-R "$tsan_tests" -E "LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber ")
 fi
 $build_only && exit 0
 # The viewer tests' independent clients (pinned in test/viewer/package-lock.json).

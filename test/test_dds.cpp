@@ -164,8 +164,11 @@ TEST_P(ReliableUnderLoad, LosesNothingAcrossTenThousandMessages) {
     // implementation's window (Fast DDS lets 32 be unacknowledged, Cyclone DDS 500 kB and wakes
     // a waiting writer only when most are acknowledged) and on how the load batches the
     // acknowledgements (67 on a busy CI machine with Cyclone DDS, several hundred here).
+    // Nor is most of the 50 s: under ThreadSanitizer the publisher's own work takes a larger
+    // share (29.5 s blocked with Cyclone DDS). A publisher that buffered instead of waiting
+    // would block for none of it.
     EXPECT_GT(source.at("waited"), 0);
-    EXPECT_GT(source.at("blocked_ms"), 30000);
+    EXPECT_GT(source.at("blocked_ms"), 10000);
     EXPECT_NE(output.find("publisher waits for DDS subscriber(s) in 'sink'"), std::string::npos)
         << output;
   }
