@@ -33,7 +33,7 @@ inline mocap_msgs::msg::FiducialArray make_sequence_message(int32_t sequence) {
 // Names one object in one process: what the sender writes as the frame id, so that an in-process
 // subscriber can tell it received the publisher's object. The process id is part of it because
 // an address alone is not unique across processes (under AddressSanitizer, whose allocator maps
-// fixed regions, a remote copy often lands at the very same address).
+// fixed regions, a remote copy can land at the very same address).
 inline std::string object_identity(const void* object) {
   return fmt::format("{}:{}", ::getpid(), reinterpret_cast<uintptr_t>(object));
 }

@@ -168,10 +168,11 @@ TEST(Identifier, SeveralBoardsDistractorsAndAnOccludedSide) {
   std::mt19937 random(3);
   std::uniform_real_distribution<double> x(0, 1280), y(0, 720);
   std::vector<Eigen::Vector2d> pixels;
+  // Distractors, each drawn last first (draw_order.hpp).
   for (int i = 0; i < 10; ++i) {
-    const double v = y(random), u = x(random);  // last first (draw_order.hpp)
+    const double v = y(random), u = x(random);
     pixels.emplace_back(u, v);
-  }  // distractors
+  }
   std::vector<std::vector<int>> truth;
   const auto& models = database.constellations();
   for (int b = 0; b < 8; ++b) {

@@ -24,16 +24,22 @@ function check(ok, line) {
 }
 const state = (page) => page.evaluate(() => ({ ...window.viewerState }));
 // Waits until `condition(viewerState)` holds and returns the state of that very moment.
+// On a timeout the error carries the page's state, so that a failure says what was missing.
 const snapshot = async (page, condition, timeout) => {
-  const handle = await page.waitForFunction(
-    (source) => {
-      const s = window.viewerState;
-      return new Function("s", `return (${source})(s)`)(s) ? { ...s } : null;
-    },
-    condition.toString(),
-    { timeout },
-  );
-  return handle.jsonValue();
+  try {
+    const handle = await page.waitForFunction(
+      (source) => {
+        const s = window.viewerState;
+        return new Function("s", `return (${source})(s)`)(s) ? { ...s } : null;
+      },
+      condition.toString(),
+      { timeout },
+    );
+    return handle.jsonValue();
+  } catch (error) {
+    const { drawLatenciesMs, ...s } = (await state(page).catch(() => ({}))) ?? {};
+    throw new Error(`${error.message.split("\n")[0]} waiting for ${condition}; the page's state: ${JSON.stringify(s)}`);
+  }
 };
 
 try {
