@@ -420,17 +420,20 @@ struct BagReader::State {
     }
   }
 
+  // Keeps the row a "SELECT id, topic_id, timestamp" statement is on, or counts it untimed.
+  static void keep_row(const sqlite::Statement& row, FileState& file, std::vector<Row>& rows) {
+    if (row.column_is_null(2)) {
+      ++file.untimed;
+      return;
+    }
+    rows.push_back({row.column_int64(2), row.column_int64(0), row.column_int64(1)});
+  }
+
   void build_index(FileState& file) {
     std::vector<Row> rows;
     sqlite::Statement all(file.db, "SELECT id, topic_id, timestamp FROM messages");
     file.untimed = 0;
-    while (all.step()) {
-      if (all.column_is_null(2)) {
-        ++file.untimed;
-        continue;
-      }
-      rows.push_back({all.column_int64(2), all.column_int64(0), all.column_int64(1)});
-    }
+    while (all.step()) keep_row(all, file, rows);
     std::sort(rows.begin(), rows.end(),
               [](const Row& a, const Row& b) { return a.key() < b.key(); });
     file.rows = std::move(rows);
@@ -479,11 +482,7 @@ struct BagReader::State {
           while (range->step()) {
             cursor = range->column_int64(0);
             ++n;
-            if (range->column_is_null(2)) {
-              ++file.untimed;
-              continue;
-            }
-            rows.push_back({range->column_int64(2), cursor, range->column_int64(1)});
+            keep_row(*range, file, rows);
           }
           if (n < kRangeBatch) break;
         }
