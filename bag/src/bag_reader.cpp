@@ -36,12 +36,14 @@ int64_t clamped_difference(int64_t a, int64_t b) {
 
 namespace fs = std::filesystem;
 
-// Salvage: ids are probed one by one past a damaged stretch, up to the highest id known plus
-// this margin (a damaged file may not say how many rows it had)...
+// Salvage seeks past a damaged stretch up to the highest id known plus this margin (a damaged
+// file may not say how many rows it had)...
 constexpr int64_t kProbeMargin = 10000;
-// ...and never more than this many probes per file, so that a file whose every page is
-// garbage ends in seconds.
-constexpr int64_t kProbeBudget = 2'000'000;
+// ...one id at a time for this many seeks, ever longer steps after...
+constexpr int64_t kLinearProbes = 1024;
+// ...and never more than this many seeks per file, so that a file whose every page is garbage
+// ends in seconds. Each damaged stretch costs at most kLinearProbes plus twice 63.
+constexpr int64_t kProbeBudget = 200'000;
 constexpr int kRangeBatch = 4096;
 
 // "12:03:04.512", local time: what a user compares with the clock of the recording.
@@ -440,7 +442,8 @@ struct BagReader::State {
   }
 
   // Finds every row whose id, topic and timestamp can still be read: ranges of ids while the
-  // b-tree walks, single ids where it does not. One problem line per damaged stretch.
+  // b-tree walks, seeks past each damaged stretch to where it walks again. One problem line per
+  // damaged stretch.
   void salvage(FileState& file, const sqlite::SqliteError& first_error) {
     file.indexed = true;
     file.cursor = {};
@@ -457,88 +460,126 @@ struct BagReader::State {
     } catch (const sqlite::SqliteError&) {
     }
 
-    std::optional<sqlite::Statement> range, point;
+    std::optional<sqlite::Statement> range, seek;
     try {
       range.emplace(file.db, fmt::format("SELECT id, topic_id, timestamp FROM messages WHERE "
                                          "id > ? ORDER BY id LIMIT {}",
                                          kRangeBatch));
-      point.emplace(file.db, "SELECT id, topic_id, timestamp FROM messages WHERE id = ?");
+      seek.emplace(
+          file.db,
+          "SELECT id, topic_id, timestamp FROM messages WHERE id >= ? ORDER BY id LIMIT 1");
     } catch (const sqlite::SqliteError& e) {
       problem(fmt::format("{}: no message readable: {}", file.name, sqlite_reason(e)));
       return;
     }
+    static constexpr const char* kOutOfOrder = "the table's row ids are out of order";
+    // Seeks the first row at or after `id`; on kRow, `seek` stays on it.
+    enum class Seek { kRow, kEnd, kDamaged };
+    auto seek_from = [&](int64_t id) {
+      try {
+        seek->reset();
+        seek->bind(1, id);
+        if (!seek->step()) return Seek::kEnd;
+        if (seek->column_int64(0) >= id) return Seek::kRow;
+        reason = kOutOfOrder;
+        return Seek::kDamaged;
+      } catch (const sqlite::SqliteError& e) {
+        reason = sqlite_reason(e);
+        return Seek::kDamaged;
+      }
+    };
+    // Where a problem line places a row: its time, or its id if it has none.
+    auto place = [&](int64_t id) {
+      return !rows.empty() && rows.back().id == id ? time_of_day(rows.back().timestamp)
+                                                   : fmt::format("id {}", id);
+    };
 
     int64_t cursor = 0;  // rosbag2's ids start at 1
     int64_t probes = 0;
-    uint64_t reported_lost = 0;  // in the stretches reported so far
-    bool budget_spent = false;
+    uint64_t reported_lost = 0;        // in the stretches reported so far
+    std::optional<int64_t> last_kept;  // the id of the last row read before a stretch
     for (;;) {
       // Fast: ranges of ids while the b-tree can be walked.
       try {
-        for (;;) {
+        for (bool more = true; more;) {
           range->reset();
           range->bind(1, cursor);
           int n = 0;
-          while (range->step()) {
-            cursor = range->column_int64(0);
-            ++n;
-            keep_row(*range, file, rows);
+          while (more && range->step()) {
+            // A damaged b-tree can give ids out of order: reading on from a smaller id would
+            // read the same rows again.
+            if (const int64_t id = range->column_int64(0); id > cursor) {
+              cursor = id;
+              ++n;
+              keep_row(*range, file, rows);
+              last_kept = cursor;
+            } else {
+              reason = kOutOfOrder;
+              more = false;
+            }
           }
-          if (n < kRangeBatch) break;
+          more = more && n == kRangeBatch;
         }
       } catch (const sqlite::SqliteError& e) {
         reason = sqlite_reason(e);
       }
       range->reset();
+      const std::string before = last_kept ? place(*last_kept) : std::string();
 
-      // Slow: single ids past the damage, until one reads again.
+      // Slow: seeks past the damage until one walks again; a seek steps over absent ids. One
+      // id at a time first, as a damaged leaf page hides a few hundred ids at most; then ever
+      // longer steps, so that a damaged interior page or a corrupt max(id) costs tens of seeks,
+      // and a binary search back to where the damage ends, so that no row past it is skipped.
       const int64_t upper =
           clamped_sum(std::max({cursor, max_id.value_or(0),
                                 static_cast<int64_t>(file.expected_count.value_or(0))}),
                       kProbeMargin);
-      int64_t lost = 0, first_lost = 0;
-      bool found = false;
-      for (int64_t id = cursor; id < upper;) {
-        ++id;  // incremented first, so that an upper bound of INT64_MAX cannot overflow it
-        if (++probes > kProbeBudget) {
-          budget_spent = true;
-          break;
-        }
-        try {
-          point->reset();
-          point->bind(1, id);
-          if (point->step()) {
-            rows.push_back(
-                {point->column_int64(2), point->column_int64(0), point->column_int64(1)});
-            point->reset();
-            found = true;
-            break;
-          }
-        } catch (const sqlite::SqliteError& e) {
-          if (lost++ == 0) first_lost = id;
-          reason = sqlite_reason(e);
+      int64_t damaged = cursor;      // the last id whose seek failed
+      std::optional<int64_t> walks;  // the first id whose seek did not fail
+      int64_t step = 1;
+      for (int64_t id = cursor, tries = 0; id < upper && !walks && probes < kProbeBudget;) {
+        id = upper - id > step ? id + step : upper;
+        ++probes;
+        if (seek_from(id) != Seek::kDamaged) {
+          walks = id;
+        } else {
+          damaged = id;
+          if (++tries >= kLinearProbes && step <= INT64_MAX / 2) step *= 2;
         }
       }
-      point->reset();
-      const bool before_any = rows.empty() || (found && rows.size() == 1);
-      if (found) {
-        const Row& next = rows.back();
+      while (walks && *walks - damaged > 1 && probes < kProbeBudget) {
+        ++probes;
+        const int64_t middle = damaged + (*walks - damaged) / 2;
+        if (seek_from(middle) != Seek::kDamaged) {
+          walks = middle;
+        } else {
+          damaged = middle;
+        }
+      }
+      // Again where the damage ends, to read the row there.
+      const bool row_after = walks && seek_from(*walks) == Seek::kRow;
+      const int64_t lost = walks ? *walks - cursor - 1 : 0;
+      if (row_after) {
+        const int64_t next = seek->column_int64(0);
+        keep_row(*seek, file, rows);
+        seek->reset();
         if (lost > 0) {
           reported_lost += static_cast<uint64_t>(lost);
-          problem(before_any
+          problem(before.empty()
                       ? fmt::format("{}: messages before {} ({}, ids {}-{}) unreadable: {}",
-                                    file.name, time_of_day(next.timestamp), lost, first_lost,
-                                    next.id - 1, reason)
+                                    file.name, place(next), lost, cursor + 1, *walks - 1, reason)
                       : fmt::format("{}: messages between {} and {} ({}, ids {}-{}) unreadable: {}",
-                                    file.name, time_of_day(rows[rows.size() - 2].timestamp),
-                                    time_of_day(next.timestamp), lost, first_lost, next.id - 1,
+                                    file.name, before, place(next), lost, cursor + 1, *walks - 1,
                                     reason));
         }
-        cursor = next.id;
+        cursor = next;
+        last_kept = next;
         continue;
       }
-      // Nothing readable after `cursor`: damaged to the end, or simply the end.
-      if (lost > 0 || budget_spent) {
+      seek->reset();
+      // Nothing readable after `cursor`: damaged to the end, or simply the end (also where the
+      // last row read has the largest id there can be).
+      if (lost > 0 || (!walks && cursor < upper)) {
         std::string how_many;
         if (max_id && *max_id > cursor) {
           how_many = fmt::format("about {}", *max_id - cursor);
@@ -547,10 +588,10 @@ struct BagReader::State {
         } else {
           how_many = "how many is unknown";
         }
-        problem(rows.empty()
+        problem(before.empty()
                     ? fmt::format("{}: no message readable ({}): {}", file.name, how_many, reason)
-                    : fmt::format("{}: messages after {} ({}) unreadable: {}", file.name,
-                                  time_of_day(rows.back().timestamp), how_many, reason));
+                    : fmt::format("{}: messages after {} ({}) unreadable: {}", file.name, before,
+                                  how_many, reason));
       } else if (file.expected_count && *file.expected_count > rows.size() + reported_lost) {
         // The walk ended cleanly short of what metadata.yaml counted: the damage hid rows
         // without an error to show for it.

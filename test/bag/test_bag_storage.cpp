@@ -1137,6 +1137,68 @@ TEST(ReadDamage, GarbageInTheMiddleIsSkipped) {
   EXPECT_EQ(back.sequences.back(), kTotal);
 }
 
+// SQLite's variable-length integer: big-endian 7-bit groups, the ninth byte whole.
+uint64_t sqlite_varint(const std::string& bytes, size_t& at) {
+  uint64_t value = 0;
+  for (int i = 0; i < 9; ++i) {
+    const auto byte = static_cast<uint8_t>(bytes.at(at++));
+    if (i == 8) return (value << 8) | byte;
+    value = (value << 7) | (byte & 0x7f);
+    if ((byte & 0x80) == 0) break;
+  }
+  return value;
+}
+
+TEST(ReadDamage, ALongDamagedStretchLosesExactlyTheRowsOfItsPages) {
+  // Thousands of consecutive ids on garbled leaf pages, more than salvage seeks one by one:
+  // it must step past them and find where they end to the id.
+  TempDir dir;
+  const fs::path bag = dir / "long";
+  constexpr uint64_t kTotal = 20000;
+  write_sequence_bag(bag, kTotal, [](uint64_t) { return 16; });
+  const fs::path db = db_of(bag);
+  std::string bytes = read_file(db);
+  const size_t page = (static_cast<uint8_t>(bytes[16]) << 8) | static_cast<uint8_t>(bytes[17]);
+  auto u16 = [&](size_t at) {
+    return static_cast<size_t>((static_cast<uint8_t>(bytes[at]) << 8) |
+                               static_cast<uint8_t>(bytes[at + 1]));
+  };
+  // The message table's leaf pages (flag 13, past the topics table's) by their first row id.
+  std::map<uint64_t, size_t> leaf_at;
+  for (size_t at = page; at + page <= bytes.size(); at += page) {
+    if (bytes[at] != 13 || u16(at + 3) == 0) continue;
+    size_t cell = at + u16(at + 8);
+    sqlite_varint(bytes, cell);  // payload size
+    leaf_at[sqlite_varint(bytes, cell)] = at;
+  }
+  ASSERT_GT(leaf_at.size(), 50u);
+  // Consecutive leaves from the middle of the ids, 3000 rows or more.
+  auto first = leaf_at.lower_bound(kTotal / 3);
+  auto end = first;
+  while (end != leaf_at.end() && end->first - first->first < 3000) ++end;
+  ASSERT_NE(end, leaf_at.end());
+  const uint64_t lost_from = first->first, lost_to = end->first - 1;
+  std::mt19937 random(11);
+  for (auto leaf = first; leaf != end; ++leaf) {
+    for (size_t i = leaf->second; i < leaf->second + page; ++i)
+      bytes[i] = static_cast<char>(random());
+  }
+  write_file(db, bytes);
+
+  BagReader reader(bag.string());
+  ReadBack back = read_sequences(reader);
+  EXPECT_EQ(back.damaged, 0u) << "a payload came back altered";
+  std::vector<uint64_t> expected;
+  for (uint64_t seq = 1; seq <= kTotal; ++seq) {
+    if (seq < lost_from || seq > lost_to) expected.push_back(seq);
+  }
+  EXPECT_EQ(back.sequences, expected);
+  ASSERT_EQ(reader.problems().size(), 1u);
+  EXPECT_THAT(reader.problems()[0],
+              HasSubstr(fmt::format("({}, ids {}-{}) unreadable", lost_to - lost_from + 1,
+                                    lost_from, lost_to)));
+}
+
 TEST(ReadDamage, RandomBytesAreNotABag) {
   TempDir dir;
   std::string noise(64 * 1024, '\0');
