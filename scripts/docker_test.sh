@@ -7,7 +7,8 @@
 # IMAGE: test that image instead of building one (kept at the end).
 # Starts a Docker engine if none answers (and stops only that one at the end), makes the
 # debian:bookworm and debian:bookworm-slim base images with debootstrap if they are missing (no
-# registry is needed), builds the image (docker/Dockerfile) and checks it as a user would: at
+# registry is needed), builds the image (docker/Dockerfile; from build/'s package where the
+# tree is built, compiling in the container where it is not) and checks it as a user would: at
 # most 400 MB, runs as the user mocap, `mocap_launch launch_yaml/mobile_mocap_demo.yaml` in it
 # publishes poses. Then starts docker/compose.yaml's four hosts and runs the phases:
 #   start         poses reach the checker container; `mocap_topic list` in another container
@@ -87,9 +88,21 @@ done
 if [ $# -eq 0 ]; then
   build_start=$SECONDS
   built_image=$image
-  docker build -f docker/Dockerfile -t "$image" . > "$work/build.log" 2>&1 ||
+  build_args=()
+  how="compiled in the container"
+  # A built tree (scripts/test.sh's build/): its package goes into the image as it is, the
+  # binaries the tests ran, instead of a second compilation in the container.
+  if [ -f build/CMakeCache.txt ]; then
+    rm -f build/mocap-graph_*_amd64.deb
+    (cd build && cpack -G DEB -D CPACK_COMPONENTS_ALL=runtime) > "$work/cpack.log" 2>&1 ||
+      { tail -20 "$work/cpack.log"; fail "cpack in build/"; }
+    deb=$(ls build/mocap-graph_*_amd64.deb)
+    build_args=(--build-arg "MOCAP_DEB=$deb")
+    how="from $deb"
+  fi
+  docker build -f docker/Dockerfile "${build_args[@]}" -t "$image" . > "$work/build.log" 2>&1 ||
     { tail -40 "$work/build.log"; fail "docker build"; }
-  echo "image: $image built in $((SECONDS - build_start)) s"
+  echo "image: $image built $how in $((SECONDS - build_start)) s"
 fi
 size_mb=$(($(docker image inspect -f '{{.Size}}' "$image") / 1000000))
 echo "image: $image, $size_mb MB"
