@@ -32,7 +32,7 @@ pid_t start_child(const std::filesystem::path& hook_file,
   if (pid == 0) {
     close(ready[0]);
     ShutdownSignal::install();
-    ShutdownSignal::ForcedExitHook hook([&] { std::ofstream(hook_file) << "written\n"; });
+    ForcedExitHook hook([&] { std::ofstream(hook_file) << "written\n"; });
     char byte = 'r';
     if (write(ready[1], &byte, 1) != 1) _exit(3);
     if (!ShutdownSignal::wait(std::nullopt)) _exit(4);

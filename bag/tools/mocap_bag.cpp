@@ -87,7 +87,7 @@ int record(const std::string& directory, const std::set<std::string>& wanted, bo
   mocap::bag::Recorder recorder(directory);
   // A second stop request well after the first (the graceful stop hangs) still leaves
   // metadata.yaml agreeing with what the database holds.
-  mocap::ShutdownSignal::ForcedExitHook metadata_first([&recorder] {
+  mocap::ForcedExitHook metadata_first([&recorder] {
     try {
       recorder.write_committed_metadata();
     } catch (const mocap::bag::BagError& e) {

@@ -118,7 +118,7 @@ int supervise(const std::vector<ChildProcess>& specs,
   ShutdownSignal::install();
   std::vector<Child> children(specs.size());
   int result = 0;
-  bool stopping = false;
+  bool stopping = false, forcing = false;
   auto now = std::chrono::steady_clock::now;
   auto kill_deadline = std::chrono::steady_clock::time_point::max();
   auto stop_all = [&](std::string_view why) {
@@ -182,15 +182,25 @@ int supervise(const std::vector<ChildProcess>& specs,
     if (!any_running) break;
     if (ShutdownSignal::received()) stop_all("stopping all groups");
     if (now() >= deadline) stop_all("time is up; stopping all groups");
+    // A group still running kStopGrace after the request gets a second one, which forces its
+    // exit after its ForcedExitHooks (a recorder's metadata); one that has not exited when
+    // those had their time is killed.
     if (now() >= kill_deadline) {
       for (Child& child : children) {
-        if (child.running) {
-          say(fmt::format("group '{}' did not stop within {} s; killing it", child.spec->name,
+        if (!child.running) continue;
+        if (!forcing) {
+          say(fmt::format("group '{}' did not stop within {} s; forcing its exit", child.spec->name,
                           kStopGrace.count()));
+          kill(child.pid, SIGTERM);
+        } else {
+          say(fmt::format("group '{}' did not exit when forced; killing it", child.spec->name));
           kill(child.pid, SIGKILL);
         }
       }
-      kill_deadline = std::chrono::steady_clock::time_point::max();
+      kill_deadline = forcing
+                          ? std::chrono::steady_clock::time_point::max()
+                          : now() + std::chrono::seconds(ShutdownSignal::kForcedExitSeconds + 1);
+      forcing = true;
     }
   }
   for (Child& child : children) {

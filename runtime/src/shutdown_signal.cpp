@@ -131,13 +131,13 @@ void ShutdownSignal::wake() {
   [[maybe_unused]] ssize_t ignored = write(pipe_fds[1], &byte, 1);
 }
 
-ShutdownSignal::ForcedExitHook::ForcedExitHook(std::function<void()> hook) {
+ForcedExitHook::ForcedExitHook(std::function<void()> hook) {
   std::lock_guard lock(hooks_mutex);
   id_ = next_hook_id++;
   hooks.emplace(id_, std::move(hook));
 }
 
-ShutdownSignal::ForcedExitHook::~ForcedExitHook() {
+ForcedExitHook::~ForcedExitHook() {
   std::lock_guard lock(hooks_mutex);
   hooks.erase(id_);
 }

@@ -5,13 +5,15 @@
 #include <functional>
 #include <optional>
 
+#include <mocap/forced_exit_hook.hpp>
+
 namespace mocap {
 
 // The first SIGINT or SIGTERM asks the process to stop gracefully. Signals within
 // kEscalationDelay of the first are the same request delivered twice (`timeout` and
 // process-group kills signal the process and its group in the same instant; `docker stop`,
 // Ctrl-C on a terminal with a supervisor) and are ignored. A signal after that, while the
-// graceful stop still runs, forces the exit: the forced-exit hooks run (at most
+// graceful stop still runs, forces the exit: the ForcedExitHooks run (at most
 // kForcedExitSeconds, then SIGALRM ends the process) and the process exits with status 130.
 class ShutdownSignal {
  public:
@@ -27,20 +29,6 @@ class ShutdownSignal {
   static bool wait(std::optional<std::chrono::steady_clock::duration> timeout);
   // Wakes wait() without a signal (a component asked to stop).
   static void wake();
-
-  // What must be done even when the exit is forced (a bag's metadata written), while this
-  // object lives. The hook runs on a thread of its own while other threads may be anywhere:
-  // it takes only what is safe to take from any thread.
-  class ForcedExitHook {
-   public:
-    explicit ForcedExitHook(std::function<void()> hook);
-    ~ForcedExitHook();
-    ForcedExitHook(const ForcedExitHook&) = delete;
-    ForcedExitHook& operator=(const ForcedExitHook&) = delete;
-
-   private:
-    uint64_t id_;
-  };
 };
 
 }  // namespace mocap

@@ -4,9 +4,15 @@
 // get the very poses of the live run back. Both runs use the launch files in launch_yaml/.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+
+#include <chrono>
 #include <map>
+#include <optional>
+#include <thread>
 
 #include <fmt/format.h>
+#include <mocap/bag/bag_metadata.hpp>
 #include <mocap/bag/bag_reader.hpp>
 
 #include "test_support.hpp"
@@ -64,6 +70,73 @@ TEST(BagPipeline, ReplayingARecordedRunGivesItsPosesBack) {
   for (size_t i = 0; i < live_poses.size(); ++i) {
     EXPECT_EQ(replayed_poses[i], live_poses[i]) << "pose message " << i;
   }
+}
+
+// A recording whose process's graceful stop hangs (a callback that never returns) ends by a
+// forced exit, which destroys nothing: the recorder's forced-exit hook still writes
+// metadata.yaml, and it counts what the database holds. `groups` 1: mocap_launch runs the group
+// itself and gets the second signal from the test; 2: the recorder's group is a child, which the
+// launcher forces once it has not stopped in 10 s.
+void expect_forced_exit_keeps_the_metadata(int groups, int slot) {
+  test::TempDir dir;
+  const std::filesystem::path bag = dir / "bag";
+  const std::string source = R"(      - plugin: sequence_source
+        name: source
+        parameters: {count: 0, batch: 10, period_s: 0.01, subscribers: 0}
+)";
+  const std::string recorder = fmt::format(R"(      - plugin: bag_recorder
+        name: recorder
+        parameters: {{output: "{}", topics: [/test/sequence]}}
+      - plugin: stuck_callback
+        name: stuck
+)",
+                                           bag.string());
+  test::write_file(dir / "launch.yaml",
+                   groups == 1 ? "groups:\n  - name: all\n    components:\n" + source + recorder
+                               : "groups:\n  - name: source\n    components:\n" + source +
+                                     "  - name: recording\n    components:\n" + recorder);
+  test::ChildProcess launch({launcher(), (dir / "launch.yaml").string()},
+                            {{"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()},
+                             {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))}},
+                            dir / "launch.log");
+  ASSERT_TRUE(launch.wait_for_output("recording 1 topic(s)", std::chrono::seconds(60)))
+      << launch.output();
+  // Some commits (every 100 ms) before the stop.
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  launch.signal(SIGTERM);
+  if (groups == 1) {
+    EXPECT_EQ(launch.wait(std::chrono::seconds(2)), std::nullopt) << "the stop did not hang";
+    launch.signal(SIGTERM);
+  }
+  const std::optional<int> status = launch.wait(std::chrono::seconds(60));
+  ASSERT_NE(status, std::nullopt) << launch.output();
+  EXPECT_NE(*status, 0) << "a forced exit is not a clean stop";
+  EXPECT_NE(launch.output().find("second stop request: forcing the exit"), std::string::npos)
+      << launch.output();
+  if (groups == 2) {
+    EXPECT_NE(launch.output().find("group 'recording' did not stop within 10 s; forcing its exit"),
+              std::string::npos)
+        << launch.output();
+  }
+
+  const BagMetadata metadata =
+      parse_metadata_yaml(test::read_file(bag / "metadata.yaml"), "metadata.yaml");
+  BagReader reader(bag.string());
+  uint64_t in_database = 0;
+  BagMessage message;
+  while (reader.next(message)) ++in_database;
+  EXPECT_GT(in_database, 20u) << launch.output();
+  EXPECT_EQ(metadata.message_count, in_database);
+  ASSERT_EQ(metadata.topics.size(), 1u);
+  EXPECT_EQ(metadata.topics[0].message_count, in_database);
+}
+
+TEST(BagRecorderComponent, AForcedExitStillWritesTheMetadata) {
+  expect_forced_exit_keeps_the_metadata(1, 48);
+}
+
+TEST(BagRecorderComponent, ALauncherForcesAGroupThatDoesNotStop) {
+  expect_forced_exit_keeps_the_metadata(2, 49);
 }
 
 }  // namespace

@@ -3,12 +3,16 @@
 // writer thread; the others arrive over DDS. Storage and crash safety: mocap/bag/recorder.hpp.
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+#include <mocap/bag/bag_error.hpp>
 #include <mocap/bag/recorder.hpp>
 #include <mocap/component.hpp>
+#include <mocap/forced_exit_hook.hpp>
 
 namespace mocap::bag {
 namespace {
@@ -69,6 +73,14 @@ class BagRecorder final : public Component {
     options.writer.commit_interval =
         std::chrono::milliseconds(param<int64_t>("commit_interval_ms"));
     recorder_ = std::make_unique<Recorder>(output, options);
+    // A forced exit destroys nothing: metadata.yaml is written from what is committed.
+    metadata_first_.emplace([recorder = recorder_.get()] {
+      try {
+        recorder->write_committed_metadata();
+      } catch (const BagError& e) {
+        fmt::print(stderr, "bag_recorder: {}\n", e.what());
+      }
+    });
     for (const KnownTopic* topic : recorded) {
       const MessageType* type = topic->type;
       const uint32_t id =
@@ -106,6 +118,7 @@ class BagRecorder final : public Component {
   }
 
   std::unique_ptr<Recorder> recorder_;
+  std::optional<ForcedExitHook> metadata_first_;  // gone before the recorder
   bool reported_ = false;
 };
 
