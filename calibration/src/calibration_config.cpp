@@ -335,7 +335,8 @@ class ConfigReader {
     const Json& data = reader_.required(root, "data", top);
     reader_.array(data, top / "data", "a list of data entries");
     for (size_t i = 0; i < data.size(); ++i) {
-      config.data.push_back(data_entry(data[i], (top / "data")[i], config));
+      DataSpec entry = data_entry(data[i], (top / "data")[i], config);
+      config.data.push_back(std::move(entry));
     }
     return config;
   }
@@ -406,15 +407,21 @@ class ConfigReader {
     return spec;
   }
 
-  DataSpec data_entry(const Json& map, const KeyPath& path, const CalibrationConfig& config) {
+  DataSpec data_entry(const Json& map, const KeyPath& path, CalibrationConfig& config) {
     reader_.object(map, path, "a data entry is an object");
-    reader_.check_keys(map, path,
-                       {"type", "camera", "transform_chain", "init", "image_width", "image_height",
-                        "data_file", "object"});
     DataSpec spec;
     spec.type = reader_.text(reader_.required(map, "type", path), path / "type");
-    if (spec.type != "ir_data") {
-      reader_.fail(path / "type", "unknown data type '" + spec.type + "' (ir_data)");
+    // "parameters" and "draw_scale" (read by visgeom's draw_improved flag) are visgeom's.
+    if (spec.type == "ir_data") {
+      reader_.check_keys(map, path,
+                         {"type", "camera", "transform_chain", "init", "image_width",
+                          "image_height", "data_file", "object", "parameters", "draw_scale"});
+    } else if (spec.type == "images") {
+      reader_.check_keys(map, path,
+                         {"type", "camera", "transform_chain", "init", "object", "parameters",
+                          "images", "draw_scale"});
+    } else {
+      reader_.fail(path / "type", "unknown data type '" + spec.type + "' (ir_data, images)");
     }
     spec.camera = reader_.text(reader_.required(map, "camera", path), path / "camera");
     std::vector<std::string> camera_names;
@@ -425,6 +432,13 @@ class ConfigReader {
     }
     const TransformSpec& per_shot = chain(map, path, config, spec);
     init(map, path, per_shot, spec);
+    flags(map, path, spec, config);
+    if (map.contains("draw_scale")) reader_.number(map["draw_scale"], path / "draw_scale");
+    if (spec.type == "images") {
+      board(reader_.required(map, "object", path), path / "object", spec);
+      images(reader_.required(map, "images", path), path / "images", spec);
+      return spec;
+    }
     spec.image_width = image_size(map, "image_width", path, kDefaultImageWidth);
     spec.image_height = image_size(map, "image_height", path, kDefaultImageHeight);
     object(reader_.required(map, "object", path), path / "object", spec);
@@ -490,6 +504,86 @@ class ConfigReader {
       return;
     }
     spec.init = reader_.transform(*found, path / "init");
+  }
+
+  // visgeom's "parameters": the flags that mean something here go to `spec.flags`, the others
+  // once to `config.ignored_flags`; a leading '_' switches one off.
+  void flags(const Json& map, const KeyPath& path, DataSpec& spec,
+             CalibrationConfig& config) const {
+    static const std::vector<std::string> kHonoured = {"improve_detection", "show_outliers"};
+    static const std::vector<std::string> kIgnored = {"check_extraction",    "user_guided",
+                                                      "do_not_solve",        "do_not_solve_global",
+                                                      "save_outlire_images", "draw_improved"};
+    auto found = map.find("parameters");
+    if (found == map.end()) return;
+    const KeyPath list_path = path / "parameters";
+    reader_.array(*found, list_path, "a list of visgeom flags (\"show_outliers\", ...)");
+    for (size_t i = 0; i < found->size(); ++i) {
+      const std::string flag = reader_.text((*found)[i], list_path[i]);
+      const std::string name = flag.starts_with('_') ? flag.substr(1) : flag;
+      const bool honoured = std::find(kHonoured.begin(), kHonoured.end(), name) != kHonoured.end();
+      if (!honoured && std::find(kIgnored.begin(), kIgnored.end(), name) == kIgnored.end()) {
+        std::vector<std::string> known = kHonoured;
+        known.insert(known.end(), kIgnored.begin(), kIgnored.end());
+        reader_.fail(list_path[i],
+                     "unknown visgeom flag '" + name + "'" + did_you_mean(name, known, "flags"));
+      }
+      if (flag.starts_with('_')) continue;
+      if (honoured) {
+        if (!spec.has_flag(name)) spec.flags.push_back(name);
+      } else if (std::find(config.ignored_flags.begin(), config.ignored_flags.end(), name) ==
+                 config.ignored_flags.end()) {
+        config.ignored_flags.push_back(name);
+      }
+    }
+  }
+
+  // visgeom's chessboard: {"type": "checkboard", "rows": R, "cols": C, "size": S}, inner corners
+  // row by row.
+  void board(const Json& map, const KeyPath& path, DataSpec& spec) const {
+    reader_.object(map, path, "{\"type\": \"checkboard\", \"rows\": R, \"cols\": C, \"size\": S}");
+    reader_.check_keys(map, path, {"type", "rows", "cols", "size"});
+    if (map.contains("type")) {
+      const std::string type = reader_.text(map["type"], path / "type");
+      if (type != "checkboard" && type != "chessboard") {
+        reader_.fail(path / "type",
+                     "'checkboard' (visgeom's name) or 'chessboard', not '" + type + "'");
+      }
+    }
+    for (auto [key, count] : {std::pair{"rows", &spec.board_rows}, {"cols", &spec.board_columns}}) {
+      *count = reader_.integer(reader_.required(map, key, path), path / key);
+      if (*count < 2) {
+        reader_.fail(path / key, "at least 2 inner corners, not " + std::to_string(*count));
+      }
+    }
+    const double size = reader_.number(reader_.required(map, "size", path), path / "size");
+    if (!(size > 0)) reader_.fail(path / "size", "must be positive, not " + number_text(size));
+    for (int i = 0; i < spec.board_rows; ++i) {
+      for (int j = 0; j < spec.board_columns; ++j) {
+        spec.corners.push_back(static_cast<int>(spec.object_points.size()));
+        spec.object_points.emplace_back(j * size, i * size, 0.0);
+      }
+    }
+  }
+
+  // visgeom's {"prefix": DIR, "names": [...]}: each image is prefix + name, as visgeom joins them.
+  void images(const Json& map, const KeyPath& path, DataSpec& spec) const {
+    reader_.object(map, path, "{\"prefix\": folder, \"names\": [file, ...]}");
+    reader_.check_keys(map, path, {"prefix", "names"});
+    const Json& prefix = reader_.required(map, "prefix", path);
+    if (!prefix.is_string()) reader_.fail(path / "prefix", "a string, not " + describe(prefix));
+    spec.data_file = prefix.get<std::string>();
+    spec.data_path = "images";
+    const Json& names = reader_.required(map, "names", path);
+    reader_.array(names, path / "names", "a list of image files");
+    if (names.empty()) reader_.fail(path / "names", "is empty");
+    for (size_t i = 0; i < names.size(); ++i) {
+      const std::filesystem::path file(spec.data_file +
+                                       reader_.text(names[i], (path / "names")[i]));
+      spec.image_files.push_back(file.is_absolute() || base_directory_.empty()
+                                     ? file.string()
+                                     : (std::filesystem::path(base_directory_) / file).string());
+    }
   }
 
   int image_size(const Json& map, const char* key, const KeyPath& path, int fallback) const {
@@ -600,6 +694,10 @@ void require_finite(std::span<const double> values) {
 }
 
 }  // namespace
+
+bool DataSpec::has_flag(std::string_view flag) const {
+  return std::find(flags.begin(), flags.end(), flag) != flags.end();
+}
 
 Eigen::Isometry3d transform_from_values(std::span<const double> values) {
   const size_t n = values.size();

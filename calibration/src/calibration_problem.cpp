@@ -196,6 +196,17 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
     s.cameras.push_back(std::move(value));
   }
 
+  // "images" entries get their shots and image size from the images (find_board_shots in
+  // mocap_calibrate): without them nothing would say what went wrong.
+  for (size_t d = 0; d < config.data.size(); ++d) {
+    const DataSpec& data = config.data[d];
+    if (data.image_width <= 0 || data.image_height <= 0) {
+      throw CalibrationError(fmt::format(
+          "{}: data[{}] ({}): no image size{}", config.source, d, data.camera,
+          data.type == "images" ? ": the board has not been looked for in its images" : ""));
+    }
+  }
+
   // Enough data for each camera: each shot of n points adds 2n measurements and 6 unknowns.
   for (size_t c = 0; c < config.cameras.size(); ++c) {
     const CameraSpec& camera = config.cameras[c];

@@ -9,14 +9,14 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <mocap/calibration/calibration_config.hpp>
 #include <mocap/calibration/calibration_problem.hpp>
 #include <mocap/calibration/camera_factory.hpp>
 #include <mocap/calibration/camera_file.hpp>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
+#include "board_images.hpp"
 #include "pixart_rig.hpp"
 
 namespace {
@@ -109,6 +109,16 @@ int calibrate_config(const std::string& config_path, const fs::path& output, std
                      const std::string& rig_path, double robust_px) {
   CalibrationConfig config = load_calibration_config(config_path);
   if (config.cameras.empty()) throw CalibrationError(config_path + ": no cameras");
+  if (!config.ignored_flags.empty()) {
+    fmt::print("visgeom flags without a meaning here, ignored: {}\n",
+               fmt::join(config.ignored_flags, ", "));
+  }
+  for (size_t d = 0; d < config.data.size(); ++d) {
+    DataSpec& data = config.data[d];
+    if (data.type != "images") continue;
+    find_board_shots(data, fmt::format("{}: data[{}]", config_path, d),
+                     data.has_flag("improve_detection"));
+  }
   if (reference.empty()) reference = config.cameras.front().name;
   // Read before solving, so that a wrong rig file costs no solver time.
   const Eigen::Isometry3d world_from_reference =
@@ -116,6 +126,14 @@ int calibrate_config(const std::string& config_path, const fs::path& output, std
   CalibrationProblem problem(config, {.robust_scale_px = robust_px});
   const CalibrationReport report = problem.solve();
   fmt::print("{}", report.summary());
+  // visgeom's show_outliers shows the outlying images; the report names them here.
+  for (const ShotResult& shot : report.shots) {
+    const DataSpec& data = config.data[shot.data];
+    if (shot.outlier && data.has_flag("show_outliers") && shot.frame < data.image_files.size()) {
+      fmt::print("outlier image: {} (data[{}], RMS {:.3f} px)\n", data.image_files[shot.frame],
+                 shot.data, shot.rms_px);
+    }
+  }
   if (!report.converged) {
     fmt::print(stderr, "mocap_calibrate: {}: the solver did not converge: {}\n", config_path,
                report.termination);
@@ -146,57 +164,37 @@ int calibrate_chessboard(const fs::path& folder, const std::string& board, doubl
   }
   std::sort(files.begin(), files.end());
 
-  // The corners of each image where the whole board is found, as shots of one data entry.
+  // One data entry: the images in name order, a shot each where the whole board shows.
   DataSpec data;
-  data.type = "chessboard";
+  data.type = "images";
   data.camera = name;
   data.data_file = folder.string();
-  data.data_path = folder.string();
+  data.data_path = "images";
+  data.board_columns = columns;
+  data.board_rows = rows;
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < columns; ++c) {
       data.object_points.emplace_back(c * square, r * square, 0.0);
       data.corners.push_back(r * columns + c);
     }
   }
+  for (const fs::path& file : files) data.image_files.push_back(file.string());
+  find_board_shots(data, folder.string(), true);
   std::vector<std::vector<cv::Point3f>> cv_objects;
   std::vector<std::vector<cv::Point2f>> cv_images;
-  cv::Size size;
-  for (size_t i = 0; i < files.size(); ++i) {
-    cv::Mat image = cv::imread(files[i].string(), cv::IMREAD_GRAYSCALE);
-    if (image.empty()) {
-      fmt::print("skipped {}: not an image\n", files[i].string());
-      continue;
-    }
-    if (size.area() == 0) size = image.size();
-    if (image.size() != size) {
-      throw CalibrationError(fmt::format("{}: {}x{}, but the first image is {}x{}",
-                                         files[i].string(), image.cols, image.rows, size.width,
-                                         size.height));
-    }
+  for (const Shot& shot : data.shots) {
     std::vector<cv::Point2f> corners;
-    if (!cv::findChessboardCorners(image, {columns, rows}, corners,
-                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
-      fmt::print("skipped {}: no {}x{} board found\n", files[i].string(), columns, rows);
-      continue;
+    for (const Eigen::Vector2d& p : shot.points) {
+      corners.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
     }
-    cv::cornerSubPix(image, corners, {5, 5}, {-1, -1},
-                     {cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3});
-    Shot shot;
-    shot.frame = i;
-    for (const cv::Point2f& p : corners) shot.points.emplace_back(p.x, p.y);
-    data.shots.push_back(std::move(shot));
-    cv_images.push_back(corners);
+    cv_images.push_back(std::move(corners));
     std::vector<cv::Point3f> object;
     for (const Eigen::Vector3d& p : data.object_points) {
       object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.0f);
     }
     cv_objects.push_back(std::move(object));
   }
-  if (data.shots.empty()) {
-    throw CalibrationError(folder.string() + ": no image shows the whole board");
-  }
-  data.image_width = size.width;
-  data.image_height = size.height;
+  const cv::Size size(data.image_width, data.image_height);
 
   // A starting camera from the boards' homographies.
   const cv::Mat k = cv::initCameraMatrix2D(cv_objects, cv_images, size);

@@ -353,8 +353,8 @@ TEST_F(ConfigFiles, ErrorsNameTheFileAndTheKeyPath) {
        "calib.json: data[1].image_height: must be positive, not -768"},
       {R"("image_height" : 768,)", R"("image_height" : 76.8,)",
        "calib.json: data[1].image_height: a whole number, not 76.8"},
-      {R"("type" : "ir_data",)", R"("type" : "images",)",
-       "calib.json: data[0].type: unknown data type 'images' (ir_data)"},
+      {R"("type" : "ir_data",)", R"("type" : "video",)",
+       "calib.json: data[0].type: unknown data type 'video' (ir_data, images)"},
       {R"("init" : "none",)", R"("init" : "xi12",)",
        "calib.json: data[1].init: a transform value, \"none\" or 'xiCamBoard' (the chain's "
        "per-shot transformation), not 'xi12'"},
@@ -465,6 +465,140 @@ TEST_F(ConfigFiles, FramesWithoutTheCameraOrWithUnseenPointsAreNotShots) {
   EXPECT_EQ(config.data[1].shots[0].frame, 0u);
   EXPECT_EQ(config.data[1].shots[1].frame, 3u);
   EXPECT_EQ(config.data[1].shots[1].points[3], Eigen::Vector2d(8, 8));
+}
+
+// visgeom's stereo example (data/calib_stereo_example.json) as visgeom has it, with its image
+// folders made relative and four names per camera.
+constexpr const char* kVisgeomStereo = R"({
+"transformations" : [
+    {"name" : "xiCamBoard1", "global" : false, "constant" : false, "prior" : false},
+    {"name" : "xiCamBoardStereo", "global" : false, "constant" : false, "prior" : false},
+    {
+        "name" : "xiCam12",
+        "global" : true,
+        "constant" : false,
+        "prior" : true,
+        "value" : [0, -0.3, 0, 0, 0, 0]
+    }
+],
+"cameras": [
+    {"name" : "camera1", "type" : "eucm", "constant" : false, "value" : [0.55, 1.2, 200, 200,  320,  240]},
+    {"name" : "camera2", "type" : "eucm", "constant" : false, "value" : [0.55, 1.2, 200, 200,  320,  240]}
+],
+"data" : [ 
+    {
+        "type" : "images",
+        "camera" : "camera1",
+        "transform_chain" : [
+            {"name" : "xiCamBoardStereo", "direct" : true}
+        ],
+        "init" : "xiCamBoardStereo",
+        "object" : {"type" : "checkboard", "rows" : 5, "cols" : 8, "size" : 0.1},
+        "parameters" : ["_check_extraction", "show_outliers", "_user_guided", "improve_detection"],
+        "images" : {
+            "prefix" : "stereo/bottom/",
+            "names" : ["000001.png", "000002.png", "000003.png", "000004.png"]
+        }
+    }, 
+    {
+        "type" : "images",
+        "camera" : "camera2",
+        "transform_chain" : [
+            {"name" : "xiCam12", "direct" : false},
+            {"name" : "xiCamBoardStereo", "direct" : true}
+        ],
+        "init" : "none",
+        "object" : {"type" : "checkboard", "rows" : 5, "cols" : 8, "size" : 0.1},
+        "parameters" : ["check_extraction", "_show_outliers", "user_guided", "_save_outlire_images"],
+        "images" : {
+            "prefix" : "stereo/top/",
+            "names" : ["000001.png", "000002.png", "000003.png", "000004.png"]
+        }
+    },
+    {
+        "type" : "images",
+        "camera" : "camera1",
+        "transform_chain" : [
+            {"name" : "xiCamBoard1", "direct" : true}
+        ],
+        "init" : "xiCamBoard1",
+        "object" : {"type" : "checkboard", "rows" : 5, "cols" : 8, "size" : 0.1},
+        "parameters" : ["check_extraction", "draw_improved"],
+        "draw_scale" : 2,
+        "images" : {
+            "prefix" : "/data/mono/",
+            "names" : ["a.png"]
+        }
+    }
+]
+}
+)";
+
+TEST_F(ConfigFiles, ReadsVisgeomsStereoExample) {
+  const CalibrationConfig config = parse(kVisgeomStereo);
+  ASSERT_EQ(config.data.size(), 3u);
+  const DataSpec& bottom = config.data[0];
+  EXPECT_EQ(bottom.type, "images");
+  EXPECT_EQ(bottom.board_rows, 5);
+  EXPECT_EQ(bottom.board_columns, 8);
+  ASSERT_EQ(bottom.object_points.size(), 40u);
+  ASSERT_EQ(bottom.corners.size(), 40u);
+  // Row by row: corner 9 is the second row's second corner.
+  EXPECT_EQ(bottom.object_points[9], Eigen::Vector3d(0.1, 0.1, 0));
+  EXPECT_EQ(bottom.object_points[39], Eigen::Vector3d(7 * 0.1, 4 * 0.1, 0));
+  ASSERT_EQ(bottom.image_files.size(), 4u);
+  EXPECT_EQ(bottom.image_files[1], (dir_ / "stereo/bottom/000002.png").string());
+  EXPECT_EQ(config.data[2].image_files[0], "/data/mono/a.png");
+  EXPECT_TRUE(bottom.shots.empty()) << "the boards are found by whoever reads the images";
+  EXPECT_EQ(bottom.image_width, 0);
+  // The stereo pair shares its board poses per image index.
+  EXPECT_EQ(bottom.data_path, config.data[1].data_path);
+  // Flags: the ones that mean something here are on where they are on; the others are listed
+  // once; '_' switches a flag off.
+  EXPECT_EQ(bottom.flags, (std::vector<std::string>{"show_outliers", "improve_detection"}));
+  EXPECT_TRUE(config.data[1].flags.empty());
+  EXPECT_EQ(config.ignored_flags,
+            (std::vector<std::string>{"check_extraction", "user_guided", "draw_improved"}));
+}
+
+TEST_F(ConfigFiles, VisgeomFormErrorsNameTheKeyPath) {
+  struct Case {
+    std::string from, to, expected;
+  };
+  const std::vector<Case> cases = {
+      {R"("show_outliers", "_user_guided")", R"("show_outlier", "_user_guided")",
+       "calib.json: data[0].parameters[1]: unknown visgeom flag 'show_outlier' (did you mean "
+       "'show_outliers'?)"},
+      {R"("_check_extraction", "show_outliers")", R"("_check_extractoin", "show_outliers")",
+       "calib.json: data[0].parameters[0]: unknown visgeom flag 'check_extractoin' (did you mean "
+       "'check_extraction'?)"},
+      {R"("type" : "checkboard", "rows" : 5, "cols" : 8, "size" : 0.1},
+        "parameters" : ["_check)",
+       R"("type" : "circles", "rows" : 5, "cols" : 8, "size" : 0.1},
+        "parameters" : ["_check)",
+       "calib.json: data[0].object.type: 'checkboard' (visgeom's name) or 'chessboard', not "
+       "'circles'"},
+      {R"("rows" : 5, "cols" : 8, "size" : 0.1},
+        "parameters" : ["_check)",
+       R"("rows" : 1, "cols" : 8, "size" : 0.1},
+        "parameters" : ["_check)",
+       "calib.json: data[0].object.rows: at least 2 inner corners, not 1"},
+      {R"("images" : {
+            "prefix" : "stereo/bottom/",)",
+       R"("imagess" : {
+            "prefix" : "stereo/bottom/",)",
+       "calib.json: data[0].imagess: unknown key (did you mean 'images'?)"},
+      {R"("prefix" : "/data/mono/",
+            "names" : ["a.png"])",
+       R"("prefix" : "/data/mono/",
+            "names" : [])",
+       "calib.json: data[2].images.names: is empty"},
+      {R"("draw_scale" : 2,)", R"("draw_scale" : "big",)",
+       "calib.json: data[2].draw_scale: a number, not the string \"big\""},
+  };
+  for (const Case& c : cases) {
+    EXPECT_EQ(error_of(replaced(kVisgeomStereo, c.from, c.to)), c.expected) << c.to;
+  }
 }
 
 }  // namespace

@@ -33,6 +33,25 @@
 // Keys starting with '_' are ignored, as the seed's program ignored them: "_points" keeps a
 // variant at hand without deleting it. Any other unknown key is an error.
 //
+// visgeom's configurations run unchanged (seed 002's calibration ran on visgeom). Data entries
+// may carry its "parameters" flag list and be of its "images" type: chessboard images, found
+// by the program that solves (mocap_calibrate), one frame per image:
+//
+//       {"type": "images", "camera": "cam0",
+//        "transform_chain": [{"name": "xiCamBoard", "direct": true}], "init": "xiCamBoard",
+//        "object": {"type": "checkboard", "rows": 6, "cols": 9, "size": 0.03},
+//        "parameters": ["show_outliers", "improve_detection", "_check_extraction"],
+//        "images": {"prefix": "left/", "names": ["000001.png", "000002.png"]}}
+//
+// "rows" and "cols" count inner corners; corner i·cols + j is at (j·size, i·size, 0). An image
+// is the string prefix + name, relative to the configuration's folder. Entries whose chains
+// share a per-shot transformation share a board pose per image index, as in visgeom: the i-th
+// image of a stereo pair's two entries is one shot. Flags: "improve_detection" refines the
+// corners to a fraction of a pixel; "show_outliers" names the outlying shots' images; visgeom's
+// other flags (interactive, drawing, solver switches) have no meaning here and are listed once
+// in `ignored_flags`; a leading '_' switches a flag off, as in visgeom; any other flag is an
+// error.
+//
 // A data file is a JSON array of frames (one board position each); a frame is an array of the
 // cameras that saw the board then, each {"camera": name, "points": [[u, v], ...]} ("Cam_id" is
 // accepted for "camera", as the seed wrote it; "stamp_ns", when the recording was made, is
@@ -45,6 +64,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -84,20 +104,31 @@ struct Shot {
 };
 
 struct DataSpec {
-  std::string type;    // "ir_data"
+  std::string type;    // "ir_data" or "images"
   std::string camera;  // a CameraSpec name
   // camera <- ... <- board, combined left to right: T = T1 * T2 * ...; pixel = project(T * X).
   std::vector<ChainLink> transform_chain;
   std::optional<Eigen::Isometry3d> init;  // starting value of the chain's per-shot transform
   int image_width = 0, image_height = 0;
-  std::string data_file;  // as written in the config
-  std::string data_path;  // resolved against the config's folder
+  // ir_data: the data file as written and resolved against the config's folder. images: the
+  // prefix as written, and "images" for every such entry. Entries with the same data_path and
+  // per-shot transformation share a pose per frame.
+  std::string data_file;
+  std::string data_path;
+  // visgeom's "parameters" flags that are on (without the ones a '_' switches off).
+  std::vector<std::string> flags;
+  // images: the files, frame i being image_files[i] (resolved), and the board's inner corners.
+  std::vector<std::string> image_files;
+  int board_columns = 0, board_rows = 0;
   // "object": {"points": [[x,y,z],...], "corners": [i,...]}
   std::vector<Eigen::Vector3d> object_points;
   // Which object points the data's points are, in order (default 0..n-1).
   std::vector<int> corners;
-  // The frames of the data file that hold this camera with all corners.
+  // The frames of the data file that hold this camera with all corners. images: empty until
+  // the boards are found in the images (image_width and image_height 0 until then too).
   std::vector<Shot> shots;
+
+  bool has_flag(std::string_view flag) const;
 };
 
 struct CalibrationConfig {
@@ -105,6 +136,9 @@ struct CalibrationConfig {
   std::vector<TransformSpec> transformations;
   std::vector<CameraSpec> cameras;
   std::vector<DataSpec> data;
+  // visgeom flags that are on somewhere but mean nothing here ("check_extraction", ...), each
+  // once, in order of appearance: for one line that says so.
+  std::vector<std::string> ignored_flags;
 };
 
 // A configuration or data file that cannot be used. One line: the file, the key path and what
