@@ -14,7 +14,7 @@ packages=(
   # calibration: configuration and data files (JSON)
   nlohmann-json3-dev
   # bags: rosbag2's sqlite3 storage (the sqlite3 shell to look inside)
-  libsqlite3-dev sqlite3
+  libsqlite3-dev sqlite3 libzstd-dev liblz4-dev
   # vision: images, geometry, least squares (camera calibration)
   libopencv-dev libeigen3-dev libceres-dev
   # the overlay's PNG snapshots
