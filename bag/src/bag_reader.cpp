@@ -496,8 +496,7 @@ struct BagReader::State {
 
     int64_t cursor = 0;  // rosbag2's ids start at 1
     int64_t probes = 0;
-    uint64_t reported_lost = 0;        // in the stretches reported so far
-    std::optional<int64_t> last_kept;  // the id of the last row read before a stretch
+    uint64_t reported_lost = 0;  // in the stretches reported so far
     for (;;) {
       // Fast: ranges of ids while the b-tree can be walked.
       try {
@@ -512,7 +511,6 @@ struct BagReader::State {
               cursor = id;
               ++n;
               keep_row(*range, file, rows);
-              last_kept = cursor;
             } else {
               reason = kOutOfOrder;
               more = false;
@@ -524,7 +522,8 @@ struct BagReader::State {
         reason = sqlite_reason(e);
       }
       range->reset();
-      const std::string before = last_kept ? place(*last_kept) : std::string();
+      // The last row read, where one was (ids read are above 0, the cursor's start).
+      const std::string before = cursor > 0 ? place(cursor) : std::string();
 
       // Slow: seeks past the damage until one walks again; a seek steps over absent ids. One
       // id at a time first, as a damaged leaf page hides a few hundred ids at most; then ever
@@ -573,7 +572,6 @@ struct BagReader::State {
                                     reason));
         }
         cursor = next;
-        last_kept = next;
         continue;
       }
       seek->reset();
