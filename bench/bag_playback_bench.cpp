@@ -1,12 +1,14 @@
 // Playback timing at rate 1: how far from its recorded offset each message is handed over
 // (the playback library alone) and received (mocap_bag play in another process, a subscriber
-// here, over DDS), against a bare sleep_until loop on the same schedule, in the same run.
+// here, over DDS), from an MCAP bag and from a sqlite3 bag of the same messages, against a bare
+// sleep_until loop on the same schedule, in the same run.
 //   build/bin/bag_playback_bench
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -27,10 +29,6 @@ using mocap_msgs::msg::FiducialArray;
 
 constexpr int kMessages = 1000;
 constexpr int64_t kPeriodNs = 5'000'000;  // 200 Hz, with up to ±1 ms of jitter
-
-struct Offsets {
-  std::vector<double> error_us;  // |handed-over or received offset − recorded offset|
-};
 
 std::string row(const std::string& path, std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -76,8 +74,14 @@ int main() {
   std::mt19937 random(1);
   std::uniform_int_distribution<int64_t> jitter(-1'000'000, 1'000'000);
   std::vector<int64_t> stamps;
-  {
-    bag::BagWriter writer((dir / "paced").string());
+  for (int i = 0; i < kMessages; ++i) {
+    stamps.push_back(1'700'000'000'000'000'000 + i * kPeriodNs + jitter(random));
+  }
+  const std::vector<std::string> storages = {"mcap", "sqlite3"};
+  for (const std::string& storage : storages) {
+    bag::BagWriterOptions options;
+    options.storage = storage;
+    bag::BagWriter writer((dir / storage).string(), options);
     const uint32_t id =
         writer.add_topic({"/paced", "mocap_msgs/msg/FiducialArray", "cdr", {Qos::reliable()}, 0});
     const MessageType& type = message_type<FiducialArray>();
@@ -86,8 +90,7 @@ int main() {
       array.header().stamp().sec(i);
       std::vector<uint8_t> bytes(type.serialized_size(&array));
       bytes.resize(type.serialize(&array, bytes));
-      stamps.push_back(1'700'000'000'000'000'000 + i * kPeriodNs + jitter(random));
-      writer.write(id, stamps.back(), bytes);
+      writer.write(id, stamps[static_cast<size_t>(i)], bytes);
     }
     writer.close();
   }
@@ -101,29 +104,6 @@ int main() {
     slept.push_back(SteadyClock::now());
   }
 
-  // The playback library: when each message is handed to the publisher.
-  std::vector<SteadyClock::time_point> handed;
-  bag::BagReader reader((dir / "paced").string());
-  std::atomic<bool> stop{false};
-  bag::play(
-      reader, {}, [&](const bag::BagMessage&) { handed.push_back(SteadyClock::now()); }, stop);
-
-  // mocap_bag play in its own process, received here over DDS.
-  const std::string domain = std::to_string(test::test_domain(90));
-  setenv("MOCAP_DOMAIN_ID", domain.c_str(), 1);
-  {
-    ComponentHost host({.name = "bench", .threads = 2, .dds = {}});
-    host.add(make_component_factory<Timer>("timer"), {.name = "timer"});
-    host.start();
-    auto [code, output] =
-        test::run_command({(test::bin_dir() / "mocap_bag").string(), "play",
-                           (dir / "paced").string(), "--delay", "1.5"},
-                          {{"MOCAP_DOMAIN_ID", domain}}, std::chrono::seconds(60));
-    if (code != 0) fmt::print(stderr, "mocap_bag play failed:\n{}", output);
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    host.stop();
-  }
-
   fmt::print(
       "## Playback timing at rate 1\n\n"
       "{} messages recorded 5 ms apart with up to ±1 ms of jitter; each message's offset from "
@@ -133,12 +113,41 @@ int main() {
       "|---|---:|---:|---:|---:|---:|\n",
       kMessages);
   fmt::print("{}", row("reference: sleep_until on the same schedule", errors(stamps, slept)));
-  fmt::print("{}", row("mocap::bag::play, handed to the publisher", errors(stamps, handed)));
-  std::lock_guard lock(received_mutex);
-  fmt::print("{}", row("mocap_bag play → DDS → subscriber in another process",
-                       errors(stamps, received_times)));
-  if (received_times.size() != stamps.size()) {
-    fmt::print("\n{} of {} messages received\n", received_times.size(), stamps.size());
+  const std::string domain = std::to_string(test::test_domain(90));
+  setenv("MOCAP_DOMAIN_ID", domain.c_str(), 1);
+  for (const std::string& storage : storages) {
+    // The playback library: when each message is handed to the publisher.
+    std::vector<SteadyClock::time_point> handed;
+    bag::BagReader reader((dir / storage).string());
+    std::atomic<bool> stop{false};
+    bag::play(
+        reader, {}, [&](const bag::BagMessage&) { handed.push_back(SteadyClock::now()); }, stop);
+    fmt::print("{}", row(fmt::format("{} bag: mocap::bag::play, handed to the publisher", storage),
+                         errors(stamps, handed)));
+
+    // mocap_bag play in its own process, received here over DDS.
+    {
+      std::lock_guard lock(received_mutex);
+      received_times.clear();
+    }
+    ComponentHost host({.name = "bench", .threads = 2, .dds = {}});
+    host.add(make_component_factory<Timer>("timer"), {.name = "timer"});
+    host.start();
+    auto [code, output] =
+        test::run_command({(test::bin_dir() / "mocap_bag").string(), "play",
+                           (dir / storage).string(), "--delay", "1.5"},
+                          {{"MOCAP_DOMAIN_ID", domain}}, std::chrono::seconds(60));
+    if (code != 0) fmt::print(stderr, "mocap_bag play failed:\n{}", output);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    host.stop();
+    std::lock_guard lock(received_mutex);
+    fmt::print("{}", row(fmt::format("{} bag: mocap_bag play → DDS → subscriber in another process",
+                                     storage),
+                         errors(stamps, received_times)));
+    if (received_times.size() != stamps.size()) {
+      fmt::print("({} bag: {} of {} messages received)\n", storage, received_times.size(),
+                 stamps.size());
+    }
   }
   return 0;
 }

@@ -1,9 +1,11 @@
-// Recording throughput of BagWriter, and of the Recorder in front of it, against raw SQLite
-// doing the same work, measured in the same run: rosbag2's schema, WAL with synchronous=NORMAL, one
-// prepared INSERT, transactions of 1000 messages. Two loads: 1280x720 mono8 images as
-// sensor_msgs/Image CDR (921 600 bytes of pixels and a ~60-byte header) and small ~100-byte
-// messages. Writes into a temporary directory under /tmp (deleted afterwards), so the numbers are
-// those of the file system of /tmp, which the output names.
+// Recording throughput of BagWriter (both storages: sqlite3, and MCAP with zstd chunks and
+// without compression), and of the Recorder in front of it, against raw SQLite doing the same
+// work, measured in the same run. The payloads are random bytes, which no compressor shrinks:
+// zstd's cost without its gain, the worst case for MCAP. Raw SQLite: rosbag2's schema, WAL with
+// synchronous=NORMAL, one prepared INSERT, transactions of 1000 messages. Two loads: 1280x720 mono8
+// images as sensor_msgs/Image CDR (921 600 bytes of pixels and a ~60-byte header) and small
+// ~100-byte messages. Writes into a temporary directory under /tmp (deleted afterwards), so the
+// numbers are those of the file system of /tmp, which the output names.
 //   build/bin/bag_record_bench [--quick]
 #include <sqlite3.h>
 
@@ -111,9 +113,12 @@ Result raw_sqlite(const fs::path& directory, const Load& load,
 }
 
 Result bag_writer(const fs::path& directory, const Load& load,
-                  const std::vector<std::vector<uint8_t>>& payloads) {
+                  const std::vector<std::vector<uint8_t>>& payloads,
+                  const std::string& storage = "sqlite3", const std::string& compression = "") {
   const auto start = Clock::now();
   mocap::bag::BagWriterOptions options;
+  options.storage = storage;
+  options.compression = compression;
   options.commit_messages = 1000;
   // Transactions of 1000 as the raw reference; the time limit only ends the last one.
   options.commit_interval = std::chrono::hours(1);
@@ -154,6 +159,7 @@ Result recorder(const fs::path& directory, const Load& load,
       image ? &mocap::message_type<sensor_msgs::msg::Image>() : nullptr;
   const auto start = Clock::now();
   mocap::bag::RecorderOptions options;
+  options.writer.storage = "mcap";  // as mocap_bag record and bag_recorder write by default
   options.writer.commit_messages = 1000;
   options.writer.commit_interval = std::chrono::hours(1);
   mocap::bag::Recorder recorder(directory.string(), options);
@@ -215,13 +221,17 @@ int main(int argc, char** argv) {
       // Rounds of raw then BagWriter, the best of each: on a shared machine one run of either
       // varies by tens of percent, which alternating and taking the best evens out.
       const bool images = load.payload_bytes > 10000;
-      Result raw, ours, queued, typed;
+      Result raw, ours, mcap_zstd, mcap_plain, queued, typed;
       for (int round = 0; round < rounds; ++round) {
         Result r = raw_sqlite(root / fmt::format("raw{}", run++), load, payloads);
         Result b = bag_writer(root / fmt::format("bag{}", run++), load, payloads);
+        Result z = bag_writer(root / fmt::format("mcap{}", run++), load, payloads, "mcap", "zstd");
+        Result p = bag_writer(root / fmt::format("mcap{}", run++), load, payloads, "mcap", "");
         Result q = recorder(root / fmt::format("rec{}", run++), load, payloads, false);
         if (round == 0 || r.seconds < raw.seconds) raw = r;
         if (round == 0 || b.seconds < ours.seconds) ours = b;
+        if (round == 0 || z.seconds < mcap_zstd.seconds) mcap_zstd = z;
+        if (round == 0 || p.seconds < mcap_plain.seconds) mcap_plain = p;
         if (round == 0 || q.seconds < queued.seconds) queued = q;
         if (images) {
           Result t = recorder(root / fmt::format("typed{}", run++), load, payloads, true);
@@ -234,10 +244,13 @@ int main(int argc, char** argv) {
       }
       std::vector<std::pair<const char*, const Result&>> rows = {
           {"raw SQLite", raw},
-          {"BagWriter", ours},
-          {"Recorder (queue, writer thread; raw CDR as mocap_bag record)", queued}};
+          {"BagWriter, sqlite3", ours},
+          {"BagWriter, MCAP, zstd chunks (the default)", mcap_zstd},
+          {"BagWriter, MCAP, chunks uncompressed", mcap_plain},
+          {"Recorder, MCAP (queue, writer thread; raw CDR as mocap_bag record)", queued}};
       if (images)
-        rows.push_back({"Recorder, typed Image serialized by its thread (bag_recorder)", typed});
+        rows.push_back(
+            {"Recorder, MCAP, typed Image serialized by its thread (bag_recorder)", typed});
       for (const auto& [name, result] : rows) {
         fmt::print("| {} ({} B) | {} | {} | {:.0f} | {:.1f} | {:.2f} |\n", load.name,
                    load.payload_bytes, name, result.messages, result.per_second(),

@@ -10,7 +10,7 @@
 #                         the page drew it, capture stamp to draw, one clock)
 # Per run: poses/s (evaluator frames over the run), latency median/p99 (image stamp -> the
 # evaluator), frames lost, the demo process's CPU (user + system over the run's steady
-# part; 100 % = one core) and its peak resident memory. Prints a markdown table. Needs test/viewer/node_modules (npm ci).
+# part; 100 % = one core) and its peak resident memory. Prints a markdown table. Needs test/node_modules (npm ci --prefix test).
 #
 #   bench/viewer_bench.sh [--duration S]   (default 20 s a run: about 2.5 min)
 set -uo pipefail
@@ -26,7 +26,7 @@ while [ $# -gt 0 ]; do
     *) echo "viewer_bench.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
-[ -d "$viewer/node_modules" ] || { echo "viewer_bench.sh: run npm ci in test/viewer first" >&2; exit 1; }
+[ -d "$viewer/../node_modules" ] || { echo "viewer_bench.sh: run npm ci --prefix test first" >&2; exit 1; }
 
 work="$(mktemp -d /tmp/viewer_bench.XXXXXX)"
 trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$work"' EXIT

@@ -13,8 +13,8 @@ packages=(
   libyaml-cpp-dev libfmt-dev
   # calibration: configuration and data files (JSON)
   nlohmann-json3-dev
-  # bags: rosbag2's sqlite3 storage (the sqlite3 shell to look inside)
-  libsqlite3-dev sqlite3 libzstd-dev liblz4-dev
+  # bags: rosbag2's sqlite3 storage (the sqlite3 shell to look inside), MCAP's zstd, lz4 and CRC-32
+  libsqlite3-dev sqlite3 libzstd-dev liblz4-dev zlib1g-dev
   # vision: images, geometry, least squares (camera calibration)
   libopencv-dev libeigen3-dev libceres-dev
   # the overlay's PNG snapshots

@@ -51,8 +51,12 @@ if [ "$mode" = address ]; then
   # client's poses with their truth (the pipeline keeping up with the camera's 30 Hz), and the
   # calibration recorder's Ctrl-C in the third LED cycle (the simulated CAN adaptor skips the
   # samples it is late for; under load a camera missed a whole cycle in 1 of 8 runs).
+  # Nor the two slow-subscriber loads, as under ThreadSanitizer (below): paced by the slow
+  # subscriber, about a minute each per implementation, and their publisher blocks and wakes
+  # as under the stalling subscriber, which runs.
   left_out='FollowerDemo\.TurretCentresBase.*|FoxgloveBridgeTest\.(TheViewerDraws|AnIndependentClient).*'
   left_out+='|CalibrationRecordTool\.CtrlCStopsTheLiveRecording.*'
+  left_out+='|(cyclonedds\.)?Dds/ReliableUnderLoad\.LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber'
   filter=(-LE install -E "^($left_out)\$")
 else
   # The threaded parts: the runtime and both transports with their tests, the bag library
@@ -65,7 +69,7 @@ else
   filter=(-R "$tsan_tests" -E "LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber ")
 fi
 $build_only && exit 0
-# The viewer tests' independent clients (pinned in test/viewer/package-lock.json).
-npm ci --prefix test/viewer --no-audit --no-fund --loglevel=error
+# The tests' independent clients and readers (pinned in test/package-lock.json).
+npm ci --prefix test --no-audit --no-fund --loglevel=error
 cd "$build"
 ctest --output-on-failure --parallel "$(nproc)" "${filter[@]}" "$@"

@@ -5,7 +5,7 @@ cd "$(dirname "$0")/.."
 scripts/install_deps.sh
 scripts/build.sh -DMOCAP_WERROR=ON -DMOCAP_BUILD_TESTS=ON -DMOCAP_BUILD_BENCHMARKS=ON
 scripts/check_format.sh
-# The viewer tests' independent clients (pinned in test/viewer/package-lock.json).
-npm ci --prefix test/viewer --no-audit --no-fund --loglevel=error
+# The tests' independent clients and readers (pinned in test/package-lock.json).
+npm ci --prefix test --no-audit --no-fund --loglevel=error
 cd build
 ctest --output-on-failure --parallel "$(nproc)"

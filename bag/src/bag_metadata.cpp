@@ -232,13 +232,14 @@ std::string format_metadata_yaml(const BagMetadata& metadata) {
   std::string out = fmt::format(
       "rosbag2_bagfile_information:\n"
       "  version: 5\n"
-      "  storage_identifier: sqlite3\n"
+      "  storage_identifier: {}\n"
       "  duration:\n"
       "    nanoseconds: {}\n"
       "  starting_time:\n"
       "    nanoseconds_since_epoch: {}\n"
       "  message_count: {}\n",
-      metadata.duration_ns, metadata.start_ns, metadata.message_count);
+      yaml_scalar(metadata.storage_identifier), metadata.duration_ns, metadata.start_ns,
+      metadata.message_count);
   out += "  topics_with_message_count:";
   if (metadata.topics.empty()) out += " []";
   out += '\n';
@@ -299,12 +300,12 @@ BagMetadata parse_metadata_yaml(const std::string& text, const std::string& sour
     reader.fail(root_path + ".version",
                 fmt::format("{} is not supported (rosbag2 versions 4 to 9 are)", version));
   }
+  std::string identifier = "sqlite3";
   if (YAML::Node storage = reader.optional(root, "storage_identifier", root_path)) {
-    auto identifier =
-        reader.value<std::string>(storage, root_path + ".storage_identifier", "a string");
-    if (identifier != "sqlite3") {
+    identifier = reader.value<std::string>(storage, root_path + ".storage_identifier", "a string");
+    if (identifier != "sqlite3" && identifier != "mcap") {
       reader.fail(root_path + ".storage_identifier",
-                  fmt::format("\"{}\" is not supported (only sqlite3 is)", identifier));
+                  fmt::format("\"{}\" is not supported (sqlite3 and mcap are)", identifier));
     }
   }
   if (YAML::Node compression = reader.optional(root, "compression_format", root_path)) {
@@ -317,6 +318,7 @@ BagMetadata parse_metadata_yaml(const std::string& text, const std::string& sour
   }
 
   BagMetadata metadata;
+  metadata.storage_identifier = identifier;
   metadata.duration_ns = reader.nested_int(root, "duration", "nanoseconds", root_path, 0);
   metadata.start_ns =
       reader.nested_int(root, "starting_time", "nanoseconds_since_epoch", root_path, 0);

@@ -16,6 +16,7 @@
 
 #include <fmt/format.h>
 
+#include "mcap_reader.hpp"
 #include "sqlite_database.hpp"
 
 namespace mocap::bag {
@@ -112,7 +113,10 @@ struct FileState {
   std::string name;                        // what problems call it: relative to the bag directory
   std::optional<uint64_t> expected_count;  // from metadata.yaml, for salvage estimates
   sqlite::Database db;
-  std::unordered_map<int64_t, size_t> topic_of;  // topics.id -> index in metadata().topics
+  // An MCAP file instead: read in index mode, a Row's id being its place in messages().
+  std::unique_ptr<mcap::FileReader> mcap;
+  // topics.id (MCAP: the channel id) -> index in metadata().topics
+  std::unordered_map<int64_t, size_t> topic_of;
   BagFile summary;
 
   // Stream: the database orders the rows (through timestamp_idx) and they are stepped one at
@@ -185,13 +189,15 @@ struct BagReader::State {
       std::stringstream text;
       text << in.rdbuf();
       if (!in) {
-        problem(fmt::format("{}: cannot read; reading the .db3 files of the directory instead",
-                            yaml_path.string()));
+        problem(fmt::format(
+            "{}: cannot read; reading the .mcap and .db3 files of the directory instead",
+            yaml_path.string()));
       } else {
         try {
           from_yaml = parse_metadata_yaml(text.str(), yaml_path.string());
         } catch (const BagError& e) {
-          problem(fmt::format("{}; reading the .db3 files of the directory instead", e.what()));
+          problem(fmt::format("{}; reading the .mcap and .db3 files of the directory instead",
+                              e.what()));
         }
       }
     }
@@ -214,7 +220,8 @@ struct BagReader::State {
     if (listed.empty()) {
       std::vector<std::string> names;
       for (const fs::directory_entry& entry : fs::directory_iterator(path, error)) {
-        if (entry.path().extension() == ".db3" && entry.is_regular_file(error)) {
+        const fs::path extension = entry.path().extension();
+        if ((extension == ".db3" || extension == ".mcap") && entry.is_regular_file(error)) {
           names.push_back(entry.path().filename().string());
         }
       }
@@ -228,7 +235,7 @@ struct BagReader::State {
       }
     }
     if (listed.empty()) {
-      throw BagError(fmt::format("{}: not a bag: no .db3 file{}", path,
+      throw BagError(fmt::format("{}: not a bag: no .mcap or .db3 file{}", path,
                                  problems.empty() ? "" : " (" + problems.front() + ")"));
     }
     return listed;
@@ -406,7 +413,59 @@ struct BagReader::State {
     }
   }
 
+  // True for a file that begins with MCAP's magic: the storage is told by content, not name.
+  static bool is_mcap(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char start[mcap::kMagic.size()] = {};
+    in.read(start, sizeof start);
+    return in && std::string_view(start, sizeof start) == mcap::kMagic;
+  }
+
+  // An MCAP file's channels merged by topic name into metadata.topics (the type from the
+  // channel's schema, the QoS from its offered_qos_profiles), and its messages as rows.
+  void prepare_mcap(FileState& file) {
+    file.mcap = std::make_unique<mcap::FileReader>(file.path);
+    metadata.storage_identifier = "mcap";  // a bag's files are of one storage
+    const mcap::FileReader& reader = *file.mcap;
+    for (const std::string& line : reader.problems()) problem(line);
+    for (const auto& [id, channel] : reader.channels()) {
+      BagTopic topic;
+      topic.name = channel.topic;
+      auto schema = reader.schemas().find(channel.schema_id);
+      if (schema != reader.schemas().end()) {
+        topic.type = schema->second.name;
+        if (schema->second.encoding == "ros2idl") topic.type_definition = schema->second.data;
+      }
+      topic.serialization_format = channel.message_encoding;
+      auto qos = channel.metadata.find("offered_qos_profiles");
+      if (qos != channel.metadata.end())
+        topic.offered_qos = parse_offered_qos_profiles(qos->second);
+      auto known = std::find_if(metadata.topics.begin(), metadata.topics.end(),
+                                [&](const BagTopic& t) { return t.name == topic.name; });
+      if (known == metadata.topics.end()) {
+        metadata.topics.push_back(std::move(topic));
+        known = metadata.topics.end() - 1;
+      }
+      file.topic_of[id] = static_cast<size_t>(known - metadata.topics.begin());
+    }
+    file.indexed = true;
+    file.rows.clear();
+    for (size_t i = 0; i < reader.messages().size(); ++i) {
+      const mcap::MessagePlace& place = reader.messages()[i];
+      file.rows.push_back(
+          {static_cast<int64_t>(place.log_time), static_cast<int64_t>(i), place.channel_id});
+    }
+    std::sort(file.rows.begin(), file.rows.end(),
+              [](const Row& a, const Row& b) { return a.key() < b.key(); });
+    count(file);
+  }
+
   void prepare(FileState& file) {
+    if (is_mcap(file.path)) {
+      prepare_mcap(file);
+      return;
+    }
+    open(file);
     read_topics(file);
     try {
       if (needs_sort(file)) {
@@ -668,6 +727,21 @@ struct BagReader::State {
       const Row row = file.rows[file.next_row++];
       auto topic = file.topic_of.find(row.topic_id);
       if (topic == file.topic_of.end() || !is_wanted(topic->second)) continue;
+      if (file.mcap) {
+        try {
+          const auto& place = file.mcap->messages()[static_cast<size_t>(row.id)];
+          fill(message, file, row.topic_id, row.timestamp, file.mcap->data(place));
+          file.position = row.key();
+          flush_loss(file);
+          return true;
+        } catch (const BagError& e) {
+          FileState::Loss& loss = file.loss;
+          if (loss.count++ == 0) loss.first_ns = row.timestamp;
+          loss.last_ns = row.timestamp;
+          loss.reason = e.what();
+          continue;
+        }
+      }
       try {
         if (!file.payload.is_prepared()) {
           file.payload = sqlite::Statement(file.db, "SELECT data FROM messages WHERE id = ?");
@@ -702,7 +776,6 @@ BagReader::BagReader(const std::string& path) : state_(std::make_unique<State>()
   std::vector<std::string> failures;
   for (auto& file : listed) {
     try {
-      s.open(*file);
       s.prepare(*file);
       s.files.push_back(std::move(file));
     } catch (const BagError& e) {

@@ -10,11 +10,13 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <optional>
 
 #include <fmt/format.h>
 
+#include "mcap_writer.hpp"
 #include "sqlite_database.hpp"
 
 namespace mocap::bag {
@@ -42,6 +44,9 @@ constexpr int64_t kMinimumPages = 16;
 // Pages a transaction may take beyond the estimate of its messages: interior b-tree pages,
 // index pages, rounding.
 constexpr double kSparePages = 4;
+// What an MCAP file's close adds after its last chunk, at most for a bag of a few dozen
+// topics: DataEnd, the summary, its offsets, the footer.
+constexpr uint64_t kMcapCloseReserve = 64 * 1024;
 
 std::string errno_text() { return std::strerror(errno); }
 
@@ -95,11 +100,17 @@ void extend_end(int64_t& start_ns, int64_t& duration_ns, uint64_t count, int64_t
 
 struct BagWriter::State {
   std::string directory;
-  fs::path db_path, yaml_path;
-  std::string db_name;  // the database as errors name it
+  fs::path file_path, yaml_path;    // the .db3 or .mcap file, and metadata.yaml
+  std::string file_name_in_errors;  // the file as errors name it
   BagWriterOptions options;
+  // sqlite3
   sqlite::Database db;
   sqlite::Statement insert;
+  // mcap: the file, each topic's channel, each type's schema
+  std::optional<mcap::FileWriter> mcap;
+  std::vector<uint16_t> channel_of;
+  std::map<std::string, uint16_t> schema_of;
+  uint64_t pending_bytes = 0;  // in the open chunk, uncompressed
 
   // Everything write() accepted, and the part of it that is committed: a failed transaction
   // takes the counts back to `committed` (changed under committed_mutex, which
@@ -127,17 +138,17 @@ struct BagWriter::State {
   bool closed = false;
 
   void check_open(std::string_view what) const {
-    if (closed) throw BagError(fmt::format("{}: {} after close()", db_name, what));
+    if (closed) throw BagError(fmt::format("{}: {} after close()", file_name_in_errors, what));
     if (failed) {
-      throw BagError(
-          fmt::format("{}: {} after an earlier write error (only close() is left)", db_name, what));
+      throw BagError(fmt::format("{}: {} after an earlier write error (only close() is left)",
+                                 file_name_in_errors, what));
     }
   }
 
   // Keeps room below max_bytes for the metadata row close() adds, so that a bag that ran
   // into its limit still gets one.
   void apply_page_limit() {
-    if (limit_pages == 0) return;
+    if (limit_pages == 0 || mcap) return;
     const auto yaml_size = static_cast<int64_t>(format_metadata_yaml(metadata).size());
     const int64_t reserve = 2 + 2 * yaml_size / page_size;
     page_limit_now = db.pragma_int(
@@ -170,6 +181,7 @@ struct BagWriter::State {
 
   void measure_room() {
     transaction_pages = 0;
+    if (mcap) return;
     try {
       committed_pages = db.pragma_int("page_count");
     } catch (const sqlite::SqliteError&) {
@@ -203,6 +215,18 @@ struct BagWriter::State {
   // `accepted`: the messages write() has returned for, when the last one counted in
   // `metadata` is still being written.
   void commit_now(std::optional<uint64_t> accepted = std::nullopt) {
+    if (mcap) {
+      if (transaction_messages == 0) return;
+      try {
+        mcap->flush();
+      } catch (const BagError& e) {
+        fail_mcap(e);
+      }
+      set_committed();
+      transaction_messages = 0;
+      pending_bytes = 0;
+      return;
+    }
     if (!db.in_transaction()) return;
     try {
       db.exec("COMMIT", "commit");
@@ -241,19 +265,102 @@ struct BagWriter::State {
       throw BagError(fmt::format(
           "{}: the disk is full (or max_bytes reached) after {} messages; the bag keeps the {} "
           "committed before",
-          db_name, accepted, committed.message_count));
+          file_name_in_errors, accepted, committed.message_count));
     }
     throw BagError(fmt::format("{}; the bag keeps the {} messages committed before", error.what(),
                                committed.message_count));
+  }
+
+  // After a failed write or flush of the MCAP file: the counts go back to what whole chunks
+  // hold, and write() reports the error.
+  [[noreturn]] void fail_mcap(const BagError& error) {
+    failed = true;
+    metadata = committed;
+    bytes = committed_bytes;
+    throw BagError(fmt::format("{}; the bag keeps the {} messages committed before", error.what(),
+                               committed.message_count));
+  }
+
+  void open_database() {
+    db = sqlite::Database(file_path.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
+                          file_name_in_errors);
+    // Write-ahead logging: a commit appends to the log, so a writer killed at any point
+    // leaves the last commit intact. NORMAL synchronisation: no fsync per commit (a killed
+    // process loses nothing the OS has; a power cut may lose the last commits, never the
+    // database).
+    db.pragma_text("journal_mode=WAL");
+    db.exec("PRAGMA synchronous=NORMAL");
+    page_size = std::max<int64_t>(512, db.pragma_int("page_size"));
+    if (options.max_bytes > 0) {
+      limit_pages = std::max(kMinimumPages, static_cast<int64_t>(options.max_bytes) / page_size);
+      apply_page_limit();
+    }
+    db.exec(std::string("BEGIN;") + kCreateSchema + "COMMIT;", "create the schema");
+    // The schema in the database file itself rather than only in the log: a reader that can
+    // not use the log (read-only directory) still finds the tables.
+    db.pragma_text("wal_checkpoint(PASSIVE)");
+    insert =
+        sqlite::Statement(db, "INSERT INTO messages (timestamp, topic_id, data) VALUES (?, ?, ?)");
+  }
+
+  // The open chunk is written whole once past max_bytes would be reached: the bag keeps
+  // every whole chunk before, and this write() reports the limit.
+  void write_mcap(uint32_t topic_id, int64_t timestamp_ns, std::span<const uint8_t> data) {
+    const uint64_t record = mcap::kRecordPrefix + mcap::kMessageHeaderSize + data.size();
+    if (options.max_bytes > 0 &&
+        mcap->file_bytes() + pending_bytes + record + kMcapCloseReserve > options.max_bytes) {
+      commit_now();
+      if (mcap->file_bytes() + record + kMcapCloseReserve > options.max_bytes) {
+        failed = true;
+        throw BagError(fmt::format(
+            "{}: max_bytes reached after {} messages; the bag keeps the {} committed before",
+            file_name_in_errors, metadata.message_count, committed.message_count));
+      }
+    }
+    if (transaction_messages == 0) transaction_start = SteadyClock::now();
+    try {
+      // MCAP's times are unsigned: a stamp before 1970 is not a receive time.
+      mcap->write(channel_of[topic_id - 1],
+                  static_cast<uint64_t>(std::max<int64_t>(0, timestamp_ns)),
+                  static_cast<uint64_t>(std::max<int64_t>(0, timestamp_ns)), data);
+    } catch (const BagError& e) {
+      fail_mcap(e);
+    }
+    pending_bytes += record;
+  }
+
+  void add_topic_row(uint32_t id, const BagTopic& topic) {
+    try {
+      sqlite::Statement statement(db,
+                                  "INSERT INTO topics (id, name, type, serialization_format, "
+                                  "offered_qos_profiles) VALUES (?, ?, ?, ?, ?)");
+      const std::string qos = format_offered_qos_profiles(topic.offered_qos);
+      statement.bind(1, id)
+          .bind_text(2, topic.name)
+          .bind_text(3, topic.type)
+          .bind_text(4, topic.serialization_format)
+          .bind_text(5, qos);
+      statement.step();
+    } catch (const sqlite::SqliteError& e) {
+      fail(e);
+    }
+    try {
+      // Into the database file, like the schema: a reader left without the log still knows
+      // the topic of what was checkpointed.
+      db.pragma_text("wal_checkpoint(PASSIVE)");
+    } catch (const sqlite::SqliteError&) {
+      // Only an optimisation for damaged bags; the log has the topic.
+    }
   }
 
   // Removes what the constructor made when it fails half way, so that the caller may retry
   // in the same directory.
   void remove_partial(bool created_directory) {
     db = {};
+    mcap.reset();
     std::error_code ignored;
     for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
-      fs::path file = db_path;
+      fs::path file = file_path;
       file += suffix;
       fs::remove(file, ignored);
     }
@@ -268,6 +375,11 @@ BagWriter::BagWriter(const std::string& directory, BagWriterOptions options)
   s.directory = directory;
   s.options = options;
   if (directory.empty()) throw BagError("BagWriter: the bag directory is empty");
+  const bool mcap = options.storage == "mcap";
+  if (!mcap && options.storage != "sqlite3") {
+    throw BagError(
+        fmt::format("{}: unknown storage '{}' (sqlite3 or mcap)", directory, options.storage));
+  }
 
   std::error_code error;
   bool created_directory = false;
@@ -292,33 +404,19 @@ BagWriter::BagWriter(const std::string& directory, BagWriterOptions options)
   fs::path absolute = fs::weakly_canonical(fs::absolute(directory), error);
   if (error || absolute.filename().empty()) absolute = fs::absolute(directory).lexically_normal();
   if (absolute.filename().empty()) absolute = absolute.parent_path();
-  const std::string file_name = absolute.filename().string() + "_0.db3";
-  s.db_path = fs::path(directory) / file_name;
+  const std::string file_name = absolute.filename().string() + (mcap ? "_0.mcap" : "_0.db3");
+  s.file_path = fs::path(directory) / file_name;
   s.yaml_path = fs::path(directory) / "metadata.yaml";
-  s.db_name = s.db_path.string();
+  s.file_name_in_errors = s.file_path.string();
 
   try {
-    s.db =
-        sqlite::Database(s.db_path.string(), SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, s.db_name);
-    // Write-ahead logging: a commit appends to the log, so a writer killed at any point
-    // leaves the last commit intact. NORMAL synchronisation: no fsync per commit (a killed
-    // process loses nothing the OS has; a power cut may lose the last commits, never the
-    // database).
-    s.db.pragma_text("journal_mode=WAL");
-    s.db.exec("PRAGMA synchronous=NORMAL");
-    s.page_size = std::max<int64_t>(512, s.db.pragma_int("page_size"));
-    if (options.max_bytes > 0) {
-      s.limit_pages =
-          std::max(kMinimumPages, static_cast<int64_t>(options.max_bytes) / s.page_size);
-      s.apply_page_limit();
+    if (mcap) {
+      s.mcap.emplace(s.file_path.string(),
+                     mcap::FileWriterOptions{.compression = options.compression});
+      s.metadata.storage_identifier = "mcap";
+    } else {
+      s.open_database();
     }
-    s.db.exec(std::string("BEGIN;") + kCreateSchema + "COMMIT;", "create the schema");
-    // The schema in the database file itself rather than only in the log: a reader that can
-    // not use the log (read-only directory) still finds the tables.
-    s.db.pragma_text("wal_checkpoint(PASSIVE)");
-    s.insert = sqlite::Statement(
-        s.db, "INSERT INTO messages (timestamp, topic_id, data) VALUES (?, ?, ?)");
-
     s.metadata.files.push_back({file_name, 0, 0, 0});
     s.committed = s.metadata;
     s.measure_room();
@@ -340,36 +438,33 @@ BagWriter::~BagWriter() {
 uint32_t BagWriter::add_topic(const BagTopic& topic) {
   State& s = *state_;
   s.check_open("add_topic");
-  if (topic.name.empty()) throw BagError(fmt::format("{}: add_topic: empty topic name", s.db_name));
+  if (topic.name.empty())
+    throw BagError(fmt::format("{}: add_topic: empty topic name", s.file_name_in_errors));
   for (const BagTopic& known : s.metadata.topics) {
     if (known.name == topic.name) {
-      throw BagError(fmt::format("{}: topic {} added twice", s.db_name, topic.name));
+      throw BagError(fmt::format("{}: topic {} added twice", s.file_name_in_errors, topic.name));
     }
   }
   // Committed first, so that the topic's row never waits in a transaction with messages of
   // other topics that a crash would take away together.
   s.commit_now();
   const auto id = static_cast<uint32_t>(s.metadata.topics.size() + 1);
-  try {
-    sqlite::Statement statement(s.db,
-                                "INSERT INTO topics (id, name, type, serialization_format, "
-                                "offered_qos_profiles) VALUES (?, ?, ?, ?, ?)");
-    const std::string qos = format_offered_qos_profiles(topic.offered_qos);
-    statement.bind(1, id)
-        .bind_text(2, topic.name)
-        .bind_text(3, topic.type)
-        .bind_text(4, topic.serialization_format)
-        .bind_text(5, qos);
-    statement.step();
-  } catch (const sqlite::SqliteError& e) {
-    s.fail(e);
-  }
-  try {
-    // Into the database file, like the schema: a reader left without the log still knows
-    // the topic of what was checkpointed.
-    s.db.pragma_text("wal_checkpoint(PASSIVE)");
-  } catch (const sqlite::SqliteError&) {
-    // Only an optimisation for damaged bags; the log has the topic.
+  if (s.mcap) {
+    // One schema per type, as rosbag2 writes them. The schema is where MCAP keeps the type's
+    // name, so a type whose definition is unknown still gets one: no encoding and no data, as
+    // the specification has it for a schema without a definition.
+    auto [known, added] = s.schema_of.emplace(topic.type, 0);
+    if (added) {
+      known->second = topic.type_definition.empty()
+                          ? s.mcap->add_schema(topic.type, "", "")
+                          : s.mcap->add_schema(topic.type, "ros2idl", topic.type_definition);
+    }
+    const uint16_t schema = known->second;
+    s.channel_of.push_back(s.mcap->add_channel(
+        topic.name, schema, topic.serialization_format,
+        {{"offered_qos_profiles", format_offered_qos_profiles(topic.offered_qos)}}));
+  } else {
+    s.add_topic_row(id, topic);
   }
   BagTopic added = topic;
   added.message_count = 0;
@@ -385,22 +480,28 @@ void BagWriter::write(uint32_t topic_id, int64_t timestamp_ns, std::span<const u
   State& s = *state_;
   s.check_open("write");
   if (topic_id == 0 || topic_id > s.metadata.topics.size()) {
-    throw BagError(fmt::format("{}: write: unknown topic id {} ({} topics added)", s.db_name,
-                               topic_id, s.metadata.topics.size()));
+    throw BagError(fmt::format("{}: write: unknown topic id {} ({} topics added)",
+                               s.file_name_in_errors, topic_id, s.metadata.topics.size()));
   }
-  // Short of room, the messages before go to the database first and this one alone, so
-  // that a full disk costs this message only and is reported by this write().
-  const double pages = s.pages_for(data.size());
-  const bool short_of_room = !s.has_room_for(pages);
-  if (short_of_room && s.transaction_messages > 0) s.commit_now();
-  try {
-    if (!s.db.in_transaction()) s.begin();
-    s.insert.bind(1, timestamp_ns).bind(2, topic_id).bind_blob(3, data);
-    s.insert.step();
-    s.insert.reset();
-  } catch (const sqlite::SqliteError& e) {
-    s.insert.reset();
-    s.fail(e);
+  double pages = 0;
+  bool short_of_room = false;
+  if (s.mcap) {
+    s.write_mcap(topic_id, timestamp_ns, data);
+  } else {
+    // Short of room, the messages before go to the database first and this one alone, so
+    // that a full disk costs this message only and is reported by this write().
+    pages = s.pages_for(data.size());
+    short_of_room = !s.has_room_for(pages);
+    if (short_of_room && s.transaction_messages > 0) s.commit_now();
+    try {
+      if (!s.db.in_transaction()) s.begin();
+      s.insert.bind(1, timestamp_ns).bind(2, topic_id).bind_blob(3, data);
+      s.insert.step();
+      s.insert.reset();
+    } catch (const sqlite::SqliteError& e) {
+      s.insert.reset();
+      s.fail(e);
+    }
   }
 
   BagMetadata& m = s.metadata;
@@ -459,6 +560,22 @@ void BagWriter::close() {
     }
   }
   const std::string yaml = format_metadata_yaml(s.metadata);
+  if (s.mcap) {
+    try {
+      // rosbag2 (Jazzy on) keeps the bag's metadata in the file too.
+      s.mcap->set_metadata("rosbag2", {{"serialized_metadata", yaml}});
+      s.mcap->close();
+    } catch (const BagError& e) {
+      report(e);
+    }
+    try {
+      s.write_yaml(yaml);
+    } catch (const BagError& e) {
+      report(e);
+    }
+    if (first_error) throw BagError(*first_error);
+    return;
+  }
   try {
     if (s.limit_pages > 0) s.db.pragma_int(fmt::format("max_page_count = {}", s.limit_pages));
     sqlite::Statement statement(s.db,

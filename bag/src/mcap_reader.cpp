@@ -15,13 +15,40 @@
 namespace mocap::bag::mcap {
 namespace {
 
-// A chunk's records may not claim more than this uncompressed (a corrupt size would otherwise
-// allocate it): four times mcap-cpp's largest chunk setting.
-constexpr uint64_t kMaxChunk = 4ull << 30;
+// A chunk's records may not claim more than this uncompressed: a chunk holds one message at
+// least, and no message of a robot's topics comes near it.
+constexpr uint64_t kMaxChunk = 1ull << 30;
+
+// The size the compressed frame itself declares, if it does (mcap-cpp's lz4 frames do not),
+// which must then be the chunk's: a corrupt size is refused before anything is allocated.
+std::optional<uint64_t> declared_size(std::string_view data, const std::string& compression) {
+  if (compression == "zstd") {
+    const unsigned long long size = ZSTD_getFrameContentSize(data.data(), data.size());
+    if (size == ZSTD_CONTENTSIZE_ERROR) throw FormatError("zstd: not a zstd frame");
+    if (size == ZSTD_CONTENTSIZE_UNKNOWN) return std::nullopt;
+    return size;
+  }
+  LZ4F_dctx* context = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION))) {
+    throw FormatError("lz4: no decompression context");
+  }
+  LZ4F_frameInfo_t info = LZ4F_INIT_FRAMEINFO;
+  size_t consumed = data.size();
+  const size_t result = LZ4F_getFrameInfo(context, &info, data.data(), &consumed);
+  LZ4F_freeDecompressionContext(context);
+  if (LZ4F_isError(result)) throw FormatError(std::string("lz4: ") + LZ4F_getErrorName(result));
+  if (info.contentSize == 0) return std::nullopt;
+  return info.contentSize;
+}
 
 std::string decompress(std::string_view data, const std::string& compression, uint64_t size) {
   if (size > kMaxChunk) {
     throw FormatError(fmt::format("Chunk.uncompressed_size: {} bytes is beyond belief", size));
+  }
+  if ((compression == "zstd" || compression == "lz4") &&
+      declared_size(data, compression).value_or(size) != size) {
+    throw FormatError(
+        fmt::format("{}: the frame's size is not the chunk's ({} bytes)", compression, size));
   }
   std::string out(static_cast<size_t>(size), '\0');
   if (compression == "zstd") {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <mocap/message_type.hpp>
 #include <mocap/waiting_scope.hpp>
 
 namespace mocap::bag {
@@ -143,8 +144,14 @@ Recorder::~Recorder() {
 }
 
 uint32_t Recorder::add_topic(const BagTopic& topic) {
+  BagTopic described = topic;
+  if (described.type_definition.empty()) {
+    if (const MessageType* type = find_message_type(topic.type)) {
+      described.type_definition = ros2idl_schema(type->name(), full_definition(*type));
+    }
+  }
   std::lock_guard writing(state_->writer_mutex);
-  return state_->writer.add_topic(topic);
+  return state_->writer.add_topic(described);
 }
 
 void Recorder::record(uint32_t topic_id, int64_t timestamp_ns, std::shared_ptr<const void> message,

@@ -26,13 +26,15 @@ namespace {
 using mocap::bag::BagError;
 
 constexpr const char* kUsage = R"(usage:
-  mocap_bag record [-o DIR] TOPIC... | --all   [--duration SECONDS]
+  mocap_bag record [-o DIR] TOPIC... | --all   [--duration SECONDS] [--storage mcap|sqlite3]
   mocap_bag play DIR [--rate R] [--loop] [--topics TOPIC...] [--delay SECONDS]
   mocap_bag info DIR
 
   record  subscribes to the topics (or to every topic published, as publishers appear) and
           writes what arrives to a new bag directory DIR (default bag_YYYY_MM_DD-HH_MM_SS),
-          stamped with its receive time, until Ctrl-C or --duration
+          stamped with its receive time, until Ctrl-C or --duration; --storage: one .mcap
+          file, zstd-compressed chunks (the default, as ROS 2 since Iron) or a .db3 database
+          (ROS 2 Humble's default); play and info read both
   play    publishes a bag's messages with their recorded types and QoS, at their recorded
           pace times R (default 1; 0: as fast as possible, in order), after waiting --delay
           seconds (default 1) for subscribers to be discovered
@@ -81,10 +83,12 @@ struct RecordedTopic {
 };
 
 int record(const std::string& directory, const std::set<std::string>& wanted, bool all,
-           std::optional<double> duration) {
+           std::optional<double> duration, const std::string& storage) {
   auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_bag");
   mocap::DdsTransport& transport = *dds;
-  mocap::bag::Recorder recorder(directory);
+  mocap::bag::RecorderOptions options;
+  options.writer.storage = storage;
+  mocap::bag::Recorder recorder(directory, options);
   // A second stop request well after the first (the graceful stop hangs) still leaves
   // metadata.yaml agreeing with what the database holds.
   mocap::ForcedExitHook metadata_first([&recorder] {
@@ -189,6 +193,11 @@ int play(const std::string& path, const mocap::bag::PlaybackOptions& options, do
                  topic.name, topic.serialization_format);
       continue;
     }
+    if (topic.type.empty()) {
+      fmt::print(stderr, "mocap_bag: not playing {}: its type is unknown (no schema names it)\n",
+                 topic.name);
+      continue;
+    }
     types.push_back(std::make_unique<mocap::RawMessageType>(mocap::dds_type_name(topic.type)));
     // Keep all: at rate 0 a reliable subscriber holds the player back rather than miss
     // messages.
@@ -245,7 +254,7 @@ int info(const std::string& path) {
                                               return files;
                                             }(),
                                             ", "));
-  fmt::print("Storage id:        sqlite3\n");
+  fmt::print("Storage id:        {}\n", metadata.storage_identifier);
   fmt::print("Duration:          {:.3f} s\n", static_cast<double>(metadata.duration_ns) / 1e9);
   if (metadata.message_count > 0) {
     fmt::print("Start:             {}\n", format_stamp(metadata.start_ns));
@@ -283,6 +292,7 @@ int main(int argc, char** argv) {
   std::optional<std::string> output, bag;
   std::set<std::string> topics;
   bool all = false;
+  std::string storage = "mcap";
   std::optional<double> duration;
   double delay = 1.0;
   mocap::bag::PlaybackOptions playback;
@@ -298,6 +308,11 @@ int main(int argc, char** argv) {
       output = value();
     } else if (arg == "--all") {
       all = true;
+    } else if (arg == "--storage") {
+      storage = value();
+      if (storage != "mcap" && storage != "sqlite3") {
+        usage_error(fmt::format("--storage {}: expected mcap or sqlite3", storage));
+      }
     } else if (arg == "--duration") {
       duration = parse_seconds(arg, value());
     } else if (arg == "--rate") {
@@ -341,7 +356,8 @@ int main(int argc, char** argv) {
   }
   try {
     if (command == "record")
-      return record(output.value_or(mocap::bag::default_bag_directory()), topics, all, duration);
+      return record(output.value_or(mocap::bag::default_bag_directory()), topics, all, duration,
+                    storage);
     if (command == "play") return play(*bag, playback, delay);
     return info(*bag);
   } catch (const std::exception& e) {

@@ -75,6 +75,23 @@ std::string full_definition(const MessageType& type) {
   return text;
 }
 
+std::string ros2idl_schema(std::string_view root_type, std::string_view full_definition) {
+  std::string out = std::string(80, '=') + "\nIDL: " + std::string(root_type) + "\n";
+  size_t start = 0;
+  while (start < full_definition.size()) {
+    size_t end = full_definition.find('\n', start);
+    if (end == std::string_view::npos) end = full_definition.size();
+    std::string_view line = full_definition.substr(start, end - start);
+    if (!line.starts_with("#ifndef") && !line.starts_with("#define") &&
+        !line.starts_with("#endif")) {
+      out.append(line);
+      out.push_back('\n');
+    }
+    start = end + 1;
+  }
+  return out;
+}
+
 std::string dds_type_name(std::string_view ros_name) {
   // pkg/msg/Type -> pkg::msg::dds_::Type_ (also srv and action interfaces).
   size_t first = ros_name.find('/');

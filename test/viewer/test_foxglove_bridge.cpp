@@ -1,7 +1,7 @@
 // The foxglove_bridge plugin in a running graph, seen by clients that are not ours:
 // @foxglove/ws-protocol's FoxgloveClient decoding with @foxglove/rosmsg2-serialization
 // (foxglove_client.mjs), and clients that break the protocol (bad_clients.mjs). Needs Node and
-// test/viewer/node_modules (`npm ci` there; scripts/test.sh runs it).
+// test/node_modules (`npm ci --prefix test`; scripts/test.sh runs it).
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -45,8 +45,8 @@ int free_port() {
 class FoxgloveBridgeTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(std::filesystem::exists(viewer_tests() / "node_modules"))
-        << "run `npm ci` in test/viewer (scripts/test.sh does)";
+    ASSERT_TRUE(std::filesystem::exists(viewer_tests().parent_path() / "node_modules"))
+        << "run `npm ci --prefix test` (scripts/test.sh does)";
     auto [node_code, node_version] = test::run_command({"node", "--version"});
     ASSERT_EQ(node_code, 0) << "node is needed: " << node_version;
     port_ = free_port();

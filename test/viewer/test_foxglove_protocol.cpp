@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <mocap/message_type.hpp>
 #include <nlohmann/json.hpp>
 
 #include "foxglove_protocol.hpp"

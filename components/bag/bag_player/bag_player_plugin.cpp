@@ -25,7 +25,7 @@ class BagPlayer final : public Component {
         "Plays a bag (rosbag2 sqlite3) into the deployment at its recorded pace times `rate` "
         "(0: as fast as subscribers take them, in order; reliable subscribers are never "
         "overrun). Message stamps are the recorded ones.");
-    spec.parameter("bag", std::string(), "the bag directory or .db3 file").path();
+    spec.parameter("bag", std::string(), "the bag directory, or one .mcap or .db3 file").path();
     spec.parameter("rate", 1.0, "pace relative to the recording; 0: as fast as possible").min(0);
     spec.parameter("loop", false, "start again after the last message");
     spec.parameter("topics", std::vector<std::string>{}, "topics to play (empty: all)");
@@ -42,7 +42,8 @@ class BagPlayer final : public Component {
 
   explicit BagPlayer(Context& context) : Component(context) {
     const std::string path = param<std::string>("bag");
-    if (path.empty()) throw std::invalid_argument("bag: give the bag directory or .db3 file");
+    if (path.empty())
+      throw std::invalid_argument("bag: give the bag directory, or one .mcap or .db3 file");
     reader_ = std::make_unique<BagReader>(path);
     for (const std::string& problem : reader_->problems()) log().warn("{}", problem);
     options_.rate = param<double>("rate");
@@ -52,6 +53,10 @@ class BagPlayer final : public Component {
     for (const BagTopic& topic : reader_->metadata().topics) {
       if (!options_.topics.empty() && std::find(options_.topics.begin(), options_.topics.end(),
                                                 topic.name) == options_.topics.end()) {
+        continue;
+      }
+      if (topic.type.empty()) {
+        log().warn("{}: not played: its type is unknown (no schema names it)", topic.name);
         continue;
       }
       const MessageType* type = find_message_type(topic.type);

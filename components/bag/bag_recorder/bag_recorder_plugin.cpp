@@ -34,6 +34,9 @@ class BagRecorder final : public Component {
     spec.parameter(
         "topics", std::vector<std::string>{},
         "topics to record (empty: every topic a component of the launch file publishes)");
+    spec.parameter("storage", std::string("mcap"),
+                   "mcap (one .mcap file, zstd-compressed chunks; ROS 2's default since Iron) "
+                   "or sqlite3 (a .db3 database, ROS 2 Humble's default)");
     spec.parameter("commit_interval_ms", int64_t{100},
                    "the most a kill can lose: messages are committed at least this often")
         .range(1, 60000);
@@ -70,6 +73,11 @@ class BagRecorder final : public Component {
     }
 
     RecorderOptions options;
+    options.writer.storage = param<std::string>("storage");
+    if (options.writer.storage != "mcap" && options.writer.storage != "sqlite3") {
+      throw std::invalid_argument(
+          fmt::format("storage: '{}' is not mcap or sqlite3", options.writer.storage));
+    }
     options.writer.commit_interval =
         std::chrono::milliseconds(param<int64_t>("commit_interval_ms"));
     recorder_ = std::make_unique<Recorder>(output, options);

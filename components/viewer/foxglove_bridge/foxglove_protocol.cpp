@@ -61,23 +61,6 @@ void put_u32(uint8_t* out, uint32_t value) {
 
 }  // namespace
 
-std::string ros2idl_schema(std::string_view root_type, std::string_view full_definition) {
-  std::string out = std::string(80, '=') + "\nIDL: " + std::string(root_type) + "\n";
-  size_t start = 0;
-  while (start < full_definition.size()) {
-    size_t end = full_definition.find('\n', start);
-    if (end == std::string_view::npos) end = full_definition.size();
-    std::string_view line = full_definition.substr(start, end - start);
-    if (!line.starts_with("#ifndef") && !line.starts_with("#define") &&
-        !line.starts_with("#endif")) {
-      out.append(line);
-      out.push_back('\n');
-    }
-    start = end + 1;
-  }
-  return out;
-}
-
 std::string server_info(std::string_view name, const std::vector<std::string>& capabilities,
                         const std::vector<std::string>& supported_encodings,
                         const std::map<std::string, std::string>& metadata,

@@ -32,12 +32,6 @@ struct Channel {
   std::string schema_encoding;
 };
 
-// A "ros2idl" schema for Foxglove's parser from mocap::full_definition()'s text (root first,
-// then each included type after a "====...\nIDL: pkg/msg/Type" line): the root gets its own
-// delimiter line, as ROS 2's foxglove_bridge writes it, and the include guards (#ifndef,
-// #define, #endif), which that parser does not read, are left out. #include lines stay.
-std::string ros2idl_schema(std::string_view root_type, std::string_view full_definition);
-
 enum class StatusLevel { Info = 0, Warning = 1, Error = 2 };
 
 // --- server -> client ----------------------------------------------------------------------

@@ -70,6 +70,11 @@ std::vector<const MessageType*> registered_message_types();
 // The type's definition followed by those of every type it includes, in the layout of
 // ROS 2's "ros2idl" message definitions (rosbag2, type description services).
 std::string full_definition(const MessageType& type);
+// full_definition()'s text as a "ros2idl" schema of an MCAP file or a Foxglove channel holds
+// it: the root gets its own delimiter line, as ROS 2's tools write it, and the include guards
+// (#ifndef, #define, #endif), which Foxglove's parser does not read, are left out. #include
+// lines stay.
+std::string ros2idl_schema(std::string_view root_type, std::string_view full_definition);
 
 // ROS 2 name mangling for DDS.
 std::string dds_type_name(std::string_view ros_type_name);    // a/msg/T -> a::msg::dds_::T_

@@ -1,5 +1,6 @@
 // What a bag holds, as rosbag2 (ROS 2 Humble) describes it in a bag directory's metadata.yaml
-// (version 5, storage_identifier sqlite3) and in the topics table of each .db3 file.
+// (version 5, storage_identifier sqlite3 or mcap), in the topics table of each .db3 file and
+// in the channels of each .mcap file.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +18,10 @@ struct BagTopic {
   // The QoS of each publisher the recorder saw, as rosbag2's offered_qos_profiles lists them.
   std::vector<Qos> offered_qos;
   uint64_t message_count = 0;
+  // The type's definition as an MCAP Schema holds it: ROS 2's "ros2idl" layout (ros2idl_schema
+  // in mocap/message_type.hpp). Empty: unknown (the schema is then left out). sqlite3 bags do
+  // not keep it.
+  std::string type_definition{};
 };
 
 struct BagFile {
@@ -26,6 +31,7 @@ struct BagFile {
 };
 
 struct BagMetadata {
+  std::string storage_identifier = "sqlite3";  // or "mcap"
   std::vector<BagFile> files;
   std::vector<BagTopic> topics;
   int64_t start_ns = 0;  // the earliest message's timestamp, nanoseconds since the epoch

@@ -1,5 +1,6 @@
-// Reads a bag written by BagWriter or by ROS 2's rosbag2 sqlite3 storage (schema versions 1
-// to 4): a bag directory (with or without metadata.yaml) or one .db3 file.
+// Reads a bag written by BagWriter or by ROS 2's rosbag2, in either storage, told apart by
+// content: MCAP (profile ros2) or sqlite3 (schema versions 1 to 4). A bag directory (with or
+// without metadata.yaml) or one .mcap or .db3 file.
 //
 //   BagReader reader("runs/walk");
 //   for (const BagTopic& topic : reader.metadata().topics) ...
@@ -8,10 +9,11 @@
 //   for (const std::string& problem : reader.problems()) warn(problem);
 //
 // Damaged bags: what is readable is read. A truncated or corrupt database gives the messages
-// its intact pages hold; each part that cannot be read is reported once in problems() (file,
-// which messages, SQLite's error) rather than thrown. Only a bag with nothing readable at all
+// its intact pages hold, an MCAP file those of its readable chunks up to a cut; each part that
+// cannot be read is reported once in problems() (file, which messages or byte, why) rather
+// than thrown. Only a bag with nothing readable at all
 // throws. A metadata.yaml that does not parse (or lists files that are missing) is reported the
-// same way, naming the file and key, and the directory's .db3 files are read instead.
+// same way, naming the file and key, and the directory's .mcap and .db3 files are read instead.
 #pragma once
 
 #include <cstdint>
@@ -32,7 +34,7 @@ struct BagMessage {
 
 class BagReader {
  public:
-  // Throws BagError when `path` is neither a bag directory nor a readable .db3 file.
+  // Throws BagError when `path` is neither a bag directory nor a readable .mcap or .db3 file.
   explicit BagReader(const std::string& path);
   ~BagReader();
   BagReader(const BagReader&) = delete;

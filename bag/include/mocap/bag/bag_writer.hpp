@@ -8,10 +8,11 @@
 //   writer.write(images, stamp_ns, cdr_bytes);           // encapsulated CDR, as on the wire
 //   writer.close();
 //
-// Crash safety: the database runs in write-ahead-log mode and messages are committed in
-// transactions of at most `commit_interval` or `commit_messages`, whichever comes first. A
-// writer killed at any moment (SIGKILL) leaves a bag that opens and holds every committed
-// message: what is lost is the last open transaction, at most `commit_interval` of data.
+// Crash safety: messages are committed at least every `commit_interval` or `commit_messages`,
+// whichever comes first, and a writer killed at any moment (SIGKILL) leaves a bag that opens
+// and holds every committed message: what is lost is at most `commit_interval` of data.
+// sqlite3: the database runs in write-ahead-log mode, a commit is a transaction. mcap: a
+// commit writes the open chunk whole, so the file only ever grows by complete chunks.
 // metadata.yaml is rewritten (atomically, by rename) whenever topics are added and at close;
 // after a kill its counts are stale, and readers count from the database.
 #pragma once
@@ -28,6 +29,10 @@
 namespace mocap::bag {
 
 struct BagWriterOptions {
+  // "sqlite3" (rosbag2's Humble default) or "mcap" (its default since Iron: one .mcap file,
+  // messages in chunks compressed with `compression`, "zstd", "lz4" or "" for none).
+  std::string storage = "sqlite3";
+  std::string compression = "zstd";
   // A transaction is committed when it is this old or holds this many messages.
   std::chrono::milliseconds commit_interval{100};
   size_t commit_messages = 1000;
@@ -39,8 +44,9 @@ struct BagWriterOptions {
 
 class BagWriter {
  public:
-  // Creates `directory` (it must not exist, or be empty) and in it `<name>_0.db3`, <name>
-  // being the directory's last component, and metadata.yaml. Throws BagError.
+  // Creates `directory` (it must not exist, or be empty) and in it `<name>_0.db3` (or
+  // `<name>_0.mcap`), <name> being the directory's last component, and metadata.yaml. Throws
+  // BagError.
   explicit BagWriter(const std::string& directory, BagWriterOptions options = {});
   ~BagWriter();  // close(), errors swallowed (logged to stderr)
   BagWriter(const BagWriter&) = delete;

@@ -40,7 +40,8 @@ class Recorder {
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
 
-  // Thread-safe. Returns the id for record().
+  // Thread-safe. Returns the id for record(). A topic without a type_definition gets its
+  // type's from this process's registered types (find_message_type), when it knows the type.
   uint32_t add_topic(const BagTopic& topic);
   // Thread-safe; quick unless max_queued_bytes wait to be written, then it waits for room.
   // Queues `message` of `type` (serialized by the writer thread) or, with `type` null,
