@@ -110,7 +110,6 @@ struct BagWriter::State {
   std::optional<mcap::FileWriter> mcap;
   std::vector<uint16_t> channel_of;
   std::map<std::string, uint16_t> schema_of;
-  uint64_t pending_bytes = 0;  // in the open chunk, uncompressed
 
   // Everything write() accepted, and the part of it that is committed: a failed transaction
   // takes the counts back to `committed` (changed under committed_mutex, which
@@ -224,7 +223,6 @@ struct BagWriter::State {
       }
       set_committed();
       transaction_messages = 0;
-      pending_bytes = 0;
       return;
     }
     if (!db.in_transaction()) return;
@@ -308,7 +306,8 @@ struct BagWriter::State {
   void write_mcap(uint32_t topic_id, int64_t timestamp_ns, std::span<const uint8_t> data) {
     const uint64_t record = mcap::kRecordPrefix + mcap::kMessageHeaderSize + data.size();
     if (options.max_bytes > 0 &&
-        mcap->file_bytes() + pending_bytes + record + kMcapCloseReserve > options.max_bytes) {
+        mcap->file_bytes() + mcap->open_chunk_bytes() + record + kMcapCloseReserve >
+            options.max_bytes) {
       commit_now();
       if (mcap->file_bytes() + record + kMcapCloseReserve > options.max_bytes) {
         failed = true;
@@ -326,7 +325,6 @@ struct BagWriter::State {
     } catch (const BagError& e) {
       fail_mcap(e);
     }
-    pending_bytes += record;
   }
 
   void add_topic_row(uint32_t id, const BagTopic& topic) {
@@ -560,28 +558,18 @@ void BagWriter::close() {
     }
   }
   const std::string yaml = format_metadata_yaml(s.metadata);
-  if (s.mcap) {
-    try {
+  try {
+    if (s.mcap) {
       // rosbag2 (Jazzy on) keeps the bag's metadata in the file too.
       s.mcap->set_metadata("rosbag2", {{"serialized_metadata", yaml}});
       s.mcap->close();
-    } catch (const BagError& e) {
-      report(e);
+    } else {
+      if (s.limit_pages > 0) s.db.pragma_int(fmt::format("max_page_count = {}", s.limit_pages));
+      sqlite::Statement statement(
+          s.db, "INSERT INTO metadata (metadata_version, metadata) VALUES (?, ?)");
+      statement.bind(1, kMetadataVersion).bind_text(2, yaml);
+      statement.step();
     }
-    try {
-      s.write_yaml(yaml);
-    } catch (const BagError& e) {
-      report(e);
-    }
-    if (first_error) throw BagError(*first_error);
-    return;
-  }
-  try {
-    if (s.limit_pages > 0) s.db.pragma_int(fmt::format("max_page_count = {}", s.limit_pages));
-    sqlite::Statement statement(s.db,
-                                "INSERT INTO metadata (metadata_version, metadata) VALUES (?, ?)");
-    statement.bind(1, kMetadataVersion).bind_text(2, yaml);
-    statement.step();
   } catch (const BagError& e) {
     report(e);
   }
@@ -589,6 +577,10 @@ void BagWriter::close() {
     s.write_yaml(yaml);
   } catch (const BagError& e) {
     report(e);
+  }
+  if (s.mcap) {
+    if (first_error) throw BagError(*first_error);
+    return;
   }
   try {
     // Back to a rollback journal: the log is merged into the database and removed, and the

@@ -55,6 +55,9 @@ class FileWriter {
 
   const std::string& path() const { return path_; }
   uint64_t file_bytes() const { return offset_; }
+  // The open chunk's records, uncompressed: what the next flush() adds at most, besides its
+  // message indexes.
+  uint64_t open_chunk_bytes() const { return chunk_.size(); }
 
  private:
   void write_out(const std::string& bytes);
