@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string_view>
 
+#include <mocap/calibration/camera_factory.hpp>
 #include <mocap/spelling.hpp>
 #include <nlohmann/json.hpp>
 
@@ -388,22 +389,11 @@ class ConfigReader {
     spec.type = reader_.text(reader_.required(map, "type", path), path / "type");
     spec.constant = reader_.boolean(map, "constant", path, false);
     spec.value = reader_.numbers(reader_.required(map, "value", path), path / "value");
-    const size_t count = spec.value.size();
-    if (spec.type == "eucm") {
-      if (count != 6) {
-        reader_.fail(path / "value", "eucm takes 6 numbers (alpha, beta, fu, fv, u0, v0), not " +
-                                         std::to_string(count));
-      }
-    } else if (spec.type == "pinhole") {
-      if (count != 4 && count != 9) {
-        reader_.fail(path / "value",
-                     "pinhole takes 4 numbers (fx, fy, cx, cy) or 9 (then k1, k2, p1, p2, k3), "
-                     "not " +
-                         std::to_string(count));
-      }
-    } else {
-      reader_.fail(path / "type", "unknown camera type '" + spec.type + "' (eucm, pinhole)");
+    if (!is_camera_type(spec.type)) {
+      reader_.fail(path / "type", "unknown camera type '" + spec.type + "' (" + kCameraTypes + ")");
     }
+    const std::string problem = camera_parameter_count_problem(spec.type, spec.value.size());
+    if (!problem.empty()) reader_.fail(path / "value", problem);
     return spec;
   }
 

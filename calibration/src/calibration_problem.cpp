@@ -46,10 +46,20 @@ void transform_point(const T* pose, bool direct, T* point) {
   }
 }
 
+enum class Lens { kPinhole, kEucm, kUcm, kMei };
+
+// The configuration reader has checked that `type` is one of these.
+Lens lens_of(const std::string& type) {
+  if (type == "eucm") return Lens::kEucm;
+  if (type == "ucm") return Lens::kUcm;
+  if (type == "mei") return Lens::kMei;
+  return Lens::kPinhole;
+}
+
 // The pixel error of one board point: parameter block 0 is the camera, then one block per
 // link of the chain, left to right (T = T1 T2 ... Tn: Tn is applied first).
 struct PointResidual {
-  bool eucm = true;
+  Lens lens = Lens::kPinhole;
   Eigen::Vector3d object;
   Eigen::Vector2d observed;
   std::vector<bool> direct;
@@ -59,12 +69,25 @@ struct PointResidual {
     T point[3] = {T(object.x()), T(object.y()), T(object.z())};
     for (size_t i = direct.size(); i-- > 0;) transform_point(parameters[1 + i], direct[i], point);
     T pixel[2];
-    const bool valid = eucm ? eucm_project(parameters[0], point, pixel)
-                            : pinhole_project(parameters[0], point, pixel);
-    if (!valid) return false;
+    if (!project(parameters[0], point, pixel)) return false;
     residuals[0] = pixel[0] - T(observed.x());
     residuals[1] = pixel[1] - T(observed.y());
     return true;
+  }
+
+  template <class T>
+  bool project(const T* camera, const T* point, T* pixel) const {
+    switch (lens) {
+      case Lens::kEucm:
+        return eucm_project(camera, point, pixel);
+      case Lens::kUcm:
+        return ucm_project(camera, point, pixel);
+      case Lens::kMei:
+        return mei_project(camera, point, pixel);
+      case Lens::kPinhole:
+        break;
+    }
+    return pinhole_project(camera, point, pixel);
   }
 };
 
@@ -93,8 +116,7 @@ struct PriorResidual {
 };
 
 int free_intrinsics(const CameraSpec& camera) {
-  if (camera.constant) return 0;
-  return camera.type == "eucm" ? kEucmParameters : static_cast<int>(camera.value.size());
+  return camera.constant ? 0 : static_cast<int>(camera.value.size());
 }
 
 // Whether the points span an area: not all on one line or in one spot (half a pixel).
@@ -317,7 +339,6 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
   for (size_t d = 0; d < config.data.size(); ++d) {
     const DataSpec& data = config.data[d];
     const size_t c = s.camera_index.at(data.camera);
-    const bool eucm = config.cameras[c].type == "eucm";
     std::vector<bool> direct;
     for (const ChainLink& link : data.transform_chain) direct.push_back(link.direct);
     for (size_t k = 0; k < data.shots.size(); ++k) {
@@ -328,9 +349,9 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
         blocks.push_back(s.pose_block(data, i, shot.frame));
       }
       for (size_t p = 0; p < shot.points.size(); ++p) {
-        auto* cost = new ceres::DynamicAutoDiffCostFunction<PointResidual, 4>(
-            new PointResidual{eucm, data.object_points[static_cast<size_t>(data.corners[p])],
-                              shot.points[p], direct});
+        auto* cost = new ceres::DynamicAutoDiffCostFunction<PointResidual, 4>(new PointResidual{
+            lens_of(config.cameras[c].type),
+            data.object_points[static_cast<size_t>(data.corners[p])], shot.points[p], direct});
         cost->AddParameterBlock(static_cast<int>(s.cameras[c].size()));
         for (size_t i = 0; i < data.transform_chain.size(); ++i) cost->AddParameterBlock(6);
         cost->SetNumResiduals(2);
@@ -373,6 +394,11 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
       s.problem.SetParameterUpperBound(block, 1, 100.0);
       s.problem.SetParameterLowerBound(block, 2, 1.0);  // focal lengths
       s.problem.SetParameterLowerBound(block, 3, 1.0);
+    } else if (spec.type == "ucm" || spec.type == "mei") {
+      s.problem.SetParameterLowerBound(block, 0, 0.0);  // xi
+      const int fu = static_cast<int>(spec.value.size()) - 4;
+      s.problem.SetParameterLowerBound(block, fu, 1.0);
+      s.problem.SetParameterLowerBound(block, fu + 1, 1.0);
     } else {
       s.problem.SetParameterLowerBound(block, 0, 1.0);
       s.problem.SetParameterLowerBound(block, 1, 1.0);

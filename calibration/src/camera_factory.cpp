@@ -3,40 +3,72 @@
 #include <algorithm>
 #include <array>
 #include <stdexcept>
-#include <string>
 
+#include <fmt/format.h>
 #include <mocap/calibration/eucm_camera.hpp>
 #include <mocap/calibration/lens_models.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
+#include <mocap/calibration/unified_camera.hpp>
 
 namespace mocap::calibration {
+namespace {
+
+struct CameraType {
+  std::string_view name;
+  std::string_view parameters;
+  size_t count;
+  size_t short_count;  // a shorter form (0: none), the first short_count parameters
+};
+
+constexpr std::array<CameraType, 4> kTypes = {{
+    {"eucm", "alpha, beta, fu, fv, u0, v0", kEucmParameters, 0},
+    {"mei", "xi, k1, k2, k3, k4, k5, fu, fv, u0, v0", kMeiParameters, 0},
+    {"pinhole", "fx, fy, cx, cy, then k1, k2, p1, p2, k3", kPinholeParameters, 4},
+    {"ucm", "xi, fu, fv, u0, v0", kUcmParameters, 0},
+}};
+
+const CameraType* find_type(std::string_view name) {
+  for (const CameraType& type : kTypes) {
+    if (type.name == name) return &type;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+const char* const kCameraTypes = "eucm, mei, pinhole, ucm";
+
+bool is_camera_type(std::string_view type) { return find_type(type) != nullptr; }
+
+std::string camera_parameter_count_problem(std::string_view name, size_t count) {
+  const CameraType* type = find_type(name);
+  if (!type) return fmt::format("unknown camera type '{}' ({})", name, kCameraTypes);
+  if (count == type->count || (type->short_count > 0 && count == type->short_count)) return "";
+  if (type->short_count > 0) {
+    return fmt::format("{} takes {} or {} numbers ({}), not {}", name, type->short_count,
+                       type->count, type->parameters, count);
+  }
+  return fmt::format("{} takes {} numbers ({}), not {}", name, type->count, type->parameters,
+                     count);
+}
 
 std::shared_ptr<const CameraModel> make_camera_model(std::string_view type, int width, int height,
                                                      std::span<const double> parameters) {
+  if (const std::string problem = camera_parameter_count_problem(type, parameters.size());
+      !problem.empty()) {
+    throw std::invalid_argument(problem);
+  }
   if (type == "eucm") {
-    if (parameters.size() != kEucmParameters) {
-      throw std::invalid_argument(
-          "camera model 'eucm' needs 6 parameters (alpha, beta, fu, fv, "
-          "u0, v0), got " +
-          std::to_string(parameters.size()));
-    }
     std::array<double, kEucmParameters> values;
     std::copy(parameters.begin(), parameters.end(), values.begin());
     return std::make_shared<EucmCamera>(width, height, values);
   }
   if (type == "pinhole") {
-    if (parameters.size() != 4 && parameters.size() != kPinholeParameters) {
-      throw std::invalid_argument(
-          "camera model 'pinhole' needs 4 parameters (fx, fy, cx, cy) or "
-          "9 (with k1, k2, p1, p2, k3), got " +
-          std::to_string(parameters.size()));
-    }
     PinholeIntrinsics intrinsics{parameters[0], parameters[1], parameters[2], parameters[3]};
     for (size_t i = 4; i < parameters.size(); ++i) intrinsics.distortion[i - 4] = parameters[i];
     return std::make_shared<PinholeCamera>(width, height, intrinsics);
   }
-  throw std::invalid_argument("unknown camera model '" + std::string(type) +
-                              "' (known: eucm, pinhole)");
+  return std::make_shared<UnifiedCamera>(width, height, parameters);  // ucm or mei
 }
 
 std::vector<double> camera_parameters(const CameraModel& model) {
@@ -45,6 +77,9 @@ std::vector<double> camera_parameters(const CameraModel& model) {
   }
   if (const auto* pinhole = dynamic_cast<const PinholeCamera*>(&model)) {
     return {pinhole->parameters().begin(), pinhole->parameters().end()};
+  }
+  if (const auto* unified = dynamic_cast<const UnifiedCamera*>(&model)) {
+    return unified->parameters();
   }
   throw std::invalid_argument("camera model '" + model.type() + "' has no parameter vector");
 }

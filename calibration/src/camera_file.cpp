@@ -14,7 +14,7 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <mocap/calibration/eucm_camera.hpp>
+#include <mocap/calibration/camera_factory.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
 namespace mocap::calibration {
@@ -130,19 +130,39 @@ std::shared_ptr<const CameraModel> read_pinhole(const Reader& reader, const YAML
   }
 }
 
-// In the order of eucm_project's parameters.
-constexpr std::array<const char*, 6> kEucmKeys = {"alpha", "beta", "fu", "fv", "u0", "v0"};
+// The lens models whose file form is a map named after them, with their parameters as keys in
+// the order of lens_models.hpp.
+struct NamedParameters {
+  std::string_view model;
+  std::vector<std::string_view> keys;
+};
+const std::array<NamedParameters, 3> kNamedParameterModels = {{
+    {"eucm", {"alpha", "beta", "fu", "fv", "u0", "v0"}},
+    {"mei", {"xi", "k1", "k2", "k3", "k4", "k5", "fu", "fv", "u0", "v0"}},
+    {"ucm", {"xi", "fu", "fv", "u0", "v0"}},
+}};
 
-std::shared_ptr<const CameraModel> read_eucm(const Reader& reader, int width, int height) {
-  YAML::Node node = reader.required("eucm");
-  reader.check_map(node, "eucm", {kEucmKeys.begin(), kEucmKeys.end()});
-  std::array<double, 6> parameters;
-  for (size_t i = 0; i < kEucmKeys.size(); ++i) {
-    std::string field = std::string("eucm.") + kEucmKeys[i];
-    parameters[i] = reader.number(reader.required(node, kEucmKeys[i], "eucm."), field);
+const NamedParameters* find_named_parameters(std::string_view model) {
+  for (const NamedParameters& named : kNamedParameterModels) {
+    if (named.model == model) return &named;
+  }
+  return nullptr;
+}
+
+std::shared_ptr<const CameraModel> read_named_parameters(const Reader& reader,
+                                                         const NamedParameters& named, int width,
+                                                         int height) {
+  const std::string model(named.model);
+  YAML::Node node = reader.required(model.c_str());
+  reader.check_map(node, model, named.keys);
+  std::vector<double> parameters;
+  for (std::string_view key : named.keys) {
+    const std::string name(key);
+    parameters.push_back(
+        reader.number(reader.required(node, name.c_str(), model + "."), model + "." + name));
   }
   try {
-    return std::make_shared<EucmCamera>(width, height, parameters);
+    return make_camera_model(model, width, height, parameters);
   } catch (const std::invalid_argument& e) {
     reader.fail(node, e.what());
   }
@@ -202,11 +222,12 @@ CameraFile parse_camera_file(const std::string& text, const std::string& source)
   std::string model = reader.text("distortion_model", "plumb_bob");
   if (model == "plumb_bob" || model == "pinhole") {
     camera.model = read_pinhole(reader, root, width, height);
-  } else if (model == "eucm") {
-    camera.model = read_eucm(reader, width, height);
+  } else if (const NamedParameters* named = find_named_parameters(model)) {
+    camera.model = read_named_parameters(reader, *named, width, height);
   } else {
-    reader.fail(root["distortion_model"],
-                "distortion_model '" + model + "' is not supported (plumb_bob, pinhole, eucm)");
+    reader.fail(root["distortion_model"], "distortion_model '" + model +
+                                              "' is not supported (plumb_bob, pinhole, eucm, "
+                                              "mei, ucm)");
   }
   if (root["pose"]) camera.world_from_camera = read_pose(reader, root["pose"]);
   return camera;
@@ -241,10 +262,11 @@ std::string format_camera_file(const CameraFile& camera) {
             list_text({1, 0, 0, 0, 1, 0, 0, 0, 1}) + "\n";
     text += "projection_matrix:\n  rows: 3\n  cols: 4\n  data: " +
             list_text({k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0}) + "\n";
-  } else if (const auto* eucm = dynamic_cast<const EucmCamera*>(&model)) {
-    text += "distortion_model: eucm\neucm:\n";
-    for (size_t i = 0; i < kEucmKeys.size(); ++i) {
-      text += fmt::format("  {}: {}\n", kEucmKeys[i], number_text(eucm->parameters()[i]));
+  } else if (const NamedParameters* named = find_named_parameters(model.type())) {
+    const std::vector<double> parameters = camera_parameters(model);
+    text += fmt::format("distortion_model: {0}\n{0}:\n", named->model);
+    for (size_t i = 0; i < named->keys.size(); ++i) {
+      text += fmt::format("  {}: {}\n", named->keys[i], number_text(parameters[i]));
     }
   } else {
     throw std::invalid_argument("camera file: camera model '" + model.type() +

@@ -3,8 +3,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <Eigen/LU>
-
 namespace mocap::calibration {
 
 PinholeCamera::PinholeCamera(int width, int height, const PinholeIntrinsics& intrinsics)
@@ -27,13 +25,6 @@ PinholeCamera::PinholeCamera(int width, int height, const PinholeIntrinsics& int
   }
 }
 
-Eigen::Vector2d PinholeCamera::distort(const Eigen::Vector2d& p) const {
-  if (!has_distortion_) return p;
-  Eigen::Vector2d distorted;
-  pinhole_distort(intrinsics_.distortion.data(), p.data(), distorted.data());
-  return distorted;
-}
-
 std::optional<Eigen::Vector2d> PinholeCamera::project(const Eigen::Vector3d& point) const {
   Eigen::Vector2d pixel;
   if (!pinhole_project(parameters_.data(), point.data(), pixel.data())) return std::nullopt;
@@ -44,21 +35,11 @@ std::optional<Eigen::Vector3d> PinholeCamera::unproject(const Eigen::Vector2d& p
   Eigen::Vector2d target((pixel.x() - intrinsics_.cx) / intrinsics_.fx,
                          (pixel.y() - intrinsics_.cy) / intrinsics_.fy);
   if (!has_distortion_) return Eigen::Vector3d(target.x(), target.y(), 1.0);
-  // Newton's method on distort(p) = target, with a numeric Jacobian: converges in a few
-  // steps wherever the distortion is monotonic.
-  Eigen::Vector2d p = target;
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    Eigen::Vector2d residual = distort(p) - target;
-    if (residual.squaredNorm() < 1e-24) break;
-    constexpr double h = 1e-7;
-    Eigen::Matrix2d jacobian;
-    jacobian.col(0) = (distort(p + Eigen::Vector2d(h, 0)) - distort(p)) / h;
-    jacobian.col(1) = (distort(p + Eigen::Vector2d(0, h)) - distort(p)) / h;
-    p -= jacobian.lu().solve(residual);
-    if (!p.allFinite()) return std::nullopt;
+  Eigen::Vector2d normalised;
+  if (!pinhole_undistort(intrinsics_.distortion.data(), target.data(), normalised.data())) {
+    return std::nullopt;
   }
-  if ((distort(p) - target).norm() > 1e-9) return std::nullopt;
-  return Eigen::Vector3d(p.x(), p.y(), 1.0);
+  return Eigen::Vector3d(normalised.x(), normalised.y(), 1.0);
 }
 
 std::unique_ptr<CameraModel> PinholeCamera::clone() const {

@@ -316,7 +316,7 @@ TEST_F(ConfigFiles, ErrorsNameTheFileAndTheKeyPath) {
       {"[1, 0, 0, 0, 0, 1.57]", "[1, 0, \"x\"]",
        "calib.json: transformations[1].value[2]: a number, not the string \"x\""},
       {R"("type" : "eucm",)", R"("type" : "fisheye",)",
-       "calib.json: cameras[0].type: unknown camera type 'fisheye' (eucm, pinhole)"},
+       "calib.json: cameras[0].type: unknown camera type 'fisheye' (eucm, mei, pinhole, ucm)"},
       {R"("value" : [0.01, 1, 1175, 1175, 512, 384])", R"("value" : [0.01, 1, 1175, 1175, 512])",
        "calib.json: cameras[0].value: eucm takes 6 numbers (alpha, beta, fu, fv, u0, v0), not 5"},
       {R"("type" : "eucm",
@@ -324,8 +324,8 @@ TEST_F(ConfigFiles, ErrorsNameTheFileAndTheKeyPath) {
     "value" : [0.01, 1, 1175, 1175, 512, 384])",
        R"("type" : "pinhole",
     "value" : [1175, 1175, 512, 384, 0])",
-       "calib.json: cameras[0].value: pinhole takes 4 numbers (fx, fy, cx, cy) or 9 (then k1, "
-       "k2, p1, p2, k3), not 5"},
+       "calib.json: cameras[0].value: pinhole takes 4 or 9 numbers (fx, fy, cx, cy, then k1, k2, "
+       "p1, p2, k3), not 5"},
       {R"("constant" : false,
     "value" : [0.01)",
        R"("constnat" : false,

@@ -1,4 +1,5 @@
 // Camera models: the EUCM lens against values worked out by hand and against its own inverse,
+// the unified (UCM, Mei) lenses against the EUCM and OpenCV's omnidirectional camera,
 // the lens formulas with Ceres Jets against finite differences, the factory, and camera files
 // (EUCM and poses) through the writer and back.
 #include <gtest/gtest.h>
@@ -20,6 +21,8 @@
 #include <mocap/calibration/eucm_camera.hpp>
 #include <mocap/calibration/lens_models.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
+#include <mocap/calibration/unified_camera.hpp>
+#include <opencv2/ccalib/omnidir.hpp>
 
 #include "test_support.hpp"
 
@@ -363,6 +366,167 @@ TEST(LensModels, JetsAreRejectedWhereDoublesAre) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Unified cameras (UCM and Mei).
+
+struct Ucm {
+  template <class T>
+  bool operator()(const T* parameters, const T* point, T* pixel) const {
+    return ucm_project(parameters, point, pixel);
+  }
+};
+
+struct Mei {
+  template <class T>
+  bool operator()(const T* parameters, const T* point, T* pixel) const {
+    return mei_project(parameters, point, pixel);
+  }
+};
+
+// Directions every 7.5 degrees over the whole sphere but the poles.
+std::vector<Eigen::Vector3d> directions_all_round() {
+  std::vector<Eigen::Vector3d> directions;
+  for (double polar = 7.5; polar < 180; polar += 7.5) {
+    for (double azimuth = 0; azimuth < 360; azimuth += 15) {
+      directions.emplace_back(std::sin(polar * kDeg) * std::cos(azimuth * kDeg),
+                              std::sin(polar * kDeg) * std::sin(azimuth * kDeg),
+                              std::cos(polar * kDeg));
+    }
+  }
+  return directions;
+}
+
+// The UCM is the EUCM with a sphere (beta = 1), alpha = xi / (1 + xi) and focal lengths divided
+// by 1 + xi: the same pixels and the same valid region, whatever side of xi = 1.
+TEST(UnifiedCamera, UcmIsEucmWithASphere) {
+  for (double xi : {0.0, 0.4, 1.0, 1.7}) {
+    SCOPED_TRACE(testing::Message() << "xi " << xi);
+    const std::array<double, kUcmParameters> ucm = {xi, 700, 710, 320.5, 240.5};
+    const std::array<double, kEucmParameters> eucm = {xi / (1 + xi),  1,     700 / (1 + xi),
+                                                      710 / (1 + xi), 320.5, 240.5};
+    int valid = 0;
+    for (const Eigen::Vector3d& direction : directions_all_round()) {
+      const Eigen::Vector3d point = 2.5 * direction;
+      std::array<double, 2> a{}, b{};
+      const bool in_ucm = ucm_project(ucm.data(), point.data(), a.data());
+      ASSERT_EQ(in_ucm, eucm_project(eucm.data(), point.data(), b.data())) << point.transpose();
+      if (!in_ucm) continue;
+      ++valid;
+      EXPECT_NEAR(a[0], b[0], 1e-9 * std::max(1.0, std::abs(b[0])));
+      EXPECT_NEAR(a[1], b[1], 1e-9 * std::max(1.0, std::abs(b[1])));
+    }
+    EXPECT_GT(valid, 100);
+  }
+}
+
+// Against OpenCV's omnidirectional camera (cv::omnidir, Mei's model with k1, k2, p1, p2), an
+// implementation of its own: visgeom's k3 is 0 there, its k4 and k5 are OpenCV's p1 and p2.
+TEST(UnifiedCamera, MeiAgreesWithOpenCVsOmnidirectionalCamera) {
+  const double xi = 1.15, k1 = -0.18, k2 = 0.04, p1 = 0.0012, p2 = -0.0007;
+  const std::array<double, kMeiParameters> mei = {xi, k1, k2, 0, p1, p2, 780, 776, 321.5, 243.0};
+  std::vector<cv::Point3d> points;
+  for (const Eigen::Vector3d& direction : directions_all_round()) {
+    if (direction.z() > std::cos(100 * kDeg)) {
+      points.emplace_back(3 * direction.x(), 3 * direction.y(), 3 * direction.z());
+    }
+  }
+  std::vector<cv::Point2d> expected;
+  const cv::Matx33d k(780, 0, 321.5, 0, 776, 243.0, 0, 0, 1);
+  cv::omnidir::projectPoints(points, expected, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), k, xi,
+                             cv::Vec4d(k1, k2, p1, p2));
+  ASSERT_EQ(expected.size(), points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d point(points[i].x, points[i].y, points[i].z);
+    std::array<double, 2> pixel;
+    ASSERT_TRUE(mei_project(mei.data(), point.data(), pixel.data())) << point.transpose();
+    EXPECT_NEAR(pixel[0], expected[i].x, 1e-9) << point.transpose();
+    EXPECT_NEAR(pixel[1], expected[i].y, 1e-9) << point.transpose();
+  }
+}
+
+TEST(UnifiedCamera, EveryPixelOfTheImageUnprojectsAndProjectsBack) {
+  const std::vector<double> ucm = {0.8, 610, 615, 320.5, 240.5};
+  const std::vector<double> narrow_ucm = {1.6, 1500, 1500, 320.5, 240.5};
+  const std::vector<double> mei = {0.95, -0.12, 0.03, -0.004, 0.0011, -0.0006, 640, 642, 318, 243};
+  for (const std::vector<double>* parameters : {&ucm, &narrow_ucm, &mei}) {
+    const UnifiedCamera camera(640, 480, *parameters);
+    SCOPED_TRACE(camera.type());
+    int pixels = 0;
+    double worst = 0;
+    for (int v = 0; v < camera.height(); v += 7) {
+      for (int u = 0; u < camera.width(); u += 7) {
+        const Eigen::Vector2d pixel(u, v);
+        auto ray = camera.unproject(pixel);
+        ASSERT_TRUE(ray) << pixel.transpose();
+        auto back = camera.project(*ray);
+        ASSERT_TRUE(back) << pixel.transpose();
+        worst = std::max(worst, (*back - pixel).norm());
+        ++pixels;
+      }
+    }
+    EXPECT_GT(pixels, 6000);
+    EXPECT_LT(worst, 1e-8);
+  }
+}
+
+// xi = 2: w = 1/2, the valid region ends 120 degrees from the axis (z = −rho / 2); the pixels
+// of points beyond it would fold back over those of valid ones.
+TEST(UnifiedCamera, ProjectionStopsAtTheModelsValidityBoundary) {
+  const UnifiedCamera ucm(640, 480, std::vector<double>{2, 900, 900, 320, 240});
+  const UnifiedCamera mei(640, 480,
+                          std::vector<double>{2, -0.1, 0.01, 0, 0.001, 0.001, 900, 900, 320, 240});
+  for (const UnifiedCamera* camera : {&ucm, &mei}) {
+    const double inside = 120 * kDeg - 1e-6, outside = 120 * kDeg + 1e-6;
+    EXPECT_TRUE(camera->project({std::sin(inside), 0, std::cos(inside)})) << camera->type();
+    EXPECT_FALSE(camera->project({std::sin(outside), 0, std::cos(outside)})) << camera->type();
+    EXPECT_FALSE(camera->project({0, 0, -1})) << camera->type();
+  }
+  // 90 degrees from the axis is r = 1/2 here (1 + (1 − xi²)·r² = xi²·r⁴): a ray (x/z, y/z, 1)
+  // ends there, short of the valid disc's edge (r² = 1 / (xi² − 1)).
+  auto ray = ucm.unproject({320 + 450 - 1e-3, 240});
+  ASSERT_TRUE(ray);
+  EXPECT_GT(ray->x(), 1e4);
+  EXPECT_FALSE(ucm.unproject({320 + 450 + 1e-3, 240}));
+  EXPECT_FALSE(ucm.unproject({320 + std::sqrt(1.0 / 3) * 900 + 1, 240}));
+}
+
+TEST(UnifiedCamera, FocalLengthIsThePixelsPerRadianAtTheCentre) {
+  const UnifiedCamera camera(640, 480, std::vector<double>{0.9, 760, 770, 320, 240});
+  const double angle = 1e-4;
+  auto pixel = camera.project({std::tan(angle), 0, 1});
+  ASSERT_TRUE(pixel);
+  EXPECT_NEAR((pixel->x() - 320) / angle, 760 / 1.9, 1e-3);
+  EXPECT_NEAR(camera.focal_length_px(), 765 / 1.9, 1e-12);
+}
+
+TEST(UnifiedCamera, RejectsParametersOutsideTheModel) {
+  auto error = [](std::vector<double> parameters) {
+    return error_of([&] { UnifiedCamera(640, 480, parameters); });
+  };
+  EXPECT_EQ(error({-0.1, 700, 700, 320, 240}), "ucm camera: xi must not be negative");
+  EXPECT_EQ(error({0.5, 700, 0, 320, 240}), "ucm camera: focal lengths fu, fv must be positive");
+  EXPECT_EQ(error({0.5, 0, 0, 0, 0, 0, -700, 700, 320, 240}),
+            "mei camera: focal lengths fu, fv must be positive");
+  EXPECT_EQ(error({0.5, NAN, 0, 0, 0, 0, 700, 700, 320, 240}),
+            "mei camera: a parameter is not finite");
+  EXPECT_EQ(error({0.5, 700, 700, 320}), "unified camera: 5 parameters (ucm) or 10 (mei), not 4");
+}
+
+TEST(LensModels, UcmAndMeiJetsMatchDoublesAndFiniteDifferences) {
+  for (double xi : {0.3, 0.95, 1.6}) {
+    SCOPED_TRACE(testing::Message() << "xi " << xi);
+    const std::array<double, kUcmParameters> ucm = {xi, 700, 710, 320.5, 240.5};
+    const std::array<double, kMeiParameters> mei = {xi,      -0.15, 0.03, -0.002, 0.0012,
+                                                    -0.0007, 700,   710,  320.5,  240.5};
+    for (const Eigen::Vector3d& point :
+         {Eigen::Vector3d(0.31, -0.22, 1.4), Eigen::Vector3d(-1.2, 0.7, 0.9),
+          Eigen::Vector3d(0.9, 0.2, -0.1)}) {
+      check_derivatives<kUcmParameters>(Ucm{}, ucm, point);
+      check_derivatives<kMeiParameters>(Mei{}, mei, point);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // The factory.
 
 TEST(CameraFactory, MakesModelsFromTheirParametersAndGivesThemBack) {
@@ -391,13 +555,14 @@ TEST(CameraFactory, MakesModelsFromTheirParametersAndGivesThemBack) {
 TEST(CameraFactory, NamesTheTypeAndTheCountItExpects) {
   const std::vector<double> five = {1, 1, 300, 300, 512};
   std::string error = error_of([&] { make_camera_model("eucm", 1024, 768, five); });
-  EXPECT_TRUE(contains(error, "'eucm' needs 6 parameters")) << error;
-  EXPECT_TRUE(contains(error, "got 5")) << error;
+  EXPECT_EQ(error, "eucm takes 6 numbers (alpha, beta, fu, fv, u0, v0), not 5");
   error = error_of([&] { make_camera_model("pinhole", 1024, 768, five); });
-  EXPECT_TRUE(contains(error, "'pinhole' needs 4 parameters")) << error;
-  EXPECT_TRUE(contains(error, "or 9")) << error;
+  EXPECT_EQ(error, "pinhole takes 4 or 9 numbers (fx, fy, cx, cy, then k1, k2, p1, p2, k3), not 5");
+  error = error_of([&] { make_camera_model("mei", 1024, 768, five); });
+  EXPECT_EQ(error, "mei takes 10 numbers (xi, k1, k2, k3, k4, k5, fu, fv, u0, v0), not 5");
+  EXPECT_NO_THROW(make_camera_model("ucm", 1024, 768, five));
   error = error_of([&] { make_camera_model("fisheye", 1024, 768, five); });
-  EXPECT_TRUE(contains(error, "unknown camera model 'fisheye' (known: eucm, pinhole)")) << error;
+  EXPECT_EQ(error, "unknown camera type 'fisheye' (eucm, mei, pinhole, ucm)");
   const std::vector<double> bad_beta = {0.5, 0, 300, 300, 512, 384};
   EXPECT_THROW(make_camera_model("eucm", 1024, 768, bad_beta), std::invalid_argument);
 
@@ -457,6 +622,31 @@ TEST(CameraFile, EucmAndPoseGoThroughTheWriterAndBack) {
   EXPECT_EQ(camera_parameters(*loaded.model), camera_parameters(*camera.model));
   ASSERT_TRUE(loaded.world_from_camera);
   expect_same_pose(*loaded.world_from_camera, *camera.world_from_camera);
+}
+
+TEST(CameraFile, UcmAndMeiGoThroughTheWriterAndBack) {
+  test::TempDir dir;
+  for (const std::vector<double>& parameters :
+       {std::vector<double>{0.1 + 0.2, 700.0 / 3, 701, 320.5, 240.5},
+        std::vector<double>{1.0 / 3, -0.1, 0.02, -0.003, 1e-4, -2e-4, 700, 701, 320.5, 240.5}}) {
+    CameraFile camera;
+    camera.name = "omni";
+    camera.model = make_camera_model(parameters.size() == 5 ? "ucm" : "mei", 640, 480, parameters);
+    const std::string path = (dir / "omni.yaml").string();
+    save_camera_file(path, camera);
+    const std::string text = test::read_file(path);
+    EXPECT_TRUE(contains(text, "distortion_model: " + camera.model->type())) << text;
+    const CameraFile loaded = load_camera_file(path);
+    ASSERT_EQ(loaded.model->type(), camera.model->type());
+    EXPECT_EQ(camera_parameters(*loaded.model), parameters);
+  }
+  const CameraFile visgeom_names = parse_camera_file(
+      "camera_name: c\nimage_width: 640\nimage_height: 480\n"
+      "distortion_model: mei\nmei: {xi: 0.9, k1: -0.1, k2: 0.02, k3: 0, "
+      "k4: 0.001, k5: -0.0005, fu: 760, fv: 761, u0: 320, v0: 240}\n",
+      "omni.yaml");
+  EXPECT_EQ(camera_parameters(*visgeom_names.model),
+            (std::vector<double>{0.9, -0.1, 0.02, 0, 0.001, -0.0005, 760, 761, 320, 240}));
 }
 
 TEST(CameraFile, PinholeKeepsTheCameraInfoLayoutAndGoesThroughTheWriterAndBack) {
@@ -535,7 +725,13 @@ TEST(CameraFile, BadFieldsAreNamedWithFileAndLine) {
        "cam.yaml:6: eucm camera: alpha must be in [0, 1]"},
       {eucm + "eucm: [0.5, 1, 300, 300, 1, 2]\n", "cam.yaml:5: 'eucm' must be a map"},
       {"distortion_model: kannala_brandt\n",
-       "cam.yaml:4: distortion_model 'kannala_brandt' is not supported (plumb_bob, pinhole, eucm)"},
+       "cam.yaml:4: distortion_model 'kannala_brandt' is not supported (plumb_bob, pinhole, eucm, "
+       "mei, ucm)"},
+      {"distortion_model: mei\nmei: {xi: 0.9, k1: 0, k2: 0, k4: 0, k5: 0, fu: 300, fv: 300, u0: 1, "
+       "v0: 2}\n",
+       "cam.yaml:5: missing field 'mei.k3'"},
+      {"distortion_model: ucm\nucm: {xi: -0.1, fu: 300, fv: 300, u0: 1, v0: 2}\n",
+       "cam.yaml:5: ucm camera: xi must not be negative"},
       {eucm + "eucm: {alpha: 0.5, beta: 1, fu: 300, fv: 300, u0: 1, v0: 2}\n" +
            "pose:\n  translation: [1, 2]\n  rotation: [0, 0, 0, 1]\n",
        "cam.yaml:7: 'pose.translation' must have 3 numbers, has 2"},

@@ -85,10 +85,9 @@ struct TransformSpec {
 
 struct CameraSpec {
   std::string name;
-  std::string type;  // "eucm" or "pinhole"
+  std::string type;  // one of camera_factory.hpp's kCameraTypes
   bool constant = false;
-  // eucm: alpha, beta, fu, fv, u0, v0 (6); pinhole: fx, fy, cx, cy[, k1, k2, p1, p2, k3] (4 or 9).
-  std::vector<double> value;
+  std::vector<double> value;  // in the type's order (camera_factory.hpp)
 };
 
 struct ChainLink {

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -11,9 +12,22 @@
 
 namespace mocap::calibration {
 
-// "eucm": alpha, beta, fu, fv, u0, v0; "pinhole": fx, fy, cx, cy and optionally k1, k2, p1, p2,
-// k3 (the order of lens_models.hpp). Throws std::invalid_argument for an unknown type, a wrong
-// number of parameters (naming the type and the count it expects) or values the model rejects.
+// The camera types and their parameters, in the order of lens_models.hpp:
+//   "eucm"     alpha, beta, fu, fv, u0, v0
+//   "mei"      xi, k1, k2, k3, k4, k5, fu, fv, u0, v0
+//   "pinhole"  fx, fy, cx, cy and optionally k1, k2, p1, p2, k3
+//   "ucm"      xi, fu, fv, u0, v0
+// "eucm, mei, pinhole, ucm": for messages that list them.
+extern const char* const kCameraTypes;
+
+bool is_camera_type(std::string_view type);
+
+// Empty when `type` takes `count` parameters; otherwise what it takes, as "eucm takes 6 numbers
+// (alpha, beta, fu, fv, u0, v0), not 5". `type` must be a camera type.
+std::string camera_parameter_count_problem(std::string_view type, size_t count);
+
+// Throws std::invalid_argument for an unknown type, a wrong number of parameters (with
+// camera_parameter_count_problem's text) or values the model rejects.
 std::shared_ptr<const CameraModel> make_camera_model(std::string_view type, int width, int height,
                                                      std::span<const double> parameters);
 

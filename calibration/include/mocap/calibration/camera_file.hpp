@@ -1,5 +1,5 @@
 // Camera files: ROS camera_info YAML (what camera_calibration writes), read into a model, and
-// the same layout extended to the EUCM lens and to where the camera is.
+// the same layout extended to the EUCM, UCM and Mei lenses and to where the camera is.
 //
 //   camera_name: ir_camera            # also the frame id unless `frame_id` is given
 //   frame_id: camera_ir_optical       # optional
@@ -16,7 +16,15 @@
 //   distortion_model: eucm
 //   eucm: {alpha: 0.6, beta: 1.1, fu: 1175, fv: 1175, u0: 512, v0: 384}
 //
-// Either may say where the camera is, as the calibration of a rig finds it: the camera's
+// and so do the unified cameras (unified_camera.hpp), with visgeom's names:
+//
+//   distortion_model: ucm
+//   ucm: {xi: 0.9, fu: 760, fv: 760, u0: 320, v0: 240}
+//   distortion_model: mei
+//   mei: {xi: 0.9, k1: -0.1, k2: 0.02, k3: 0, k4: 0.001, k5: -0.0005,
+//         fu: 760, fv: 760, u0: 320, v0: 240}
+//
+// Any of them may say where the camera is, as the calibration of a rig finds it: the camera's
 // optical frame in the rig's (world) frame, the quaternion normalised on reading (its norm
 // must be within 1e-3 of 1):
 //

@@ -25,8 +25,7 @@ class PinholeCamera final : public CameraModel {
   int height() const override { return height_; }
   // pinhole_project: nullopt for z <= 0.
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const override;
-  // Inverts the distortion by fixed-point iteration (as cv::undistortPoints does); nullopt
-  // when it does not converge.
+  // Inverts the distortion (pinhole_undistort); nullopt where that does not converge.
   std::optional<Eigen::Vector3d> unproject(const Eigen::Vector2d& pixel) const override;
   double focal_length_px() const override { return 0.5 * (intrinsics_.fx + intrinsics_.fy); }
   std::unique_ptr<CameraModel> clone() const override;
@@ -34,9 +33,6 @@ class PinholeCamera final : public CameraModel {
   const PinholeIntrinsics& intrinsics() const { return intrinsics_; }
   // fx, fy, cx, cy, k1, k2, p1, p2, k3, the order of pinhole_project.
   const std::array<double, kPinholeParameters>& parameters() const { return parameters_; }
-
-  // Normalised image coordinates (x/z, y/z) after distortion.
-  Eigen::Vector2d distort(const Eigen::Vector2d& normalised) const;
 
  private:
   int width_, height_;
