@@ -44,8 +44,10 @@ constexpr int64_t kMinimumPages = 16;
 // Pages a transaction may take beyond the estimate of its messages: interior b-tree pages,
 // index pages, rounding.
 constexpr double kSparePages = 4;
-// What an MCAP file's close adds after its last chunk, at most for a bag of a few dozen
-// topics: DataEnd, the summary, its offsets, the footer.
+// What an MCAP file's close adds after its last chunk besides the chunk indexes (which
+// FileWriter counts), at most for a bag of a few dozen topics: the metadata, DataEnd, the
+// summary's schemas, channels and statistics, its offsets, the footer; and the index of the
+// chunk a commit closes.
 constexpr uint64_t kMcapCloseReserve = 64 * 1024;
 
 std::string errno_text() { return std::strerror(errno); }
@@ -305,11 +307,11 @@ struct BagWriter::State {
   // every whole chunk before, and this write() reports the limit.
   void write_mcap(uint32_t topic_id, int64_t timestamp_ns, std::span<const uint8_t> data) {
     const uint64_t record = mcap::kRecordPrefix + mcap::kMessageHeaderSize + data.size();
+    auto closing = [&] { return mcap->chunk_index_bytes() + kMcapCloseReserve; };
     if (options.max_bytes > 0 &&
-        mcap->file_bytes() + mcap->open_chunk_bytes() + record + kMcapCloseReserve >
-            options.max_bytes) {
+        mcap->file_bytes() + mcap->open_chunk_bytes() + record + closing() > options.max_bytes) {
       commit_now();
-      if (mcap->file_bytes() + record + kMcapCloseReserve > options.max_bytes) {
+      if (mcap->file_bytes() + record + closing() > options.max_bytes) {
         failed = true;
         throw BagError(fmt::format(
             "{}: max_bytes reached after {} messages; the bag keeps the {} committed before",

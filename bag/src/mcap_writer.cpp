@@ -163,7 +163,7 @@ void FileWriter::close_chunk() {
   index.message_index_length =
       offset_ + bytes.size() - index.chunk_start_offset - index.chunk_length;
   write_out(bytes);
-  chunk_index_.push_back(std::move(index));
+  append(chunk_index_records_, index);
   ++statistics_.chunk_count;
   chunk_.clear();
   chunk_indexes_.clear();
@@ -224,9 +224,7 @@ void FileWriter::close() {
   statistics_.channel_count = static_cast<uint32_t>(channels_.size());
   statistics_.metadata_count = static_cast<uint32_t>(metadata_.size());
   group(Op::kStatistics, [&] { append(summary, statistics_); });
-  group(Op::kChunkIndex, [&] {
-    for (const ChunkIndex& index : chunk_index_) append(summary, index);
-  });
+  group(Op::kChunkIndex, [&] { summary += chunk_index_records_; });
   group(Op::kMetadataIndex, [&] {
     for (const MetadataIndex& index : metadata_index) append(summary, index);
   });

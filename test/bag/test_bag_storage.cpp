@@ -1034,6 +1034,41 @@ TEST(BagDiskFull, MaxBytesEndsTheRecordingCleanly) {
             (std::vector<std::vector<std::string>>{{"1"}}));
 }
 
+// An MCAP file that closes a chunk per message: its summary's chunk indexes (about a hundred
+// bytes a chunk) outgrow any fixed reserve, and close() must still end within max_bytes.
+TEST(BagDiskFull, MaxBytesHoldsForAnMcapFileOfManySmallChunks) {
+  TempDir dir;
+  const fs::path bag = dir / "chunky";
+  BagWriterOptions options;
+  options.storage = "mcap";
+  options.commit_messages = 1;
+  options.max_bytes = 2 * 1024 * 1024;
+  BagWriter writer(bag.string(), options);
+  uint32_t topic = writer.add_topic({"/small", "std_msgs/msg/ByteMultiArray", "cdr", {}});
+  FillResult fill;
+  for (uint64_t seq = 1; seq < 100'000; ++seq) {
+    try {
+      writer.write(topic, kEpoch + static_cast<int64_t>(seq), sequence_payload(seq, 1000));
+      fill.accepted = seq;
+    } catch (const BagError& e) {
+      fill.error = e.what();
+      break;
+    }
+  }
+  ASSERT_FALSE(fill.error.empty()) << "max_bytes never reached";
+  EXPECT_THAT(fill.error, HasSubstr("max_bytes reached"));
+  EXPECT_GT(fill.accepted, 1000u);  // a chunk each: more index than the fixed reserve
+  EXPECT_NO_THROW(writer.close());
+  const fs::path file = bag / "chunky_0.mcap";
+  EXPECT_LE(fs::file_size(file), options.max_bytes);
+
+  BagReader reader(bag.string());
+  ReadBack back = read_sequences(reader);
+  EXPECT_TRUE(reader.problems().empty()) << ::testing::PrintToString(reader.problems());
+  EXPECT_EQ(back.sequences.size(), fill.accepted);
+  EXPECT_TRUE(consecutive_from_one(back.sequences));
+}
+
 TEST(BagDiskFull, RealFullFileSystem) {
   if (geteuid() != 0) GTEST_SKIP() << "mounting a small tmpfs needs root";
   TempDir dir;
