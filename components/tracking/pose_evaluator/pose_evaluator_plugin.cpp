@@ -45,6 +45,10 @@ class PoseEvaluatorComponent final : public Component {
         .range(0, 1e9);
     spec.parameter("summary_file", std::string(), "where the final figures go (YAML), optional")
         .path();
+    spec.parameter("max_lag_frames", 200,
+                   "a frame whose estimate is this many truth frames late counts as lost (a "
+                   "test that must not depend on the machine's speed sets it high)")
+        .range(1, 1e7);
     spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kTruth, Qos::reliable(),
                                                              "ground truth, one array per image");
     spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoses, Qos::reliable(),
@@ -54,6 +58,7 @@ class PoseEvaluatorComponent final : public Component {
   explicit PoseEvaluatorComponent(Context& context) : Component(context) {
     EvaluationOptions options;
     options.min_visible_markers = param<int>("min_visible_markers");
+    options.max_pending_frames = static_cast<size_t>(param<int>("max_lag_frames"));
     evaluator_ = PoseEvaluator(options);
     stop_after_ = static_cast<uint64_t>(param<int>("stop_after_frames"));
     summary_file_ = param<std::string>("summary_file");
