@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <mocap/calibration/eucm_camera.hpp>
 #include <mocap/calibration/lens_models.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
@@ -15,16 +16,15 @@ namespace {
 
 struct CameraType {
   std::string_view name;
-  std::string_view parameters;
-  size_t count;
-  size_t short_count;  // a shorter form (0: none), the first short_count parameters
+  std::vector<std::string_view> parameters;  // the full form's, in order
+  size_t short_count;                        // a shorter form (0: none), the first parameters
 };
 
-constexpr std::array<CameraType, 4> kTypes = {{
-    {"eucm", "alpha, beta, fu, fv, u0, v0", kEucmParameters, 0},
-    {"mei", "xi, k1, k2, k3, k4, k5, fu, fv, u0, v0", kMeiParameters, 0},
-    {"pinhole", "fx, fy, cx, cy, then k1, k2, p1, p2, k3", kPinholeParameters, 4},
-    {"ucm", "xi, fu, fv, u0, v0", kUcmParameters, 0},
+const std::array<CameraType, 4> kTypes = {{
+    {"eucm", {"alpha", "beta", "fu", "fv", "u0", "v0"}, 0},
+    {"mei", {"xi", "k1", "k2", "k3", "k4", "k5", "fu", "fv", "u0", "v0"}, 0},
+    {"pinhole", {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"}, 4},
+    {"ucm", {"xi", "fu", "fv", "u0", "v0"}, 0},
 }};
 
 const CameraType* find_type(std::string_view name) {
@@ -40,16 +40,26 @@ const char* const kCameraTypes = "eucm, mei, pinhole, ucm";
 
 bool is_camera_type(std::string_view type) { return find_type(type) != nullptr; }
 
+std::span<const std::string_view> camera_parameter_names(std::string_view name) {
+  const CameraType* type = find_type(name);
+  if (!type) return {};
+  return type->parameters;
+}
+
 std::string camera_parameter_count_problem(std::string_view name, size_t count) {
   const CameraType* type = find_type(name);
   if (!type) return fmt::format("unknown camera type '{}' ({})", name, kCameraTypes);
-  if (count == type->count || (type->short_count > 0 && count == type->short_count)) return "";
-  if (type->short_count > 0) {
-    return fmt::format("{} takes {} or {} numbers ({}), not {}", name, type->short_count,
-                       type->count, type->parameters, count);
+  const size_t full = type->parameters.size(), short_count = type->short_count;
+  if (count == full || (short_count > 0 && count == short_count)) return "";
+  const auto names = [&](size_t from, size_t to) {
+    return fmt::format("{}", fmt::join(type->parameters.begin() + static_cast<long>(from),
+                                       type->parameters.begin() + static_cast<long>(to), ", "));
+  };
+  if (short_count > 0) {
+    return fmt::format("{} takes {} or {} numbers ({}, then {}), not {}", name, short_count, full,
+                       names(0, short_count), names(short_count, full), count);
   }
-  return fmt::format("{} takes {} numbers ({}), not {}", name, type->count, type->parameters,
-                     count);
+  return fmt::format("{} takes {} numbers ({}), not {}", name, full, names(0, full), count);
 }
 
 std::shared_ptr<const CameraModel> make_camera_model(std::string_view type, int width, int height,

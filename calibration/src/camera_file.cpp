@@ -2,7 +2,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -130,33 +129,20 @@ std::shared_ptr<const CameraModel> read_pinhole(const Reader& reader, const YAML
   }
 }
 
-// The lens models whose file form is a map named after them, with their parameters as keys in
-// the order of lens_models.hpp.
-struct NamedParameters {
-  std::string_view model;
-  std::vector<std::string_view> keys;
-};
-const std::array<NamedParameters, 3> kNamedParameterModels = {{
-    {"eucm", {"alpha", "beta", "fu", "fv", "u0", "v0"}},
-    {"mei", {"xi", "k1", "k2", "k3", "k4", "k5", "fu", "fv", "u0", "v0"}},
-    {"ucm", {"xi", "fu", "fv", "u0", "v0"}},
-}};
-
-const NamedParameters* find_named_parameters(std::string_view model) {
-  for (const NamedParameters& named : kNamedParameterModels) {
-    if (named.model == model) return &named;
-  }
-  return nullptr;
+// Every model but the pinhole (which keeps camera_info's matrices) is a map named after it,
+// with its parameters (camera_parameter_names) as keys.
+bool has_named_parameters(std::string_view model) {
+  return model != "pinhole" && is_camera_type(model);
 }
 
 std::shared_ptr<const CameraModel> read_named_parameters(const Reader& reader,
-                                                         const NamedParameters& named, int width,
+                                                         const std::string& model, int width,
                                                          int height) {
-  const std::string model(named.model);
+  const std::span<const std::string_view> keys = camera_parameter_names(model);
   YAML::Node node = reader.required(model.c_str());
-  reader.check_map(node, model, named.keys);
+  reader.check_map(node, model, {keys.begin(), keys.end()});
   std::vector<double> parameters;
-  for (std::string_view key : named.keys) {
+  for (std::string_view key : keys) {
     const std::string name(key);
     parameters.push_back(
         reader.number(reader.required(node, name.c_str(), model + "."), model + "." + name));
@@ -222,8 +208,8 @@ CameraFile parse_camera_file(const std::string& text, const std::string& source)
   std::string model = reader.text("distortion_model", "plumb_bob");
   if (model == "plumb_bob" || model == "pinhole") {
     camera.model = read_pinhole(reader, root, width, height);
-  } else if (const NamedParameters* named = find_named_parameters(model)) {
-    camera.model = read_named_parameters(reader, *named, width, height);
+  } else if (has_named_parameters(model)) {
+    camera.model = read_named_parameters(reader, model, width, height);
   } else {
     reader.fail(root["distortion_model"], "distortion_model '" + model +
                                               "' is not supported (plumb_bob, pinhole, eucm, "
@@ -262,11 +248,12 @@ std::string format_camera_file(const CameraFile& camera) {
             list_text({1, 0, 0, 0, 1, 0, 0, 0, 1}) + "\n";
     text += "projection_matrix:\n  rows: 3\n  cols: 4\n  data: " +
             list_text({k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0}) + "\n";
-  } else if (const NamedParameters* named = find_named_parameters(model.type())) {
+  } else if (has_named_parameters(model.type())) {
     const std::vector<double> parameters = camera_parameters(model);
-    text += fmt::format("distortion_model: {0}\n{0}:\n", named->model);
-    for (size_t i = 0; i < named->keys.size(); ++i) {
-      text += fmt::format("  {}: {}\n", named->keys[i], number_text(parameters[i]));
+    const std::span<const std::string_view> keys = camera_parameter_names(model.type());
+    text += fmt::format("distortion_model: {0}\n{0}:\n", model.type());
+    for (size_t i = 0; i < keys.size(); ++i) {
+      text += fmt::format("  {}: {}\n", keys[i], number_text(parameters[i]));
     }
   } else {
     throw std::invalid_argument("camera file: camera model '" + model.type() +

@@ -22,6 +22,10 @@ extern const char* const kCameraTypes;
 
 bool is_camera_type(std::string_view type);
 
+// The names of `type`'s parameters in order, as visgeom and camera files spell them ("alpha",
+// "beta", ...); empty for an unknown type.
+std::span<const std::string_view> camera_parameter_names(std::string_view type);
+
 // Empty when `type` takes `count` parameters; otherwise what it takes, as "eucm takes 6 numbers
 // (alpha, beta, fu, fv, u0, v0), not 5". `type` must be a camera type.
 std::string camera_parameter_count_problem(std::string_view type, size_t count);
