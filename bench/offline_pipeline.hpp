@@ -11,6 +11,7 @@
 #include <mocap/calibration/camera_model.hpp>
 
 #include "constellation_identifier.hpp"
+#include "constellation_tracker.hpp"
 #include "fiducial_detector.hpp"
 #include "planar_pose.hpp"
 #include "scene.hpp"
@@ -56,24 +57,44 @@ struct PipelinePose {
   pose::PlanarPose pose;
 };
 
+// The per-frame pipeline, as the shipped deployments ran before tracking: every frame
+// identified from scratch (identifier options as the constellation_identifier plugin's), then
+// planar PnP.
 class OfflinePipeline {
  public:
   OfflinePipeline(const constellations::ConstellationDatabase& database,
-                  std::shared_ptr<const calibration::CameraModel> camera)
-      : camera_(std::move(camera)), identifier_(database) {}
+                  std::shared_ptr<const calibration::CameraModel> camera,
+                  constellations::IdentifierOptions options = {})
+      : camera_(std::move(camera)), identifier_(database, options) {}
 
-  // Accepted poses of one image; `fiducials` and `times` report what happened on the way.
-  std::vector<PipelinePose> run(const cv::Mat& mono8, PipelineTimes* times = nullptr,
-                                PipelineTrace* trace = nullptr) {
-    using Clock = std::chrono::steady_clock;
-    auto t0 = Clock::now();
+  // The fiducials of one image, pixels.
+  const std::vector<Eigen::Vector2d>& detect(const cv::Mat& mono8, PipelineTimes* times = nullptr) {
+    auto t0 = std::chrono::steady_clock::now();
     const auto& detected = detector_.detect(mono8);
-    auto t1 = Clock::now();
     pixels_.clear();
-    ideal_.clear();
+    fiducials_.clear();
     for (const auto& f : detected) {
-      Eigen::Vector2d pixel(f.x, f.y);
-      pixels_.push_back(pixel);
+      pixels_.emplace_back(f.x, f.y);
+      fiducials_.push_back({pixels_.back(), f.area_px});
+    }
+    if (times) {
+      times->tracker_s +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    return pixels_;
+  }
+
+  // The last detect()'s fiducials with their sizes, as the tracker takes them.
+  const std::vector<tracking::ImageFiducial>& fiducials() const { return fiducials_; }
+
+  // Accepted poses of one frame's fiducials.
+  std::vector<PipelinePose> identify(const std::vector<Eigen::Vector2d>& pixels,
+                                     PipelineTimes* times = nullptr,
+                                     PipelineTrace* trace = nullptr) {
+    using Clock = std::chrono::steady_clock;
+    auto t1 = Clock::now();
+    ideal_.clear();
+    for (const auto& pixel : pixels) {
       auto ray = camera_->unproject(pixel);
       ideal_.push_back(ray ? Eigen::Vector2d(camera_->focal_length_px() * ray->head<2>())
                            : Eigen::Vector2d::Constant(NAN));
@@ -88,7 +109,7 @@ class OfflinePipeline {
         int i = constellation.image_point_of[m];
         if (i < 0) continue;
         object.push_back(constellation.model->points[m]);
-        image.push_back(pixels_[i]);
+        image.push_back(pixels[i]);
       }
       pose::PlanarPose pose = pose::estimate_planar_pose(*camera_, object, image);
       if (pose.valid) poses.push_back({constellation.model->name, pose});
@@ -100,12 +121,17 @@ class OfflinePipeline {
     }
     auto t3 = Clock::now();
     if (times) {
-      times->tracker_s += std::chrono::duration<double>(t1 - t0).count();
       times->identifier_s += std::chrono::duration<double>(t2 - t1).count();
       times->pose_s += std::chrono::duration<double>(t3 - t2).count();
     }
-    if (trace) trace->fiducials = detected.size();
+    if (trace) trace->fiducials = pixels.size();
     return poses;
+  }
+
+  std::vector<PipelinePose> run(const cv::Mat& mono8, PipelineTimes* times = nullptr,
+                                PipelineTrace* trace = nullptr) {
+    detect(mono8, times);
+    return identify(pixels_, times, trace);
   }
 
  private:
@@ -113,6 +139,15 @@ class OfflinePipeline {
   tracking::FiducialDetector detector_;
   constellations::ConstellationIdentifier identifier_;
   std::vector<Eigen::Vector2d> pixels_, ideal_;
+  std::vector<tracking::ImageFiducial> fiducials_;
 };
+
+// The identifier's options as the per-frame deployments used them before tracking: a
+// constellation from two whole lines needed two more markers, none from one line.
+inline constellations::IdentifierOptions per_frame_options() {
+  constellations::IdentifierOptions options;
+  options.min_extra_markers = 2;
+  return options;
+}
 
 }  // namespace mocap::bench

@@ -66,6 +66,16 @@ poses:
     covariance: [0.25, 0, 0, 0, ...] # 36 items
     reprojection_rms_px: 0.5
     points_used: 12
+    velocity:
+      linear:
+        x: 0
+        y: 0
+        z: 0
+      angular:
+        x: 0
+        y: 0
+        z: 0
+    velocity_covariance: [0, 0, 0, 0, ...] # 36 items
 )");
 }
 

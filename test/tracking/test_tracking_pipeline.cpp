@@ -1,6 +1,7 @@
-// The whole tracking pipeline through the runtime: synthetic camera -> tracker ->
-// identifier -> pose estimator -> evaluator, in one process and across two over DDS; and the
-// components' handling of bad input.
+// The whole tracking pipeline through the runtime: synthetic camera -> fiducial tracker ->
+// constellation tracker -> evaluator, in one process and across two over DDS; the per-frame
+// stages (identifier -> pose estimator) that anyone may still run; and the components'
+// handling of bad input.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -26,9 +27,33 @@ std::string config(const std::string& file) {
 // (lost, as with any volatile DDS topic) do not matter. A pipeline slower than the camera (a
 // sanitized build on a busy machine) falls behind, its image queue growing: the evaluator waits
 // for its estimates however late, so that only a frame the pipeline drops counts as lost.
+// The stage that turns fiducials into poses: the constellation tracker, or the per-frame
+// identifier and pose estimator.
+enum class Stages { Tracker, PerFrame };
+
+std::string pose_stages(Stages stages, const std::string& parameters) {
+  if (stages == Stages::Tracker) {
+    return R"(
+      - plugin: constellation_tracker
+        name: boards
+        parameters:)" +
+           parameters;
+  }
+  return R"(
+      - plugin: constellation_identifier
+        name: identifier
+        parameters:)" +
+         parameters + R"(
+      - plugin: pose_estimator
+        name: pose
+        parameters:)" +
+         parameters;
+}
+
 std::string pipeline_launch_file(
     const std::filesystem::path& summary, int frames, bool two_processes, int domain,
-    const std::string& camera_file = config("cameras/synthetic_ir_1280x720.yaml")) {
+    const std::string& camera_file = config("cameras/synthetic_ir_1280x720.yaml"),
+    Stages stages = Stages::Tracker) {
   std::string camera = fmt::format(R"(
       - plugin: synthetic_ir_camera
         name: camera
@@ -43,22 +68,15 @@ std::string pipeline_launch_file(
       - plugin: fiducial_tracker
         name: tracker
         qos:
-          /camera/ir/image_raw: {{profile: reliable, depth: 1000}}
-      - plugin: constellation_identifier
-        name: identifier
-        parameters:
-          camera: {0}
-      - plugin: pose_estimator
-        name: pose
-        parameters:
-          camera: {0}
+          /camera/ir/image_raw: {{profile: reliable, depth: 1000}}{3}
       - plugin: pose_evaluator
         name: evaluator
         parameters:
           stop_after_frames: {1}
           max_lag_frames: 1000000
           summary_file: {2})",
-                                     camera_file, frames, summary.string());
+                                     camera_file, frames, summary.string(),
+                                     pose_stages(stages, "\n          camera: " + camera_file));
   std::string dds = fmt::format("dds:\n  enabled: {}\n  domain_id: {}\n",
                                 two_processes ? "true" : "false", domain);
   if (two_processes) {
@@ -129,6 +147,21 @@ TEST(TrackingPipeline, InOneProcess) {
   EXPECT_GT(cv::countNonZero(green), 200);  // identified lines and their names
 }
 
+// The per-frame stages, for constellations from elsewhere or a comparison: each frame
+// identified from scratch by constellation_identifier, posed by pose_estimator.
+TEST(TrackingPipeline, PerFrameIdentifierAndPoseEstimator) {
+  test::TempDir dir;
+  constexpr int kFrames = 40;
+  test::write_file(
+      dir / "pipeline.yaml",
+      pipeline_launch_file(dir / "summary.yaml", kFrames, false, 0,
+                           config("cameras/synthetic_ir_1280x720.yaml"), Stages::PerFrame));
+  auto [code, output] = test::run_command({launcher(), (dir / "pipeline.yaml").string()}, {},
+                                          std::chrono::seconds(120));
+  ASSERT_EQ(code, 0) << output;
+  expect_accurate(dir / "summary.yaml", kFrames);
+}
+
 TEST(TrackingPipeline, CameraAndTrackingInTwoProcesses) {
   test::TempDir dir;
   constexpr int kFrames = 60;
@@ -143,7 +176,7 @@ TEST(TrackingPipeline, CameraAndTrackingInTwoProcesses) {
 }
 
 // The seed's own board (Table 12) from its two CSV files, spinning in its plane at 1.2 m:
-// every component reads the CSV database, the identifier tells its lines apart at 3 %.
+// every component reads the CSV database, the tracker tells its lines apart at 3 %.
 TEST(TrackingPipeline, TheSeedBoardFromItsCsvFiles) {
   test::TempDir dir;
   test::write_file(dir / "scene.yaml", R"(
@@ -170,11 +203,8 @@ groups:
         name: tracker
         qos:
           /camera/ir/image_raw: {{profile: reliable, depth: 1000}}
-      - plugin: constellation_identifier
-        name: identifier
-        parameters:
-{1}      - plugin: pose_estimator
-        name: pose
+      - plugin: constellation_tracker
+        name: boards
         parameters:
 {1}      - plugin: pose_evaluator
         name: evaluator
@@ -219,6 +249,10 @@ TEST(TrackingPipeline, BadConfigurationFilesAreOneLineErrors) {
        "db.csv: line 'L' needs 4 point rows ',x,y,z', found 0"},
       {"pose_estimator", "database", (dir / "missing.yaml").string(),
        "missing.yaml: cannot read the constellation database"},
+      {"constellation_tracker", "camera", (dir / "camera.yaml").string(),
+       "camera.yaml:1: missing field 'camera_matrix'"},
+      {"constellation_tracker", "database", (dir / "db.csv").string(),
+       "db.csv: line 'L' needs 4 point rows ',x,y,z', found 0"},
   };
   for (const Case& c : cases) {
     std::string file = fmt::format(

@@ -71,6 +71,22 @@ IrRenderer::IrRenderer(Scene scene, std::shared_ptr<const calibration::CameraMod
         "motion_blur_steps >= 0");
   }
   draw_static_layer();
+  // A board reaches a marker's radius and a centimetre beyond its outermost markers.
+  for (const SceneObject& object : scene_.objects) {
+    BoardExtent extent;
+    for (const Eigen::Vector3d& marker : object.markers) {
+      extent.x0 = std::min(extent.x0, marker.x());
+      extent.y0 = std::min(extent.y0, marker.y());
+      extent.x1 = std::max(extent.x1, marker.x());
+      extent.y1 = std::max(extent.y1, marker.y());
+    }
+    const double border = marker_radius_m_ + 0.01;
+    extent.x0 -= border;
+    extent.y0 -= border;
+    extent.x1 += border;
+    extent.y1 += border;
+    board_extents_.push_back(extent);
+  }
 }
 
 IrRenderer::Rect IrRenderer::clip(double x0, double y0, double x1, double y1) const {
@@ -335,9 +351,9 @@ std::vector<double> IrRenderer::exposure_times(const SceneObject& object, double
   return times;
 }
 
-IrRenderer::Rect IrRenderer::object_occlusion(const SceneObject& object,
-                                              const ObjectTruth& truth) const {
-  if (!object.occlusion || object.occlusion->fraction <= 0) return {};
+IrRenderer::Rect IrRenderer::object_occlusion(const SceneObject& object, const ObjectTruth& truth,
+                                              double time_s) const {
+  if (!object.occlusion || object.occlusion->fraction_at(time_s) <= 0) return {};
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
   double reach_px = 0;  // a marker's radius in the image, at the nearest marker
   for (size_t i = 0; i < truth.markers.size(); ++i) {
@@ -355,7 +371,7 @@ IrRenderer::Rect IrRenderer::object_occlusion(const SceneObject& object,
   y0 -= reach_px;
   x1 += reach_px;
   y1 += reach_px;
-  double fraction = object.occlusion->fraction;
+  double fraction = object.occlusion->fraction_at(time_s);
   switch (object.occlusion->side) {
     case ObjectOcclusion::Side::Left:
       x1 = x0 + fraction * (x1 - x0);
@@ -373,6 +389,28 @@ IrRenderer::Rect IrRenderer::object_occlusion(const SceneObject& object,
   return clip(x0, y0, x1, y1);
 }
 
+bool IrRenderer::hidden_by_a_board(const Eigen::Vector3d& point, size_t own,
+                                   const std::vector<ObjectTruth>& objects) const {
+  for (size_t o = 0; o < objects.size(); ++o) {
+    if (o == own) continue;
+    const Eigen::Isometry3d& pose = objects[o].pose;
+    const Eigen::Vector3d normal = pose.linear().col(2);
+    const double towards = normal.dot(point);
+    if (std::abs(towards) < 1e-12) continue;
+    // The line of sight meets the board's plane at s·point; the board hides the point when
+    // that is between the camera and the point, inside the board.
+    const double s = normal.dot(pose.translation()) / towards;
+    if (!(s > 0 && s < 1 - 1e-9)) continue;
+    const Eigen::Vector3d on_board = pose.inverse() * (s * point);
+    const BoardExtent& extent = board_extents_[o];
+    if (on_board.x() >= extent.x0 && on_board.x() <= extent.x1 && on_board.y() >= extent.y0 &&
+        on_board.y() <= extent.y1) {
+      return true;
+    }
+  }
+  return false;
+}
+
 RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
                                  const Eigen::Isometry3d& camera_from_world) {
   camera_from_world_ = camera_from_world;
@@ -386,13 +424,20 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
 
   RenderedFrame frame;
   frame.time_s = time_s;
-  std::vector<Rect> object_occlusions;
   for (const SceneObject& object : scene_.objects) {
     ObjectTruth truth;
     truth.constellation = object.constellation;
     truth.pose = object_pose(object, time_s);
     truth.in_front = truth.pose.translation().z() > 0;
     truth.facing_camera = truth.pose.linear().col(2).dot(truth.pose.translation()) < 0;
+    // Velocities by central differences over a millisecond: exact for the piecewise-smooth
+    // trajectories but at their corners.
+    constexpr double kStep = 5e-4;
+    const Eigen::Isometry3d before = object_pose(object, time_s - kStep);
+    const Eigen::Isometry3d after = object_pose(object, time_s + kStep);
+    truth.linear_velocity = (after.translation() - before.translation()) / (2 * kStep);
+    const Eigen::AngleAxisd turn(after.linear() * before.linear().transpose());
+    truth.angular_velocity = turn.angle() * turn.axis() / (2 * kStep);
     for (const Eigen::Vector3d& marker : object.markers) {
       MarkerTruth marker_truth;
       if (auto pixel = camera_->project(truth.pose * marker)) {
@@ -402,15 +447,34 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
       }
       truth.markers.push_back(marker_truth);
     }
+    frame.objects.push_back(std::move(truth));
+  }
 
+  // Boards are opaque: a marker whose line of sight crosses a nearer board is not drawn.
+  std::vector<std::vector<bool>> behind_board(scene_.objects.size());
+  for (size_t o = 0; o < scene_.objects.size(); ++o) {
+    const ObjectTruth& truth = frame.objects[o];
+    for (const Eigen::Vector3d& marker : scene_.objects[o].markers) {
+      behind_board[o].push_back(hidden_by_a_board(truth.pose * marker, o, frame.objects));
+    }
+  }
+
+  std::vector<Rect> object_occlusions;
+  for (size_t o = 0; o < scene_.objects.size(); ++o) {
+    const SceneObject& object = scene_.objects[o];
+    ObjectTruth& truth = frame.objects[o];
     std::vector<double> times = exposure_times(object, time_s);
     std::vector<Eigen::Isometry3d> poses;
     for (double t : times) poses.push_back(object_pose(object, t));
-    for (const Eigen::Vector3d& marker : object.markers) draw_marker(poses, marker, work_);
-
-    Rect occlusion = object_occlusion(object, truth);
+    for (size_t m = 0; m < object.markers.size(); ++m) {
+      if (behind_board[o][m]) {
+        truth.markers[m].visible = false;
+        continue;
+      }
+      draw_marker(poses, object.markers[m], work_);
+    }
+    Rect occlusion = object_occlusion(object, truth, time_s);
     if (!occlusion.empty()) object_occlusions.push_back(occlusion);
-    frame.objects.push_back(std::move(truth));
   }
 
   // Occluders are in front of every marker: they cover what was drawn.

@@ -9,8 +9,9 @@
 // corners all land inside (or whose footprint on the plane is far from the disc) skip the
 // rays. A disc seen from behind (its board facing away) is not drawn. The coverage is blurred
 // (Gaussian, on the marker's own patch), scaled by the exposure and added to the background;
-// motion blur averages the coverage of several poses spread over the exposure time. Boards
-// themselves are transparent: one board does not hide another's markers.
+// motion blur averages the coverage of several poses spread over the exposure time. Boards are
+// opaque and dark: a board hides the markers of boards behind it (a marker whose centre is
+// behind a nearer board, within its markers' rectangle grown by a centimetre, is not drawn).
 //
 // The random parts of a frame (the noise window, moving hot points) are a function of the
 // scene's seed and the frame number only, so a frame renders the same every time.
@@ -47,8 +48,12 @@ struct ObjectTruth {
   std::string constellation;
   // Constellation frame in the camera frame at mid-exposure (see trajectory.hpp).
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  bool in_front = false;             // its origin has z > 0
-  bool facing_camera = false;        // the marker side of the board faces the camera
+  bool in_front = false;       // its origin has z > 0
+  bool facing_camera = false;  // the marker side of the board faces the camera
+  // Velocity of the constellation frame in the camera frame at mid-exposure: of its origin
+  // (m/s) and of its axes (rad/s, dR/dt = [angular]x R). The camera is held still.
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   std::vector<MarkerTruth> markers;  // in the order of the constellation's points
 
   int visible_markers() const;
@@ -100,7 +105,9 @@ class IrRenderer {
                    cv::Mat& image);
   void draw_static_layer();
   void occlude(const Rect& rect, double level_dn, const cv::Mat& noise, cv::Mat& image) const;
-  Rect object_occlusion(const SceneObject& object, const ObjectTruth& truth) const;
+  Rect object_occlusion(const SceneObject& object, const ObjectTruth& truth, double time_s) const;
+  bool hidden_by_a_board(const Eigen::Vector3d& point, size_t own,
+                         const std::vector<ObjectTruth>& objects) const;
   Rect clip(double x0, double y0, double x1, double y1) const;
 
   Scene scene_;
@@ -112,6 +119,12 @@ class IrRenderer {
   double peak_dn_;        // a fully covered pixel, above the background
   cv::Mat static_layer_;  // CV_32F: everything that does not move
   std::vector<Rect> fixed_occluders_;
+  // Per object, the rectangle of its board in its own frame (metres).
+  struct BoardExtent {
+    double x0 = std::numeric_limits<double>::infinity(), y0 = x0;
+    double x1 = -std::numeric_limits<double>::infinity(), y1 = x1;
+  };
+  std::vector<BoardExtent> board_extents_;
   std::vector<cv::Point> fixed_hot_points_;
   cv::Mat work_;   // CV_32F: the frame being drawn
   cv::Mat patch_;  // CV_32F: one marker's coverage

@@ -88,9 +88,11 @@ class SceneReader : YamlReader<SceneError> {
     object.markers = model->points;
     object.trajectory = trajectory(required(map, "trajectory", "an object"));
     if (YAML::Node occlusion = map["occlusion"]) {
-      check_keys(occlusion, {"fraction", "side"}, "'occlusion'");
+      check_keys(occlusion, {"fraction", "side", "max_fraction", "period_s"}, "'occlusion'");
       ObjectOcclusion value;
       value.fraction = to_number(required(occlusion, "fraction", "'occlusion'"), "fraction", 0, 1);
+      value.max_fraction = number(occlusion, "max_fraction", value.fraction, 0, 1);
+      value.period_s = number(occlusion, "period_s", 0, 0, 1e6);
       value.side = static_cast<ObjectOcclusion::Side>(
           choice(occlusion, "side", {"left", "right", "top", "bottom"}, 0));
       object.occlusion = value;
@@ -249,6 +251,11 @@ Scene load_scene(const std::string& path, const constellations::ConstellationDat
   std::stringstream text;
   text << file.rdbuf();
   return parse_scene(text.str(), path, database);
+}
+
+double ObjectOcclusion::fraction_at(double time_s) const {
+  if (!(period_s > 0) || max_fraction <= fraction) return fraction;
+  return fraction + (max_fraction - fraction) * 0.5 * (1 - std::cos(2 * M_PI * time_s / period_s));
 }
 
 }  // namespace mocap::synthetic

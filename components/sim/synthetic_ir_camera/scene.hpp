@@ -17,12 +17,19 @@
 namespace mocap::synthetic {
 
 // Hides the part of an object's image on one side: a hand or a pole in front of the board.
-// The covered region is `fraction` of the bounding box of the object's markers in the image,
-// measured from `side`, and moves with the object.
+// The covered region is a fraction of the bounding box of the object's markers in the image,
+// measured from `side`, and moves with the object. With a period, the fraction swings from
+// `fraction` to `max_fraction` and back (a hand passing over the board), starting at
+// `fraction` at time 0.
 struct ObjectOcclusion {
   enum class Side { Left, Right, Top, Bottom };
   double fraction = 0;  // 0..1
   Side side = Side::Left;
+  double max_fraction = 0;  // 0..1; below `fraction`: no swing
+  double period_s = 0;      // 0 = no swing
+
+  // The fraction hidden at scene time `time_s`.
+  double fraction_at(double time_s) const;
 };
 
 struct SceneObject {

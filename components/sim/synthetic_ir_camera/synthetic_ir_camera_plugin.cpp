@@ -98,8 +98,9 @@ class SyntheticIrCamera final : public Component {
         "the camera file's lens with each frame, same header (pinhole cameras only)");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
         kTruthTopic, Qos::reliable(),
-        "per frame, the true pose of every constellation in front of the camera (camera frame, "
-        "mid-exposure); points_used = its visible markers; same header as the image");
+        "per frame, the true pose and velocity of every constellation in front of the camera "
+        "(camera frame, mid-exposure; the velocity of a fixed camera's view); points_used = its "
+        "visible markers; same header as the image");
   }
 
   explicit SyntheticIrCamera(Context& context) : Component(context) {
@@ -190,6 +191,12 @@ class SyntheticIrCamera final : public Component {
       pose.pose().pose(to_pose_message(object.pose));
       pose.reprojection_rms_px(0);
       pose.points_used(static_cast<uint32_t>(object.visible_markers()));
+      pose.velocity().linear().x(object.linear_velocity.x());
+      pose.velocity().linear().y(object.linear_velocity.y());
+      pose.velocity().linear().z(object.linear_velocity.z());
+      pose.velocity().angular().x(object.angular_velocity.x());
+      pose.velocity().angular().y(object.angular_velocity.y());
+      pose.velocity().angular().z(object.angular_velocity.z());
       truth->poses().push_back(std::move(pose));
     }
     images_.publish(std::move(image));

@@ -6,25 +6,14 @@
 #include <optional>
 
 #include "cross_ratio.hpp"
+#include "line_candidate.hpp"
+#include "one_line_search.hpp"
 #include "plane_homography.hpp"
 
 namespace mocap::constellations {
-namespace {
 
-struct Candidate {
-  std::array<int, 4> points;  // along the image line
-  double cross_ratio;
-};
-
-struct Fit {
-  Eigen::Matrix3d homography = Eigen::Matrix3d::Identity();  // plane to image
-  double rms = 0;
-  double max = 0;
-};
-
-// The plane-to-image homography of the assigned points and how well it explains them.
-std::optional<Fit> plane_fit(const ConstellationModel& model, const std::vector<int>& image_of,
-                             const std::vector<Eigen::Vector2d>& points) {
+std::optional<PlaneFit> plane_fit(const ConstellationModel& model, const std::vector<int>& image_of,
+                                  const std::vector<Eigen::Vector2d>& points) {
   std::vector<Eigen::Vector2d> from, to;
   for (size_t m = 0; m < image_of.size(); ++m) {
     if (image_of[m] < 0) continue;
@@ -33,7 +22,19 @@ std::optional<Fit> plane_fit(const ConstellationModel& model, const std::vector<
   }
   auto h = fit_homography(from, to);
   if (!h) return std::nullopt;
-  Fit fit;
+  double nearest = std::numeric_limits<double>::infinity(), farthest = -nearest;
+  for (const auto& p : model.plane_points) {
+    const double depth = h->row(2).dot(Eigen::Vector3d(p.x(), p.y(), 1.0));
+    nearest = std::min(nearest, depth);
+    farthest = std::max(farthest, depth);
+  }
+  if (nearest < 0) {  // the same board, seen from the other side of its plane's horizon
+    std::swap(nearest, farthest);
+    nearest = -nearest;
+    farthest = -farthest;
+  }
+  if (!(nearest > 0) || farthest > kMaxDepthRatio * nearest) return std::nullopt;
+  PlaneFit fit;
   fit.homography = *h;
   for (size_t i = 0; i < from.size(); ++i) {
     double e = (apply_homography(*h, from[i]) - to[i]).norm();
@@ -43,6 +44,8 @@ std::optional<Fit> plane_fit(const ConstellationModel& model, const std::vector<
   fit.rms = std::sqrt(fit.rms / static_cast<double>(from.size()));
   return fit;
 }
+
+namespace {
 
 // Finds one constellation among the candidates: hypothesise from two lines that share a
 // marker (seven points fix a plane-to-image homography), then extend by the remaining lines
@@ -127,12 +130,6 @@ class ConstellationSearch {
   }
 
  private:
-  struct Choice {
-    const Candidate* candidate = nullptr;
-    bool reversed = false;
-    int image_point(int k) const { return candidate->points[reversed ? 3 - k : k]; }
-  };
-
   // Adds the unseen markers that an image point lies on, where the plane of the best
   // assignment puts them (the nearest within a third of max_fit_error_px: the prediction from
   // whole lines is good to a fraction of a pixel, and a tight radius keeps stray points from
@@ -140,6 +137,7 @@ class ConstellationSearch {
   int complete_with_markers() {
     auto fit = plane_fit(model_, best_image_of_, points_);
     if (!fit) return 0;
+    const std::vector<int> before = best_image_of_;
     int added = 0;
     for (size_t m = 0; m < best_image_of_.size(); ++m) {
       if (best_image_of_[m] >= 0) continue;
@@ -161,7 +159,13 @@ class ConstellationSearch {
       }
     }
     if (added > 0) {
-      if (auto refit = plane_fit(model_, best_image_of_, points_)) best_fit_ = *refit;
+      // Markers the whole cannot explain together are strays after all.
+      auto refit = plane_fit(model_, best_image_of_, points_);
+      if (!refit || refit->max > options_.max_fit_error_px) {
+        best_image_of_ = before;
+        return 0;
+      }
+      best_fit_ = *refit;
     }
     return added;
   }
@@ -222,7 +226,7 @@ class ConstellationSearch {
   // puts it, then scores the whole.
   void extend_and_evaluate() {
     std::vector<size_t> added;
-    std::optional<Fit> fit;
+    std::optional<PlaneFit> fit;
     bool stale = true;
     for (size_t line = 0; line < model_.lines.size(); ++line) {
       if (chosen_[line].candidate != nullptr) continue;
@@ -309,7 +313,7 @@ class ConstellationSearch {
   std::vector<std::array<std::vector<std::pair<int, int>>, 4>> at_position_;
   int best_count_ = 0;
   bool complete_ = false;
-  Fit best_fit_;
+  PlaneFit best_fit_;
   std::vector<int> best_image_of_;
   std::vector<IdentifiedLine> best_lines_;
 };
@@ -403,22 +407,70 @@ std::vector<IdentifiedConstellation> ConstellationIdentifier::identify(
   });
   std::vector<bool> taken(points.size(), false);
   std::vector<IdentifiedConstellation> accepted;
-  for (auto& candidate : found) {
-    bool free = std::none_of(candidate.image_point_of.begin(), candidate.image_point_of.end(),
-                             [&](int i) { return i >= 0 && taken[i]; });
-    if (!free) {
-      ++s.conflicts;
-      continue;
+  auto accept_free = [&](std::vector<IdentifiedConstellation>& candidates) {
+    for (auto& candidate : candidates) {
+      bool free = std::none_of(candidate.image_point_of.begin(), candidate.image_point_of.end(),
+                               [&](int i) { return i >= 0 && taken[i]; });
+      if (!free) {
+        ++s.conflicts;
+        continue;
+      }
+      for (int i : candidate.image_point_of) {
+        if (i >= 0) taken[i] = true;
+      }
+      accepted.push_back(std::move(candidate));
     }
-    for (int& i : candidate.image_point_of) {
-      if (i < 0) continue;
-      taken[i] = true;
-      i = input_index[i];
+  };
+  accept_free(found);
+  // Constellations not found by two or more lines may show one whole line and loose markers.
+  if (options_.focal_length_px > 0 && options_.min_loose_markers > 0) {
+    std::vector<IdentifiedConstellation> from_one_line;
+    for (size_t m = 0; m < models.size(); ++m) {
+      bool known = std::any_of(accepted.begin(), accepted.end(),
+                               [&](const auto& a) { return a.model == &models[m]; });
+      if (known) continue;
+      if (auto result = find_from_one_line(models[m], line_type_of_[m], by_type, points, taken,
+                                           options_, s)) {
+        from_one_line.push_back(std::move(*result));
+      }
     }
-    for (IdentifiedLine& line : candidate.lines) {
+    std::sort(from_one_line.begin(), from_one_line.end(), [](const auto& a, const auto& b) {
+      if (a.points_identified() != b.points_identified()) {
+        return a.points_identified() > b.points_identified();
+      }
+      return a.fit_rms_px < b.fit_rms_px;
+    });
+    // Two boards that explain the same points equally well cannot be told apart: boards of one
+    // size hinged on a side of one line type share their corners. Neither is named.
+    std::vector<bool> ambiguous(from_one_line.size(), false);
+    for (size_t a = 0; a < from_one_line.size(); ++a) {
+      for (size_t b = a + 1; b < from_one_line.size(); ++b) {
+        const auto& first = from_one_line[a].image_point_of;
+        const auto& second = from_one_line[b].image_point_of;
+        if (from_one_line[a].points_identified() != from_one_line[b].points_identified()) continue;
+        bool overlap = std::any_of(first.begin(), first.end(), [&](int i) {
+          return i >= 0 && std::find(second.begin(), second.end(), i) != second.end();
+        });
+        if (overlap) ambiguous[a] = ambiguous[b] = true;
+      }
+    }
+    std::vector<IdentifiedConstellation> clear;
+    for (size_t k = 0; k < from_one_line.size(); ++k) {
+      if (ambiguous[k]) {
+        ++s.conflicts;
+      } else {
+        clear.push_back(std::move(from_one_line[k]));
+      }
+    }
+    accept_free(clear);
+  }
+  for (auto& constellation : accepted) {
+    for (int& i : constellation.image_point_of) {
+      if (i >= 0) i = input_index[i];
+    }
+    for (IdentifiedLine& line : constellation.lines) {
       for (int& i : line.image_points) i = input_index[i];
     }
-    accepted.push_back(std::move(candidate));
   }
   return accepted;
 }

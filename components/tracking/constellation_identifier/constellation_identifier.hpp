@@ -31,14 +31,25 @@ struct IdentifierOptions {
   int min_lines = 3;
   // A constellation with fewer whole lines than min_lines, but at least two that share a
   // marker, is identified when this many of its other markers lie where its plane puts them
-  // (a board with a corner hidden keeps only two whole sides). 0 disables it.
-  int min_extra_markers = 2;
+  // (a board with a corner hidden keeps only two whole sides and four other markers). 0
+  // disables it. Two let chance alignments through (about one in 1000 frames of 60 random
+  // points with distractor lines, test_constellation_identifier).
+  int min_extra_markers = 3;
   // Largest distance, pixels, of an identified point from where the plane-to-image
   // homography of all identified points puts it.
   double max_fit_error_px = 3.0;
   // A line's four points are taken from at most this many consecutive points of a group, so
   // a group holding several boards' sides yields a handful of candidates, not C(n, 4).
   int candidate_window = 6;
+  // Pixels per unit of the points' coordinates when they are a calibrated camera's ideal
+  // pixels, f·(x/z, y/z) (the principal point at the origin, as the tracker and the identifier
+  // plugin with a camera pass them); 0 when they are not. With it, a constellation of which a
+  // single whole line is seen is found by its loose markers (min_loose_markers below).
+  double focal_length_px = 0;
+  // Fewest loose markers (off the one whole line) that must land where the line's place in
+  // space and one turn about it put them, for a constellation seen by one line only; 0 turns
+  // that search off. Needs focal_length_px.
+  int min_loose_markers = 3;
 };
 
 struct IdentifiedLine {
@@ -55,15 +66,19 @@ struct IdentifiedConstellation {
   std::vector<int> image_point_of;
   double fit_rms_px = 0;  // of the plane-to-image homography over all points
   double fit_max_px = 0;
+  // Found from one whole line and loose markers (IdentifierOptions::min_loose_markers): a
+  // weaker identification, which a caller with the camera should verify by its pose.
+  bool from_one_line = false;
   int points_identified() const;
 };
 
 struct IdentificationStats {
-  size_t groups = 0;           // collinear groups of >= 4 points
-  size_t candidates = 0;       // four-point candidates measured
-  size_t matched = 0;          // candidates whose cross-ratio matched a line type
-  size_t rejected_by_fit = 0;  // constellations found by lines but rejected by the plane fit
-  size_t conflicts = 0;        // constellations dropped because a better one took their points
+  size_t groups = 0;               // collinear groups of >= 4 points
+  size_t candidates = 0;           // four-point candidates measured
+  size_t matched = 0;              // candidates whose cross-ratio matched a line type
+  size_t rejected_by_fit = 0;      // constellations found by lines but rejected by the plane fit
+  size_t conflicts = 0;            // constellations dropped because a better one took their points
+  size_t one_line_hypotheses = 0;  // line placements tried for constellations seen by one line
 };
 
 class ConstellationIdentifier {

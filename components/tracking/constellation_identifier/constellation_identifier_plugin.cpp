@@ -11,7 +11,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 #include "constellation_identifier.hpp"
-#include "cross_ratio.hpp"
+#include "constellation_message.hpp"
 
 namespace mocap::constellations {
 namespace {
@@ -40,7 +40,7 @@ class ConstellationIdentifierComponent final : public Component {
     spec.parameter("line_tolerance_px", 1.5, "largest distance of a point from its line, pixels")
         .range(0.01, 100);
     spec.parameter("min_lines", 3, "fewest lines that identify a constellation").range(1, 64);
-    spec.parameter("min_extra_markers", 2,
+    spec.parameter("min_extra_markers", 3,
                    "with two whole lines only, markers that must lie where their plane puts "
                    "them (a board with a hidden corner); 0 = never identify from two lines")
         .range(0, 1000);
@@ -96,50 +96,7 @@ class ConstellationIdentifierComponent final : public Component {
     auto message = std::make_shared<mocap_msgs::msg::ConstellationArray>();
     message->header(array.header());
     for (const IdentifiedConstellation& found : identifier_->identify(points_)) {
-      const ConstellationModel& model = *found.model;
-      mocap_msgs::msg::Constellation constellation;
-      constellation.name(model.name);
-      constellation.point_names(model.line_names());
-      constellation.xyz_tol(static_cast<float>(found.fit_rms_px));
-      // Every line with a marker seen, its fiducials in database order; a marker not seen
-      // (hidden, out of view) is a fiducial with NaN coordinates.
-      for (size_t l = 0; l < model.lines.size(); ++l) {
-        const ConstellationLine& model_line = model.lines[l];
-        mocap_msgs::msg::SubConstellation sub;
-        sub.name(model_line.name);
-        sub.fiducial_array().header(array.header());
-        float cx = 0, cy = 0;
-        int seen = 0;
-        for (int marker : model_line.points) {
-          int index = found.image_point_of[marker];
-          if (index < 0) {
-            mocap_msgs::msg::Fiducial unseen;
-            unseen.x(std::numeric_limits<float>::quiet_NaN());
-            unseen.y(std::numeric_limits<float>::quiet_NaN());
-            sub.fiducial_array().fiducials().push_back(unseen);
-            continue;
-          }
-          sub.fiducial_array().fiducials().push_back(fiducials[index]);
-          cx += fiducials[index].x();
-          cy += fiducials[index].y();
-          ++seen;
-        }
-        if (seen == 0) continue;
-        sub.Cx(cx / seen);
-        sub.Cy(cy / seen);
-        sub.Cz(0);
-        // How far the measured cross-ratio is from the database's; NaN for a broken line.
-        float difference = std::numeric_limits<float>::quiet_NaN();
-        for (const IdentifiedLine& line : found.lines) {
-          if (line.model_line == static_cast<int>(l)) {
-            difference =
-                static_cast<float>(relative_difference(line.cross_ratio, model_line.cross_ratio));
-          }
-        }
-        sub.uncertainty(difference);
-        constellation.sub_constellations().push_back(std::move(sub));
-      }
-      message->constellations().push_back(std::move(constellation));
+      message->constellations().push_back(to_constellation_message(found, array));
       ++identified_;
     }
     publisher_.publish(std::move(message));

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 namespace mocap::constellations {
@@ -32,23 +32,38 @@ std::optional<Eigen::Matrix3d> fit_homography(const std::vector<Eigen::Vector2d>
   auto tf = normalisation(from);
   auto tt = normalisation(to);
   if (!tf || !tt) return std::nullopt;
-  // Normal equations of the 2N x 9 DLT system: the eigenvector of the smallest eigenvalue.
-  Eigen::Matrix<double, 9, 9> ata = Eigen::Matrix<double, 9, 9>::Zero();
+  // Points on one line leave no unique plane mapping: the smaller spread of either set,
+  // against the larger, tells.
+  auto flat = [](const std::vector<Eigen::Vector2d>& points, const Eigen::Matrix3d& t) {
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (const auto& p : points) {
+      const Eigen::Vector2d q = t.topLeftCorner<2, 2>() * p + t.topRightCorner<2, 1>();
+      scatter += q * q.transpose();
+    }
+    const double trace = scatter.trace(), det = scatter.determinant();
+    return !(det > 1e-9 * trace * trace);
+  };
+  if (flat(from, *tf) || flat(to, *tt)) return std::nullopt;
+  // The DLT with h33 = 1, in least squares by the normal equations (8x8). Normalised, the
+  // centroid of `from` is the origin and maps to a finite point, so h33 is not zero; this is
+  // an order of magnitude faster than the 9x9 eigenproblem of the homogeneous form, and the
+  // identifier fits many hypotheses per frame.
+  Eigen::Matrix<double, 8, 8> ata = Eigen::Matrix<double, 8, 8>::Zero();
+  Eigen::Matrix<double, 8, 1> atb = Eigen::Matrix<double, 8, 1>::Zero();
   for (size_t i = 0; i < from.size(); ++i) {
-    Eigen::Vector3d a = *tf * Eigen::Vector3d(from[i].x(), from[i].y(), 1);
-    Eigen::Vector3d b = *tt * Eigen::Vector3d(to[i].x(), to[i].y(), 1);
-    Eigen::Matrix<double, 9, 1> r1, r2;
-    r1 << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y();
-    r2 << a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
+    const Eigen::Vector2d a = tf->topLeftCorner<2, 2>() * from[i] + tf->topRightCorner<2, 1>();
+    const Eigen::Vector2d b = tt->topLeftCorner<2, 2>() * to[i] + tt->topRightCorner<2, 1>();
+    Eigen::Matrix<double, 8, 1> r1, r2;
+    r1 << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y();
+    r2 << a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y();
     ata.noalias() += r1 * r1.transpose() + r2 * r2.transpose();
+    atb.noalias() += -b.y() * r1 + b.x() * r2;
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(ata);
-  // Collinear input leaves two (near-)zero eigenvalues: no unique plane mapping.
-  const auto& values = solver.eigenvalues();
-  if (!(values(1) > 1e-9 * values(8))) return std::nullopt;
-  Eigen::Matrix<double, 9, 1> h = solver.eigenvectors().col(0);
+  const Eigen::LDLT<Eigen::Matrix<double, 8, 8>> solver(ata);
+  if (solver.info() != Eigen::Success) return std::nullopt;
+  const Eigen::Matrix<double, 8, 1> h = solver.solve(atb);
   Eigen::Matrix3d hn;
-  hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
+  hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), 1;
   Eigen::Matrix3d result = tt->inverse() * hn * *tf;
   if (!result.allFinite() || std::abs(result(2, 2)) < 1e-300) return std::nullopt;
   return result / result(2, 2);

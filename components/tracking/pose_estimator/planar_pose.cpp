@@ -114,6 +114,54 @@ Refined refine(const calibration::CameraModel& camera, Eigen::Isometry3d pose,
   return out;
 }
 
+// The pairs the camera can use: finite, and seen by a pixel the model can unproject.
+struct UsablePoints {
+  std::vector<Eigen::Vector3d> object;
+  std::vector<Eigen::Vector2d> image;
+  std::vector<cv::Point2d> rays;
+};
+
+UsablePoints usable_points(const calibration::CameraModel& camera,
+                           const std::vector<Eigen::Vector3d>& object_points,
+                           const std::vector<Eigen::Vector2d>& pixels) {
+  UsablePoints usable;
+  for (size_t i = 0; i < object_points.size() && i < pixels.size(); ++i) {
+    if (!pixels[i].allFinite() || !object_points[i].allFinite()) continue;
+    auto ray = camera.unproject(pixels[i]);
+    if (!ray) continue;
+    usable.object.push_back(object_points[i]);
+    usable.image.push_back(pixels[i]);
+    usable.rays.emplace_back(ray->x(), ray->y());
+  }
+  return usable;
+}
+
+bool enough_points(const PlanarPoseOptions& options, PlanarPose& result) {
+  if (result.points_used >= std::max(4, options.min_points)) return true;
+  result.rejection = fmt::format("{} usable points, {} needed", result.points_used,
+                                 std::max(4, options.min_points));
+  return false;
+}
+
+// The refined pose as the result: its covariance and the checks that reject it.
+void accept_if_valid(const Refined& best, const PlanarPoseOptions& options, PlanarPose& result) {
+  result.camera_from_object = best.pose;
+  result.reprojection_rms_px = best.rms;
+  // Residual variance per coordinate, with the 6 pose parameters taken out.
+  int dof = 2 * result.points_used - 6;
+  double sigma2 = dof > 0 ? best.rms * best.rms * result.points_used / dof : 0;
+  Eigen::FullPivLU<Matrix6d> lu(best.information);
+  if (lu.isInvertible()) result.covariance = sigma2 * lu.inverse();
+  if (best.pose.translation().z() <= 0) {
+    result.rejection = "the pose puts the object behind the camera";
+  } else if (best.rms > options.max_reprojection_rms_px) {
+    result.rejection = fmt::format("reprojection RMS {:.2f} px exceeds {:.2f} px", best.rms,
+                                   options.max_reprojection_rms_px);
+  } else {
+    result.valid = true;
+  }
+}
+
 }  // namespace
 
 PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
@@ -122,23 +170,12 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
                                 const PlanarPoseOptions& options) {
   PlanarPose result;
   // Points the camera model cannot unproject (or non-finite ones) are left out.
-  std::vector<Eigen::Vector3d> object;
-  std::vector<Eigen::Vector2d> image;
-  std::vector<cv::Point2d> rays;
-  for (size_t i = 0; i < object_points.size() && i < pixels.size(); ++i) {
-    if (!pixels[i].allFinite() || !object_points[i].allFinite()) continue;
-    auto ray = camera.unproject(pixels[i]);
-    if (!ray) continue;
-    object.push_back(object_points[i]);
-    image.push_back(pixels[i]);
-    rays.emplace_back(ray->x(), ray->y());
-  }
+  UsablePoints usable = usable_points(camera, object_points, pixels);
+  const auto& object = usable.object;
+  const auto& image = usable.image;
+  const auto& rays = usable.rays;
   result.points_used = static_cast<int>(object.size());
-  if (result.points_used < std::max(4, options.min_points)) {
-    result.rejection = fmt::format("{} usable points, {} needed", result.points_used,
-                                   std::max(4, options.min_points));
-    return result;
-  }
+  if (!enough_points(options, result)) return result;
   // The object's plane as its own frame: IPPE wants z = 0 points.
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   for (const auto& p : object) origin += p;
@@ -196,21 +233,25 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
     result.rejection = "no pose puts every point in front of the camera";
     return result;
   }
-  result.camera_from_object = best.pose;
-  result.reprojection_rms_px = best.rms;
-  // Residual variance per coordinate, with the 6 pose parameters taken out.
-  int dof = 2 * result.points_used - 6;
-  double sigma2 = dof > 0 ? best.rms * best.rms * result.points_used / dof : 0;
-  Eigen::FullPivLU<Matrix6d> lu(best.information);
-  if (lu.isInvertible()) result.covariance = sigma2 * lu.inverse();
-  if (best.pose.translation().z() <= 0) {
-    result.rejection = "the pose puts the object behind the camera";
-  } else if (best.rms > options.max_reprojection_rms_px) {
-    result.rejection = fmt::format("reprojection RMS {:.2f} px exceeds {:.2f} px", best.rms,
-                                   options.max_reprojection_rms_px);
-  } else {
-    result.valid = true;
+  accept_if_valid(best, options, result);
+  return result;
+}
+
+PlanarPose refine_planar_pose(const calibration::CameraModel& camera,
+                              const Eigen::Isometry3d& start,
+                              const std::vector<Eigen::Vector3d>& object_points,
+                              const std::vector<Eigen::Vector2d>& pixels,
+                              const PlanarPoseOptions& options) {
+  PlanarPose result;
+  UsablePoints usable = usable_points(camera, object_points, pixels);
+  result.points_used = static_cast<int>(usable.object.size());
+  if (!enough_points(options, result)) return result;
+  Refined refined = refine(camera, start, usable.object, usable.image, options.max_iterations);
+  if (!refined.valid) {
+    result.rejection = "no pose near the start puts every point in front of the camera";
+    return result;
   }
+  accept_if_valid(refined, options, result);
   return result;
 }
 

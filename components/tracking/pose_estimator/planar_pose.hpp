@@ -43,6 +43,15 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
                                 const std::vector<Eigen::Vector2d>& pixels,
                                 const PlanarPoseOptions& options = {});
 
+// The pose refined from `start` (a prediction from the previous frames) through the camera
+// model, without IPPE: for tracking, where the start is near the answer and points may be as
+// few as four in any arrangement. Same checks and covariance as estimate_planar_pose.
+PlanarPose refine_planar_pose(const calibration::CameraModel& camera,
+                              const Eigen::Isometry3d& start,
+                              const std::vector<Eigen::Vector3d>& object_points,
+                              const std::vector<Eigen::Vector2d>& pixels,
+                              const PlanarPoseOptions& options = {});
+
 // The angle between two rotations (seed eq. 10), radians.
 double rotation_angle_between(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b);
 

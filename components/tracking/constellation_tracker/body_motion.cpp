@@ -1,0 +1,116 @@
+#include "body_motion.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+namespace mocap::tracking {
+namespace {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+
+// White-noise acceleration of density q over dt: the covariance it adds to (position, velocity)
+// along one axis block.
+void add_acceleration_noise(Matrix12d& covariance, int position, int velocity, double q,
+                            double dt) {
+  const double adt = std::abs(dt);
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  covariance.block<3, 3>(position, position) += q * adt * adt * adt / 3 * identity;
+  covariance.block<3, 3>(position, velocity) += q * dt * adt / 2 * identity;
+  covariance.block<3, 3>(velocity, position) += q * dt * adt / 2 * identity;
+  covariance.block<3, 3>(velocity, velocity) += q * adt * identity;
+}
+
+}  // namespace
+
+Eigen::Matrix3d rotation_from_vector(const Eigen::Vector3d& angle_vector) {
+  const double angle = angle_vector.norm();
+  if (angle < 1e-12) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, angle_vector / angle).toRotationMatrix();
+}
+
+Eigen::Vector3d vector_from_rotation(const Eigen::Matrix3d& rotation) {
+  const Eigen::AngleAxisd angle_axis(rotation);
+  return angle_axis.angle() * angle_axis.axis();
+}
+
+BodyMotionFilter::BodyMotionFilter(const Eigen::Isometry3d& camera_from_body,
+                                   const Matrix6d& pose_covariance, int64_t stamp_ns,
+                                   BodyMotionOptions options)
+    : options_(options) {
+  state_.stamp_ns = stamp_ns;
+  state_.camera_from_body = camera_from_body;
+  state_.covariance.setZero();
+  state_.covariance.topLeftCorner<6, 6>() = pose_covariance;
+  const double sv = options_.initial_linear_velocity_sigma_mps;
+  const double sw = options_.initial_angular_velocity_sigma_rps;
+  state_.covariance.block<3, 3>(6, 6) = sv * sv * Eigen::Matrix3d::Identity();
+  state_.covariance.block<3, 3>(9, 9) = sw * sw * Eigen::Matrix3d::Identity();
+}
+
+BodyState BodyMotionFilter::predicted(int64_t stamp_ns) const {
+  const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
+  BodyState next = state_;
+  next.stamp_ns = stamp_ns;
+  if (dt == 0) return next;
+  const Eigen::Matrix3d turn = rotation_from_vector(state_.angular_velocity * dt);
+  next.camera_from_body.translation() += state_.linear_velocity * dt;
+  next.camera_from_body.linear() = turn * state_.camera_from_body.linear();
+  Matrix12d f = Matrix12d::Identity();
+  f.block<3, 3>(0, 6) = dt * Eigen::Matrix3d::Identity();
+  f.block<3, 3>(3, 3) = turn;
+  f.block<3, 3>(3, 9) = dt * Eigen::Matrix3d::Identity();
+  next.covariance = f * state_.covariance * f.transpose();
+  add_acceleration_noise(next.covariance, 0, 6, options_.linear_acceleration_density, dt);
+  add_acceleration_noise(next.covariance, 3, 9, options_.angular_acceleration_density, dt);
+  return next;
+}
+
+namespace {
+
+// The measured pose's difference from a predicted one: translation, then rotation vector.
+Vector6d innovation_of(const BodyState& prior, const Eigen::Isometry3d& measured) {
+  Vector6d residual;
+  residual.head<3>() = measured.translation() - prior.camera_from_body.translation();
+  residual.tail<3>() =
+      vector_from_rotation(measured.linear() * prior.camera_from_body.linear().transpose());
+  return residual;
+}
+
+}  // namespace
+
+double BodyMotionFilter::surprise(int64_t stamp_ns, const Eigen::Isometry3d& measured,
+                                  const Matrix6d& pose_covariance) const {
+  const BodyState prior = predicted(stamp_ns);
+  const Vector6d residual = innovation_of(prior, measured);
+  const Matrix6d innovation = prior.covariance.topLeftCorner<6, 6>() + pose_covariance;
+  return residual.dot(innovation.ldlt().solve(residual));
+}
+
+double BodyMotionFilter::correct(int64_t stamp_ns, const Eigen::Isometry3d& measured,
+                                 const Matrix6d& pose_covariance) {
+  BodyState prior = predicted(stamp_ns);
+  const Vector6d residual = innovation_of(prior, measured);
+  const Matrix6d innovation = prior.covariance.topLeftCorner<6, 6>() + pose_covariance;
+  const Eigen::LDLT<Matrix6d> solver(innovation);
+  const Eigen::Matrix<double, 12, 6> gain =
+      solver.solve(prior.covariance.leftCols<6>().transpose()).transpose();
+  const Vector12d delta = gain * residual;
+
+  state_ = prior;
+  state_.camera_from_body.translation() += delta.segment<3>(0);
+  state_.camera_from_body.linear() =
+      rotation_from_vector(delta.segment<3>(3)) * prior.camera_from_body.linear();
+  state_.linear_velocity += delta.segment<3>(6);
+  state_.angular_velocity += delta.segment<3>(9);
+  // Joseph form: stays symmetric and positive however the gain was rounded.
+  Matrix12d keep = Matrix12d::Identity();
+  keep.leftCols<6>() -= gain;
+  state_.covariance =
+      keep * prior.covariance * keep.transpose() + gain * pose_covariance * gain.transpose();
+  ++corrections_;
+  return residual.dot(solver.solve(residual));
+}
+
+}  // namespace mocap::tracking

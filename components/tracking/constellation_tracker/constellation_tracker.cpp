@@ -1,0 +1,508 @@
+#include "constellation_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "cross_ratio.hpp"
+#include "marker_association.hpp"
+
+namespace mocap::tracking {
+namespace {
+
+using constellations::ConstellationModel;
+using constellations::IdentifiedConstellation;
+using constellations::IdentifiedLine;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// How a marker's image moves with a small change of the pose (translation, rotation vector in
+// the camera frame, as PlanarPose::covariance): 2x6, by differences through the camera model.
+std::optional<Eigen::Matrix<double, 2, 6>> image_jacobian(const calibration::CameraModel& camera,
+                                                          const Eigen::Vector3d& position,
+                                                          const Eigen::Vector3d& lever,
+                                                          const Eigen::Vector2d& pixel) {
+  // d(position)/d(pose) = [I, -[lever]x], lever = the marker's offset from the body's origin.
+  Eigen::Matrix<double, 2, 3> projection;
+  const double h = 1e-6 * std::max(1.0, position.norm());
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d moved = position;
+    moved(k) += h;
+    auto shifted = camera.project(moved);
+    if (!shifted) return std::nullopt;
+    projection.col(k) = (*shifted - pixel) / h;
+  }
+  Eigen::Matrix<double, 3, 6> motion;
+  motion.leftCols<3>().setIdentity();
+  motion.rightCols<3>() << 0, lever.z(), -lever.y(), -lever.z(), 0, lever.x(), lever.y(),
+      -lever.x(), 0;
+  return projection * motion;
+}
+
+// Whole lines among the identified markers, with their cross-ratios measured on `ideal`
+// pixels (computed here for the lines' points only).
+std::vector<IdentifiedLine> whole_lines(const calibration::CameraModel& camera,
+                                        const ConstellationModel& model,
+                                        const std::vector<int>& image_point_of,
+                                        const std::vector<Eigen::Vector2d>& fiducials) {
+  std::vector<IdentifiedLine> lines;
+  for (size_t l = 0; l < model.lines.size(); ++l) {
+    IdentifiedLine line;
+    line.model_line = static_cast<int>(l);
+    std::array<Eigen::Vector2d, 4> ideal;
+    bool whole = true;
+    for (int k = 0; k < 4 && whole; ++k) {
+      line.image_points[k] = image_point_of[model.lines[l].points[k]];
+      if (line.image_points[k] < 0) {
+        whole = false;
+        break;
+      }
+      auto ray = camera.unproject(fiducials[line.image_points[k]]);
+      if (!ray) whole = false;
+      if (ray) ideal[k] = ray->head<2>();
+    }
+    if (!whole) continue;
+    line.cross_ratio = constellations::cross_ratio(ideal[0], ideal[1], ideal[2], ideal[3]);
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+// A measured pose's covariance as the motion filter takes it. It comes from the fit's own
+// residuals; a floor of a tenth of a pixel keeps a lucky, nearly perfect fit from freezing the
+// filter.
+Matrix6d measurement_covariance(const pose::PlanarPose& pose) {
+  constexpr double kFloorPx = 0.1;
+  const double rms = std::max(pose.reprojection_rms_px, 1e-9);
+  return rms < kFloorPx ? Matrix6d(pose.covariance * (kFloorPx * kFloorPx) / (rms * rms))
+                        : pose.covariance;
+}
+
+// The model points and the pixels of an identification's markers, pair by pair.
+std::vector<Eigen::Vector3d> marker_points(const IdentifiedConstellation& found) {
+  std::vector<Eigen::Vector3d> points;
+  for (size_t m = 0; m < found.image_point_of.size(); ++m) {
+    if (found.image_point_of[m] >= 0) points.push_back(found.model->points[m]);
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector2d> marker_pixels(const IdentifiedConstellation& found,
+                                           const std::vector<Eigen::Vector2d>& fiducials) {
+  std::vector<Eigen::Vector2d> pixels;
+  for (int i : found.image_point_of) {
+    if (i >= 0) pixels.push_back(fiducials[i]);
+  }
+  return pixels;
+}
+
+}  // namespace
+
+const char* to_string(PoseSource source) {
+  switch (source) {
+    case PoseSource::Tracked:
+      return "tracked";
+    case PoseSource::Identified:
+      return "identified";
+    case PoseSource::FromOneLine:
+      return "one line";
+  }
+  return "?";
+}
+
+struct ConstellationTracker::Candidate {
+  const ConstellationModel* model = nullptr;
+  PoseSource source = PoseSource::Tracked;
+  int track = -1;  // index into tracks_; -1 for a board found by identification
+  IdentifiedConstellation identified;
+  pose::PlanarPose pose;
+  std::vector<MarkerImage> images;  // every marker at the pose
+  std::string rejection;            // why not believed; empty when it is
+};
+
+ConstellationTracker::ConstellationTracker(const constellations::ConstellationDatabase& database,
+                                           std::shared_ptr<const calibration::CameraModel> camera,
+                                           TrackerOptions options)
+    : database_(database),
+      camera_(std::move(camera)),
+      options_([&] {
+        options.identification.focal_length_px = camera_ ? camera_->focal_length_px() : 0;
+        return options;
+      }()),
+      identifier_(database, options_.identification) {
+  if (!camera_) throw std::invalid_argument("ConstellationTracker: no camera model");
+}
+
+std::vector<TrackedConstellation> ConstellationTracker::update(
+    int64_t stamp_ns, const std::vector<ImageFiducial>& detected, TrackerStats* stats_out) {
+  pixels_.resize(detected.size());
+  for (size_t i = 0; i < detected.size(); ++i) pixels_[i] = detected[i].pixel;
+  const std::vector<Eigen::Vector2d>& fiducials = pixels_;
+  TrackerStats local;
+  TrackerStats& stats = stats_out ? *stats_out : local;
+  stats = {};
+  if (stamp_ns < last_stamp_ns_) tracks_.clear();
+  last_stamp_ns_ = stamp_ns;
+
+  std::vector<Candidate> candidates;
+  follow_tracks(stamp_ns, detected, candidates, stats);
+
+  // Who holds which fiducial; a tracked board whose pose fails its check lets its go.
+  std::vector<int> owner(fiducials.size(), -1);
+  auto claim = [&](size_t c) {
+    for (int i : candidates[c].identified.image_point_of) {
+      if (i >= 0) owner[i] = static_cast<int>(c);
+    }
+  };
+  for (size_t c = 0; c < candidates.size(); ++c) claim(c);
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    Candidate& candidate = candidates[c];
+    candidate.rejection = verify(candidate, candidates, fiducials, owner);
+    if (candidate.rejection.empty()) continue;
+    for (int& o : owner) {
+      if (o == static_cast<int>(c)) o = -1;
+    }
+  }
+
+  std::vector<bool> claimed(fiducials.size());
+  for (size_t i = 0; i < fiducials.size(); ++i) claimed[i] = owner[i] >= 0;
+  const size_t tracked_count = candidates.size();
+  identify_others(fiducials, claimed, candidates, stats);
+  for (size_t c = tracked_count; c < candidates.size(); ++c) {
+    claim(c);
+    candidates[c].rejection = verify(candidates[c], candidates, fiducials, owner);
+  }
+
+  // The tracks go on with what was believed; the rest are dropped.
+  std::vector<Track> next_tracks;
+  std::vector<TrackedConstellation> result;
+  for (Candidate& candidate : candidates) {
+    if (!candidate.rejection.empty()) {
+      ++stats.rejected;
+      stats.rejections.push_back(candidate.model->name + ": " + candidate.rejection);
+      continue;
+    }
+    const Matrix6d measured = measurement_covariance(candidate.pose);
+    if (candidate.track >= 0) {
+      Track track = std::move(tracks_[candidate.track]);
+      track.motion.correct(stamp_ns, candidate.pose.camera_from_object, measured);
+      ++track.frames;
+      next_tracks.push_back(std::move(track));
+      ++stats.tracked;
+    } else {
+      next_tracks.push_back(
+          {candidate.model,
+           BodyMotionFilter(candidate.pose.camera_from_object, measured, stamp_ns, options_.motion),
+           next_track_id_++, 1});
+      ++stats.identified;
+      stats.from_one_line += candidate.source == PoseSource::FromOneLine;
+    }
+    const Track& track = next_tracks.back();
+    TrackedConstellation out;
+    out.identified = std::move(candidate.identified);
+    if (candidate.source == PoseSource::Tracked) {
+      out.identified.lines =
+          whole_lines(*camera_, *candidate.model, out.identified.image_point_of, fiducials);
+    }
+    out.source = candidate.source;
+    out.pose = candidate.pose;
+    out.motion = track.motion.state();
+    out.track_id = track.id;
+    out.frames_tracked = track.frames;
+    result.push_back(std::move(out));
+  }
+  tracks_ = std::move(next_tracks);
+  const auto& models = database_.constellations();
+  std::sort(result.begin(), result.end(), [&](const auto& a, const auto& b) {
+    return a.identified.model - models.data() < b.identified.model - models.data();
+  });
+  return result;
+}
+
+void ConstellationTracker::follow_tracks(int64_t stamp_ns,
+                                         const std::vector<ImageFiducial>& detected,
+                                         std::vector<Candidate>& candidates, TrackerStats& stats) {
+  const std::vector<Eigen::Vector2d>& fiducials = pixels_;
+  // Every tracked board's markers where the camera should see them now.
+  std::vector<PredictedMarker> predictions;
+  std::vector<std::pair<int, int>> predicted_marker;  // (track, marker) of each prediction
+  std::vector<BodyState> predicted(tracks_.size());
+  const double fiducial_variance = options_.fiducial_sigma_px * options_.fiducial_sigma_px;
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    predicted[t] = tracks_[t].motion.predicted(stamp_ns);
+  }
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    const Eigen::Isometry3d& pose = predicted[t].camera_from_body;
+    const Matrix6d pose_covariance = predicted[t].pose_covariance();
+    const ConstellationModel& model = *tracks_[t].model;
+    const auto images = marker_images(*camera_, model, pose, options_.visibility);
+    for (size_t m = 0; m < model.points.size(); ++m) {
+      if (images[m].sight != MarkerSight::InView) continue;
+      // A marker behind another tracked board is not looked for: boards are opaque.
+      bool covered = false;
+      for (size_t u = 0; u < tracks_.size() && !covered; ++u) {
+        covered = u != t && behind_board(pose * model.points[m], *tracks_[u].model,
+                                         predicted[u].camera_from_body);
+      }
+      if (covered) continue;
+      const Eigen::Vector3d lever = pose.linear() * model.points[m];
+      auto jacobian = image_jacobian(*camera_, pose * model.points[m], lever, images[m].pixel);
+      if (!jacobian) continue;
+      PredictedMarker marker;
+      marker.pixel = images[m].pixel;
+      marker.covariance = *jacobian * pose_covariance * jacobian->transpose() +
+                          fiducial_variance * Eigen::Matrix2d::Identity();
+      predictions.push_back(marker);
+      predicted_marker.emplace_back(static_cast<int>(t), static_cast<int>(m));
+    }
+  }
+  const std::vector<int> fiducial_of =
+      associate_markers(predictions, fiducials, options_.association_gate);
+
+  std::vector<std::vector<int>> image_point_of(tracks_.size());
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    image_point_of[t].assign(tracks_[t].model->points.size(), -1);
+  }
+  for (size_t p = 0; p < predictions.size(); ++p) {
+    image_point_of[predicted_marker[p].first][predicted_marker[p].second] = fiducial_of[p];
+  }
+  pose::PlanarPoseOptions pose_options = options_.pose;
+  pose_options.min_points = options_.min_tracked_markers;
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    const ConstellationModel& model = *tracks_[t].model;
+    std::vector<int>& image_of = image_point_of[t];
+    const std::vector<bool> in_fit =
+        whole_markers(model, predicted[t].camera_from_body, image_of, detected);
+    Candidate candidate;
+    candidate.model = &model;
+    candidate.track = static_cast<int>(t);
+    // Fit, then take out the worst marker while one is further than the bound from its
+    // reprojection (a distractor taken for a hidden marker), and fit again.
+    while (true) {
+      std::vector<Eigen::Vector3d> object;
+      std::vector<Eigen::Vector2d> image;
+      std::vector<int> marker_of_pair;
+      for (size_t m = 0; m < image_of.size(); ++m) {
+        if (image_of[m] < 0 || !in_fit[m]) continue;
+        object.push_back(model.points[m]);
+        image.push_back(fiducials[image_of[m]]);
+        marker_of_pair.push_back(static_cast<int>(m));
+      }
+      if (static_cast<int>(object.size()) < options_.min_tracked_markers) {
+        candidate.pose = {};
+        candidate.pose.rejection = fmt::format("{} markers associated, {} needed", object.size(),
+                                               options_.min_tracked_markers);
+        break;
+      }
+      candidate.pose = pose::refine_planar_pose(*camera_, predicted[t].camera_from_body, object,
+                                                image, pose_options);
+      if (candidate.pose.points_used != static_cast<int>(object.size())) break;
+      int worst = -1;
+      double worst_error = options_.max_marker_error_px;
+      for (size_t k = 0; k < object.size(); ++k) {
+        auto at = camera_->project(candidate.pose.camera_from_object * object[k]);
+        const double error = at ? (*at - image[k]).norm() : std::numeric_limits<double>::infinity();
+        if (error > worst_error) {
+          worst_error = error;
+          worst = marker_of_pair[k];
+        }
+      }
+      if (worst < 0) break;
+      image_of[worst] = -1;
+    }
+    if (candidate.pose.valid &&
+        tracks_[t].motion.surprise(stamp_ns, candidate.pose.camera_from_object,
+                                   measurement_covariance(candidate.pose)) >
+            options_.max_motion_surprise) {
+      candidate.pose.valid = false;
+      candidate.pose.rejection = "it moved further than its motion allows";
+    }
+    if (!candidate.pose.valid) {
+      ++stats.lost;
+      stats.rejections.push_back(model.name + ": " + candidate.pose.rejection);
+      continue;
+    }
+    candidate.identified.model = &model;
+    candidate.identified.image_point_of = image_of;
+    candidate.images =
+        marker_images(*camera_, model, candidate.pose.camera_from_object, options_.visibility);
+    candidates.push_back(std::move(candidate));
+  }
+}
+
+std::vector<bool> ConstellationTracker::whole_markers(
+    const ConstellationModel& model, const Eigen::Isometry3d& pose,
+    const std::vector<int>& image_of, const std::vector<ImageFiducial>& detected) const {
+  std::vector<bool> whole(model.points.size(), true);
+  if (!(options_.min_size_ratio > 0)) return whole;
+  // Each size against what the marker's depth and angle lead to expect: a flat disc's image
+  // shrinks with the square of its distance and with the cosine of its angle to the ray.
+  const Eigen::Vector3d normal = pose.linear().col(2);
+  std::vector<double> ratio(model.points.size(), 0);
+  std::vector<double> ratios;
+  for (size_t m = 0; m < model.points.size(); ++m) {
+    if (image_of[m] < 0 || !(detected[image_of[m]].size > 0)) continue;
+    const Eigen::Vector3d position = pose * model.points[m];
+    const double distance = position.norm();
+    const double cosine = std::max(0.1, normal.dot(-position) / distance);
+    ratio[m] = detected[image_of[m]].size * distance * distance / cosine;
+    ratios.push_back(ratio[m]);
+  }
+  if (ratios.size() < 3) return whole;
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  const double median = ratios[ratios.size() / 2];
+  for (size_t m = 0; m < model.points.size(); ++m) {
+    if (ratio[m] > 0) {
+      whole[m] = ratio[m] >= options_.min_size_ratio * median &&
+                 ratio[m] * options_.min_size_ratio <= median;
+    }
+  }
+  return whole;
+}
+
+void ConstellationTracker::identify_others(const std::vector<Eigen::Vector2d>& fiducials,
+                                           const std::vector<bool>& claimed,
+                                           std::vector<Candidate>& candidates,
+                                           TrackerStats& stats) {
+  const auto& models = database_.constellations();
+  std::vector<bool> known(models.size(), false);
+  for (const Candidate& candidate : candidates) {
+    if (candidate.rejection.empty()) known[candidate.model - models.data()] = true;
+  }
+  if (std::all_of(known.begin(), known.end(), [](bool k) { return k; })) return;
+  stats.identification_ran = true;
+  // Lines are straight only without lens distortion: the identifier sees ideal pixels.
+  const double focal = camera_->focal_length_px();
+  ideal_.resize(fiducials.size());
+  for (size_t i = 0; i < fiducials.size(); ++i) {
+    ideal_[i] = Eigen::Vector2d::Constant(kNaN);
+    if (claimed[i] || !fiducials[i].allFinite()) continue;
+    if (auto ray = camera_->unproject(fiducials[i])) ideal_[i] = focal * ray->head<2>();
+  }
+  std::vector<IdentifiedConstellation> found_boards = identifier_.identify(ideal_);
+  // Fiducials taken: by tracks, or by a board identified here.
+  std::vector<bool> used = claimed;
+  for (const IdentifiedConstellation& found : found_boards) {
+    for (int i : found.image_point_of) {
+      if (i >= 0) used[i] = true;
+    }
+  }
+  for (IdentifiedConstellation& found : found_boards) {
+    if (known[found.model - models.data()]) continue;
+    Candidate candidate;
+    candidate.model = found.model;
+    candidate.source = found.from_one_line ? PoseSource::FromOneLine : PoseSource::Identified;
+    candidate.pose = pose::estimate_planar_pose(*camera_, marker_points(found),
+                                                marker_pixels(found, fiducials), options_.pose);
+    if (!candidate.pose.valid) {
+      ++stats.rejected;
+      stats.rejections.push_back(candidate.model->name + ": " + candidate.pose.rejection);
+      continue;
+    }
+    // The pose from the identified markers places the others: those that land on a free
+    // fiducial join, and the pose is fitted again with them.
+    bool completed = false;
+    const auto images = marker_images(*camera_, *found.model, candidate.pose.camera_from_object,
+                                      options_.visibility);
+    for (size_t m = 0; m < images.size(); ++m) {
+      if (found.image_point_of[m] >= 0 || images[m].sight != MarkerSight::InView) continue;
+      int nearest = -1;
+      double nearest_distance = options_.max_marker_error_px;
+      for (size_t i = 0; i < fiducials.size(); ++i) {
+        if (used[i] || !fiducials[i].allFinite()) continue;
+        const double distance = (fiducials[i] - images[m].pixel).norm();
+        if (distance <= nearest_distance) {
+          nearest = static_cast<int>(i);
+          nearest_distance = distance;
+        }
+      }
+      if (nearest < 0) continue;
+      found.image_point_of[m] = nearest;
+      used[nearest] = true;
+      completed = true;
+    }
+    if (completed) {
+      pose::PlanarPose refined = pose::refine_planar_pose(
+          *camera_, candidate.pose.camera_from_object, marker_points(found),
+          marker_pixels(found, fiducials), options_.pose);
+      if (refined.valid) candidate.pose = refined;
+    }
+    candidate.identified = std::move(found);
+    candidate.images = marker_images(*camera_, *candidate.model, candidate.pose.camera_from_object,
+                                     options_.visibility);
+    candidates.push_back(std::move(candidate));
+  }
+}
+
+std::string ConstellationTracker::verify(const Candidate& candidate,
+                                         const std::vector<Candidate>& others,
+                                         const std::vector<Eigen::Vector2d>& fiducials,
+                                         const std::vector<int>& owner) const {
+  const ConstellationModel& model = *candidate.model;
+  const Eigen::Isometry3d& pose = candidate.pose.camera_from_object;
+  const int self = static_cast<int>(&candidate - others.data());
+  std::vector<Eigen::Vector2d> seen, unexplained;
+  for (size_t m = 0; m < model.points.size(); ++m) {
+    const MarkerImage& image = candidate.images[m];
+    const int fiducial = candidate.identified.image_point_of[m];
+    if (fiducial >= 0) {
+      // A marker found where the pose turns it away from the camera: the pose is wrong.
+      if (image.sight == MarkerSight::BehindCamera ||
+          (pose.linear().col(2).dot(-(pose * model.points[m])) < 0)) {
+        return "the pose turns found markers away from the camera";
+      }
+      seen.push_back(fiducials[fiducial]);
+      continue;
+    }
+    if (image.sight != MarkerSight::InView) continue;
+    // Merged with, or under, a fiducial that is not this board's.
+    bool hidden = false;
+    for (size_t i = 0; i < fiducials.size() && !hidden; ++i) {
+      hidden = owner[i] != self && fiducials[i].allFinite() &&
+               (fiducials[i] - image.pixel).norm() <= options_.merge_distance_px;
+    }
+    // Behind another board believed this frame.
+    for (size_t o = 0; o < others.size() && !hidden; ++o) {
+      const Candidate& other = others[o];
+      if (static_cast<int>(o) == self || !other.rejection.empty()) continue;
+      hidden = behind_board(pose * model.points[m], *other.model, other.pose.camera_from_object);
+    }
+    if (!hidden) unexplained.push_back(image.pixel);
+  }
+  if (!one_band_covers(unexplained, seen, options_.spare_missing_markers)) {
+    return fmt::format("{} of its markers are missing in plain view ({} found)", unexplained.size(),
+                       seen.size());
+  }
+  // Fiducials on its sides where it has no marker: a board found by one line could be another
+  // board of the same size hinged on a side of the same line type, whose markers lie there.
+  // One could be a stray light; two are the other board's.
+  if (candidate.source != PoseSource::FromOneLine) return {};
+  int on_sides = 0;
+  for (const auto& line : model.lines) {
+    for (int k = 0; k < 3; ++k) {
+      const MarkerImage& a = candidate.images[line.points[k]];
+      const MarkerImage& b = candidate.images[line.points[k + 1]];
+      if (a.sight == MarkerSight::BehindCamera || b.sight == MarkerSight::BehindCamera) continue;
+      const Eigen::Vector2d along = b.pixel - a.pixel;
+      const double length = along.norm();
+      if (length < 2 * options_.merge_distance_px) continue;
+      for (size_t i = 0; i < fiducials.size(); ++i) {
+        if (owner[i] >= 0 || !fiducials[i].allFinite()) continue;
+        const Eigen::Vector2d offset = fiducials[i] - a.pixel;
+        const double u = offset.dot(along) / length;
+        if (u < options_.merge_distance_px || u > length - options_.merge_distance_px) continue;
+        if (std::abs(offset.x() * along.y() - offset.y() * along.x()) / length <=
+            options_.side_tolerance_px) {
+          ++on_sides;
+        }
+      }
+    }
+  }
+  if (on_sides >= 2)
+    return fmt::format("{} fiducials lie on its sides where it has no marker", on_sides);
+  return {};
+}
+
+}  // namespace mocap::tracking

@@ -1,0 +1,194 @@
+// constellation_tracker: FiducialArray -> ConstellationArray + ConstellationPoseArray with
+// velocities (constellation_tracker.hpp). The tracking stage of the shipped deployments: it
+// keeps its tracks itself and needs nothing but the fiducials, in order.
+#include <chrono>
+#include <memory>
+#include <optional>
+
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_array.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+
+#include "constellation_message.hpp"
+#include "constellation_tracker.hpp"
+#include "pose_message.hpp"
+
+namespace mocap::tracking {
+namespace {
+
+constexpr const char* kInput = "/mocap/fiducials";
+constexpr const char* kConstellations = "/mocap/constellations";
+constexpr const char* kPoses = "/mocap/poses";
+
+class ConstellationTrackerComponent final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    const TrackerOptions defaults;
+    spec.description(
+        "Follows constellations from frame to frame: predicts each tracked board at the "
+        "frame's capture time, associates the fiducials with its markers, estimates the pose "
+        "from any four or more of them and verifies it against the whole board; identifies "
+        "the boards not tracked (also from one whole line and loose markers). Publishes the "
+        "seed's constellations and each board's pose with its velocity.");
+    spec.parameter("database", mocap::config_file("constellations.yaml"),
+                   "constellation database: YAML, or the seed's constellation CSV")
+        .path();
+    spec.parameter("sub_constellations", std::string(),
+                   "the seed's sub-constellation CSV (line types), optional")
+        .path();
+    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
+                   "camera file (ROS camera_info YAML, or one mocap_calibrate wrote)")
+        .path();
+    spec.parameter("cross_ratio_tolerance", defaults.identification.cross_ratio_tolerance,
+                   "identification: largest relative cross-ratio difference (the seed used 0.20)")
+        .range(1e-4, 0.5);
+    spec.parameter("line_tolerance_px", defaults.identification.line_search.tolerance_px,
+                   "identification: largest distance of a point from its line, pixels")
+        .range(0.01, 100);
+    spec.parameter("min_loose_markers", defaults.identification.min_loose_markers,
+                   "identification from one whole line: loose markers that must confirm it; 0 = "
+                   "never identify from one line")
+        .range(0, 1000);
+    spec.parameter("max_reprojection_rms_px", defaults.pose.max_reprojection_rms_px,
+                   "poses with a larger RMS reprojection error are not believed")
+        .range(0.01, 1000);
+    spec.parameter("min_tracked_markers", defaults.min_tracked_markers,
+                   "fewest markers that keep a tracked board")
+        .range(4, 1000);
+    spec.parameter("linear_acceleration_density", defaults.motion.linear_acceleration_density,
+                   "motion model: white-noise acceleration, m^2/s^3 (larger follows faster "
+                   "changes of speed, with noisier velocities)")
+        .range(1e-6, 1e6);
+    spec.parameter("angular_acceleration_density", defaults.motion.angular_acceleration_density,
+                   "motion model: white-noise angular acceleration, rad^2/s^3")
+        .range(1e-6, 1e6);
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(
+        kInput, Qos::reliable(), "fiducials of one image, pixels, stamped at capture");
+    spec.publishes<mocap_msgs::msg::ConstellationArray>(
+        kConstellations, Qos::reliable(),
+        "the boards found in each fiducial array: each line's fiducials in database order, NaN "
+        "for a marker not seen");
+    spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
+        kPoses, Qos::reliable(),
+        "one pose per board found, in the camera's frame, with its velocity; stamped with the "
+        "image's capture time");
+  }
+
+  explicit ConstellationTrackerComponent(Context& context) : Component(context) {
+    database_ = constellations::load_database(param<std::string>("database"),
+                                              param<std::string>("sub_constellations"));
+    camera_ = calibration::load_camera_file(param<std::string>("camera"));
+    TrackerOptions options;
+    options.identification.cross_ratio_tolerance = param<double>("cross_ratio_tolerance");
+    options.identification.line_search.tolerance_px = param<double>("line_tolerance_px");
+    options.identification.min_loose_markers = param<int>("min_loose_markers");
+    options.pose.max_reprojection_rms_px = param<double>("max_reprojection_rms_px");
+    options.min_tracked_markers = param<int>("min_tracked_markers");
+    options.motion.linear_acceleration_density = param<double>("linear_acceleration_density");
+    options.motion.angular_acceleration_density = param<double>("angular_acceleration_density");
+    for (const std::string& problem :
+         database_.ambiguities(options.identification.cross_ratio_tolerance)) {
+      log().warn("{}", problem);
+    }
+    tracker_.emplace(database_, camera_.model, options);
+    log().info("{} constellations from {}", database_.constellations().size(),
+               param<std::string>("database"));
+    constellations_ = create_publisher<mocap_msgs::msg::ConstellationArray>(kConstellations);
+    poses_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kPoses);
+    create_subscription<mocap_msgs::msg::FiducialArray>(
+        kInput, [this](const mocap_msgs::msg::FiducialArray& array) { track(array); });
+  }
+
+  ~ConstellationTrackerComponent() override {
+    log().info(
+        "{} arrays: {} poses ({} tracked, {} identified, {} of them from one line), {} not "
+        "believed, {} tracks lost",
+        arrays_, totals_.tracked + totals_.identified, totals_.tracked, totals_.identified,
+        totals_.from_one_line, totals_.rejected, totals_.lost);
+  }
+
+ private:
+  void track(const mocap_msgs::msg::FiducialArray& array) {
+    ++arrays_;
+    const auto& fiducials = array.fiducials();
+    fiducials_.resize(fiducials.size());
+    for (size_t i = 0; i < fiducials.size(); ++i) {
+      fiducials_[i] = {Eigen::Vector2d(fiducials[i].x(), fiducials[i].y()), fiducials[i].size()};
+    }
+    TrackerStats stats;
+    const auto found = tracker_->update(to_nanoseconds(array.header().stamp()), fiducials_, &stats);
+    totals_.tracked += stats.tracked;
+    totals_.identified += stats.identified;
+    totals_.from_one_line += stats.from_one_line;
+    totals_.rejected += stats.rejected;
+    totals_.lost += stats.lost;
+    if (!stats.rejections.empty()) report(stats);
+
+    auto constellations = std::make_shared<mocap_msgs::msg::ConstellationArray>();
+    constellations->header(array.header());
+    auto poses = std::make_shared<mocap_msgs::msg::ConstellationPoseArray>();
+    poses->header(array.header());
+    if (poses->header().frame_id().empty()) poses->header().frame_id(camera_.frame_id);
+    for (const TrackedConstellation& board : found) {
+      constellations->constellations().push_back(
+          constellations::to_constellation_message(board.identified, array));
+      poses->poses().push_back(to_message(board, poses->header()));
+    }
+    constellations_.publish(std::move(constellations));
+    poses_.publish(std::move(poses));
+  }
+
+  static mocap_msgs::msg::ConstellationPose to_message(const TrackedConstellation& board,
+                                                       const std_msgs::msg::Header& header) {
+    mocap_msgs::msg::ConstellationPose out;
+    out.name(board.identified.model->name);
+    out.pose().header(header);
+    out.pose().pose(to_pose_message(board.pose.camera_from_object));
+    const Matrix6d velocity_covariance = board.motion.velocity_covariance();
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) {
+        out.covariance()[6 * i + j] = board.pose.covariance(i, j);
+        out.velocity_covariance()[6 * i + j] = velocity_covariance(i, j);
+      }
+    }
+    out.reprojection_rms_px(static_cast<float>(board.pose.reprojection_rms_px));
+    out.points_used(static_cast<uint32_t>(board.pose.points_used));
+    const Eigen::Vector3d& v = board.motion.linear_velocity;
+    const Eigen::Vector3d& w = board.motion.angular_velocity;
+    out.velocity().linear().x(v.x());
+    out.velocity().linear().y(v.y());
+    out.velocity().linear().z(v.z());
+    out.velocity().angular().x(w.x());
+    out.velocity().angular().y(w.y());
+    out.velocity().angular().z(w.z());
+    return out;
+  }
+
+  // At most one line a second, so a scene full of near misses cannot flood the log.
+  void report(const TrackerStats& stats) {
+    Clock::time_point t = now();
+    if (t - last_report_ < std::chrono::seconds(1)) return;
+    last_report_ = t;
+    log().info("not believed or lost: {} ({} so far)", fmt::join(stats.rejections, "; "),
+               totals_.rejected + totals_.lost);
+  }
+
+  constellations::ConstellationDatabase database_;
+  calibration::CameraFile camera_;
+  std::optional<ConstellationTracker> tracker_;
+  Publisher<mocap_msgs::msg::ConstellationArray> constellations_;
+  Publisher<mocap_msgs::msg::ConstellationPoseArray> poses_;
+  std::vector<ImageFiducial> fiducials_;
+  uint64_t arrays_ = 0;
+  TrackerStats totals_;
+  Clock::time_point last_report_{};
+};
+
+}  // namespace
+}  // namespace mocap::tracking
+
+MOCAP_REGISTER_COMPONENT(mocap::tracking::ConstellationTrackerComponent, "constellation_tracker")
