@@ -1,9 +1,11 @@
 #include "constellation_identifier.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 
 #include "cross_ratio.hpp"
 #include "line_candidate.hpp"
@@ -14,12 +16,26 @@ namespace mocap::constellations {
 
 std::optional<PlaneFit> plane_fit(const ConstellationModel& model, const std::vector<int>& image_of,
                                   const std::vector<Eigen::Vector2d>& points) {
-  std::vector<Eigen::Vector2d> from, to;
+  // The searches fit thousands of hypotheses a frame: the pairs stay on the stack for boards
+  // of up to 64 markers.
+  constexpr size_t kOnStack = 64;
+  std::array<Eigen::Vector2d, kOnStack> from_stack, to_stack;
+  std::vector<Eigen::Vector2d> from_heap, to_heap;
+  const bool small = image_of.size() <= kOnStack;
+  if (!small) {
+    from_heap.resize(image_of.size());
+    to_heap.resize(image_of.size());
+  }
+  Eigen::Vector2d* from_data = small ? from_stack.data() : from_heap.data();
+  Eigen::Vector2d* to_data = small ? to_stack.data() : to_heap.data();
+  size_t count = 0;
   for (size_t m = 0; m < image_of.size(); ++m) {
     if (image_of[m] < 0) continue;
-    from.push_back(model.plane_points[m]);
-    to.push_back(points[image_of[m]]);
+    from_data[count] = model.plane_points[m];
+    to_data[count] = points[image_of[m]];
+    ++count;
   }
+  const std::span<const Eigen::Vector2d> from(from_data, count), to(to_data, count);
   auto h = fit_homography(from, to);
   if (!h) return std::nullopt;
   double nearest = std::numeric_limits<double>::infinity(), farthest = -nearest;
@@ -47,6 +63,40 @@ std::optional<PlaneFit> plane_fit(const ConstellationModel& model, const std::ve
 
 namespace {
 
+// A line type's candidates read both ways, and per position k the choices grouped by the
+// image point they put there (counting sort: choice ids by point, in increasing choice order):
+// built once a frame and shared by every constellation with a line of that type.
+struct TypeChoices {
+  std::vector<Choice> choices;
+  std::array<std::vector<int>, 4> first;  // per k, per image point: offset into `by_point`
+  std::array<std::vector<int>, 4> by_point;
+
+  TypeChoices(const std::vector<Candidate>& candidates, size_t points) {
+    for (const Candidate& candidate : candidates) {
+      choices.push_back({&candidate, false});
+      choices.push_back({&candidate, true});
+    }
+    for (int k = 0; k < 4; ++k) {
+      first[k].assign(points + 1, 0);
+      for (const Choice& choice : choices) ++first[k][choice.image_point(k) + 1];
+      for (size_t p = 0; p < points; ++p) first[k][p + 1] += first[k][p];
+      by_point[k].resize(choices.size());
+      std::vector<int> next(first[k].begin(), first[k].end() - 1);
+      for (size_t c = 0; c < choices.size(); ++c) {
+        by_point[k][next[choices[c].image_point(k)]++] = static_cast<int>(c);
+      }
+    }
+  }
+
+  // The choices whose image point at position k is `point`.
+  std::span<const int> holding(int k, int point) const {
+    return {by_point[k].data() + first[k][point],
+            static_cast<size_t>(first[k][point + 1] - first[k][point])};
+  }
+  // Every choice, in the order of the image point they put at position 0.
+  std::span<const int> all() const { return by_point[0]; }
+};
+
 // Finds one constellation among the candidates: hypothesise from two lines that share a
 // marker (seven points fix a plane-to-image homography), then extend by the remaining lines
 // whose candidates land where that homography puts them. Two linked lines are selective
@@ -55,7 +105,7 @@ namespace {
 class ConstellationSearch {
  public:
   ConstellationSearch(const ConstellationModel& model, const std::vector<int>& type_of_line,
-                      const std::vector<std::vector<Candidate>>& by_type,
+                      const std::vector<TypeChoices>& by_type,
                       const std::vector<Eigen::Vector2d>& points, const IdentifierOptions& options)
       : model_(model),
         type_of_line_(type_of_line),
@@ -65,28 +115,13 @@ class ConstellationSearch {
         min_lines_(std::min<int>(options.min_lines, static_cast<int>(model.lines.size()))),
         search_min_lines_(options.min_extra_markers > 0 ? std::min(min_lines_, 2) : min_lines_),
         image_of_(model.points.size(), -1),
-        chosen_(model.lines.size()),
-        choices_(model.lines.size()),
-        at_position_(model.lines.size()) {}
+        chosen_(model.lines.size()) {}
 
   std::optional<IdentifiedConstellation> search(IdentificationStats& stats) {
     stats_ = &stats;
     const size_t lines = model_.lines.size();
-    for (size_t line = 0; line < lines; ++line) {
-      for (const Candidate& candidate : by_type_[type_of_line_[line]]) {
-        choices_[line].push_back({&candidate, false});
-        choices_[line].push_back({&candidate, true});
-      }
-      for (int k = 0; k < 4; ++k) {
-        auto& index = at_position_[line][k];
-        for (size_t c = 0; c < choices_[line].size(); ++c) {
-          index.emplace_back(choices_[line][c].image_point(k), static_cast<int>(c));
-        }
-        std::sort(index.begin(), index.end());
-      }
-    }
     if (lines == 1) {
-      for (const Choice& first : choices_[0]) {
+      for (const Choice& first : choices(0)) {
         if (!assign(0, first)) continue;
         extend_and_evaluate();
         release(0);
@@ -102,14 +137,13 @@ class ConstellationSearch {
       for (size_t b = a + 1; b < lines; ++b) {
         auto shared = shared_marker(a, b);
         if (linked && !shared) continue;
-        for (size_t f = 0; f < choices_[a].size() && !complete_; ++f) {
-          const Choice& first = choices_[a][f];
+        for (size_t f = 0; f < choices(a).size() && !complete_; ++f) {
+          const Choice& first = choices(a)[f];
           if (!assign(a, first)) continue;
-          IndexRange seconds{at_position_[b][0].begin(), at_position_[b][0].end()};
-          if (shared)
-            seconds = choices_holding(b, shared->second, first.image_point(shared->first));
-          for (auto it = seconds.first; it != seconds.second && !complete_; ++it) {
-            if (!assign(b, choices_[b][it->second])) continue;
+          std::span<const int> seconds = index(b).all();
+          if (shared) seconds = index(b).holding(shared->second, first.image_point(shared->first));
+          for (auto it = seconds.begin(); it != seconds.end() && !complete_; ++it) {
+            if (!assign(b, choices(b)[*it])) continue;
             extend_and_evaluate();
             release(b);
           }
@@ -170,17 +204,6 @@ class ConstellationSearch {
     return added;
   }
 
-  // The choices for `line` whose image point at position k is `point`, from a sorted index,
-  // so that linked lines are found in logarithmic time rather than by a scan.
-  using IndexRange = std::pair<std::vector<std::pair<int, int>>::const_iterator,
-                               std::vector<std::pair<int, int>>::const_iterator>;
-  IndexRange choices_holding(size_t line, int k, int point) const {
-    const auto& index = at_position_[line][k];
-    return {std::lower_bound(index.begin(), index.end(), std::make_pair(point, -1)),
-            std::upper_bound(index.begin(), index.end(),
-                             std::make_pair(point, std::numeric_limits<int>::max()))};
-  }
-
   // Positions (in line a, in line b) of a marker both lines hold, if any.
   std::optional<std::pair<int, int>> shared_marker(size_t a, size_t b) const {
     for (int i = 0; i < 4; ++i) {
@@ -227,42 +250,50 @@ class ConstellationSearch {
   void extend_and_evaluate() {
     std::vector<size_t> added;
     std::optional<PlaneFit> fit;
-    bool stale = true;
+    bool stale = false;  // the fit predates lines added since
     for (size_t line = 0; line < model_.lines.size(); ++line) {
       if (chosen_[line].candidate != nullptr) continue;
       const ConstellationLine& model_line = model_.lines[line];
       // A marker of this line already placed narrows the choices to those holding it.
-      IndexRange range{at_position_[line][0].begin(), at_position_[line][0].end()};
+      std::span<const int> range = index(line).all();
       for (int k = 0; k < 4; ++k) {
         if (image_of_[model_line.points[k]] >= 0) {
-          range = choices_holding(line, k, image_of_[model_line.points[k]]);
+          range = index(line).holding(k, image_of_[model_line.points[k]]);
           break;
         }
       }
-      if (range.first == range.second) continue;
-      if (stale) {
-        fit = plane_fit(model_, image_of_, points_);
-        stale = false;
+      if (range.empty()) continue;
+      // The plane of the lines so far predicts this one; a fit that has not seen the lines
+      // added since is refitted only when it finds nothing (a refit costs more than a look).
+      const Choice* best = nullptr;
+      for (bool retry : {false, true}) {
+        if (retry && !stale) break;
+        if (!fit || retry) {
+          fit = plane_fit(model_, image_of_, points_);
+          stale = false;
+        }
+        if (!fit) break;
+        std::array<Eigen::Vector2d, 4> predicted;
+        for (int k = 0; k < 4; ++k) {
+          predicted[k] =
+              apply_homography(fit->homography, model_.plane_points[model_line.points[k]]);
+        }
+        // The candidate whose points lie closest to where the plane puts this line.
+        double best_error = options_.max_fit_error_px;
+        for (int c : range) {
+          const Choice& choice = choices(line)[c];
+          double error = 0;
+          for (int k = 0; k < 4 && error <= best_error; ++k) {
+            error = std::max(error, (predicted[k] - points_[choice.image_point(k)]).norm());
+          }
+          if (error <= best_error) {
+            best_error = error;
+            best = &choice;
+          }
+        }
+        if (best != nullptr) break;
       }
       if (!fit) break;
-      std::array<Eigen::Vector2d, 4> predicted;
-      for (int k = 0; k < 4; ++k) {
-        predicted[k] = apply_homography(fit->homography, model_.plane_points[model_line.points[k]]);
-      }
-      // The candidate whose points lie closest to where the plane puts this line.
-      double best_error = options_.max_fit_error_px;
-      const Choice* best = nullptr;
-      for (auto it = range.first; it != range.second; ++it) {
-        const Choice& choice = choices_[line][it->second];
-        double error = 0;
-        for (int k = 0; k < 4 && error <= best_error; ++k) {
-          error = std::max(error, (predicted[k] - points_[choice.image_point(k)]).norm());
-        }
-        if (error <= best_error) {
-          best_error = error;
-          best = &choice;
-        }
-      }
       if (best != nullptr && assign(line, *best)) {
         added.push_back(line);
         stale = true;
@@ -300,7 +331,7 @@ class ConstellationSearch {
 
   const ConstellationModel& model_;
   const std::vector<int>& type_of_line_;
-  const std::vector<std::vector<Candidate>>& by_type_;
+  const std::vector<TypeChoices>& by_type_;
   const std::vector<Eigen::Vector2d>& points_;
   const IdentifierOptions& options_;
   const int min_lines_;
@@ -308,9 +339,9 @@ class ConstellationSearch {
   IdentificationStats* stats_ = nullptr;
   std::vector<int> image_of_;
   std::vector<Choice> chosen_;
-  std::vector<std::vector<Choice>> choices_;  // per line: every candidate, both directions
-  // Per line, per position k: (image point at k, index into choices_), sorted.
-  std::vector<std::array<std::vector<std::pair<int, int>>, 4>> at_position_;
+  // Per line: every candidate of its type, both directions, and the index by position.
+  const TypeChoices& index(size_t line) const { return by_type_[type_of_line_[line]]; }
+  const std::vector<Choice>& choices(size_t line) const { return index(line).choices; }
   int best_count_ = 0;
   bool complete_ = false;
   PlaneFit best_fit_;
@@ -390,10 +421,13 @@ std::vector<IdentifiedConstellation> ConstellationIdentifier::identify(
     }
   }
 
+  std::vector<TypeChoices> choices_by_type;
+  choices_by_type.reserve(by_type.size());
+  for (const auto& candidates : by_type) choices_by_type.emplace_back(candidates, points.size());
   std::vector<IdentifiedConstellation> found;
   const auto& models = database_.constellations();
   for (size_t m = 0; m < models.size(); ++m) {
-    ConstellationSearch search(models[m], line_type_of_[m], by_type, points, options_);
+    ConstellationSearch search(models[m], line_type_of_[m], choices_by_type, points, options_);
     if (auto result = search.search(s)) found.push_back(std::move(*result));
   }
   // Most lines first, then most markers, then the best fit; a constellation whose points a

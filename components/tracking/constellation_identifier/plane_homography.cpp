@@ -10,7 +10,7 @@ namespace {
 
 // Moves the centroid to the origin and scales the mean distance to √2 (Hartley), so the
 // linear system is well conditioned in pixels and in metres alike.
-std::optional<Eigen::Matrix3d> normalisation(const std::vector<Eigen::Vector2d>& points) {
+std::optional<Eigen::Matrix3d> normalisation(std::span<const Eigen::Vector2d> points) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const auto& p : points) mean += p;
   mean /= static_cast<double>(points.size());
@@ -26,15 +26,15 @@ std::optional<Eigen::Matrix3d> normalisation(const std::vector<Eigen::Vector2d>&
 
 }  // namespace
 
-std::optional<Eigen::Matrix3d> fit_homography(const std::vector<Eigen::Vector2d>& from,
-                                              const std::vector<Eigen::Vector2d>& to) {
+std::optional<Eigen::Matrix3d> fit_homography(std::span<const Eigen::Vector2d> from,
+                                              std::span<const Eigen::Vector2d> to) {
   if (from.size() < 4 || from.size() != to.size()) return std::nullopt;
   auto tf = normalisation(from);
   auto tt = normalisation(to);
   if (!tf || !tt) return std::nullopt;
   // Points on one line leave no unique plane mapping: the smaller spread of either set,
   // against the larger, tells.
-  auto flat = [](const std::vector<Eigen::Vector2d>& points, const Eigen::Matrix3d& t) {
+  auto flat = [](std::span<const Eigen::Vector2d> points, const Eigen::Matrix3d& t) {
     Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
     for (const auto& p : points) {
       const Eigen::Vector2d q = t.topLeftCorner<2, 2>() * p + t.topRightCorner<2, 1>();
@@ -47,19 +47,39 @@ std::optional<Eigen::Matrix3d> fit_homography(const std::vector<Eigen::Vector2d>
   // The DLT with h33 = 1, in least squares by the normal equations (8x8). Normalised, the
   // centroid of `from` is the origin and maps to a finite point, so h33 is not zero; this is
   // an order of magnitude faster than the 9x9 eigenproblem of the homogeneous form, and the
-  // identifier fits many hypotheses per frame.
-  Eigen::Matrix<double, 8, 8> ata = Eigen::Matrix<double, 8, 8>::Zero();
-  Eigen::Matrix<double, 8, 1> atb = Eigen::Matrix<double, 8, 1>::Zero();
+  // identifier fits many hypotheses per frame. Each pair gives the rows
+  //   r1 = [0, -a, b.y p],  r2 = [a, 0, -b.x p]   (a = (p, 1), p = the normalised `from`),
+  // so AᵀA and Aᵀb come from a handful of sums instead of two 8x8 outer products a pair.
+  Eigen::Matrix3d sum_aa = Eigen::Matrix3d::Zero();
+  Eigen::Matrix2d sum_pp = Eigen::Matrix2d::Zero();  // weighted by |b|²
+  Eigen::Matrix<double, 3, 2> sum_bx_ap = Eigen::Matrix<double, 3, 2>::Zero();
+  Eigen::Matrix<double, 3, 2> sum_by_ap = Eigen::Matrix<double, 3, 2>::Zero();
+  Eigen::Vector3d sum_bx_a = Eigen::Vector3d::Zero(), sum_by_a = Eigen::Vector3d::Zero();
+  Eigen::Vector2d sum_bb_p = Eigen::Vector2d::Zero();
   for (size_t i = 0; i < from.size(); ++i) {
-    const Eigen::Vector2d a = tf->topLeftCorner<2, 2>() * from[i] + tf->topRightCorner<2, 1>();
+    const Eigen::Vector2d p = tf->topLeftCorner<2, 2>() * from[i] + tf->topRightCorner<2, 1>();
     const Eigen::Vector2d b = tt->topLeftCorner<2, 2>() * to[i] + tt->topRightCorner<2, 1>();
-    Eigen::Matrix<double, 8, 1> r1, r2;
-    r1 << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y();
-    r2 << a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y();
-    ata.noalias() += r1 * r1.transpose() + r2 * r2.transpose();
-    atb.noalias() += -b.y() * r1 + b.x() * r2;
+    const Eigen::Vector3d a(p.x(), p.y(), 1.0);
+    const double bb = b.squaredNorm();
+    sum_aa.noalias() += a * a.transpose();
+    sum_pp.noalias() += bb * p * p.transpose();
+    sum_bx_ap.noalias() += b.x() * a * p.transpose();
+    sum_by_ap.noalias() += b.y() * a * p.transpose();
+    sum_bx_a += b.x() * a;
+    sum_by_a += b.y() * a;
+    sum_bb_p += bb * p;
   }
-  const Eigen::LDLT<Eigen::Matrix<double, 8, 8>> solver(ata);
+  Eigen::Matrix<double, 8, 8> ata = Eigen::Matrix<double, 8, 8>::Zero();
+  ata.block<3, 3>(0, 0) = sum_aa;
+  ata.block<3, 3>(3, 3) = sum_aa;
+  ata.block<2, 2>(6, 6) = sum_pp;
+  ata.block<3, 2>(0, 6) = -sum_bx_ap;
+  ata.block<3, 2>(3, 6) = -sum_by_ap;
+  ata.block<2, 3>(6, 0) = -sum_bx_ap.transpose();
+  ata.block<2, 3>(6, 3) = -sum_by_ap.transpose();
+  Eigen::Matrix<double, 8, 1> atb;
+  atb << sum_bx_a, sum_by_a, -sum_bb_p;
+  const Eigen::LDLT<Eigen::Matrix<double, 8, 8>, Eigen::Lower> solver(ata);
   if (solver.info() != Eigen::Success) return std::nullopt;
   const Eigen::Matrix<double, 8, 1> h = solver.solve(atb);
   Eigen::Matrix3d hn;

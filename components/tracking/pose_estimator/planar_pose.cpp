@@ -84,7 +84,7 @@ Refined refine(const calibration::CameraModel& camera, Eigen::Isometry3d pose,
       Eigen::Isometry3d candidate = perturbed(pose, delta);
       Residuals next = residuals(camera, candidate, object, pixels);
       if (next.valid && next.values.squaredNorm() < cost) {
-        bool converged = cost - next.values.squaredNorm() < 1e-10 * (1 + cost);
+        bool converged = cost - next.values.squaredNorm() < 1e-8 * (1 + cost);
         pose = candidate;
         current = next;
         cost = next.values.squaredNorm();
