@@ -112,7 +112,7 @@ echo "image: $image, $size_mb MB"
 # The shipped demo, as a user would run it (in-process DDS only: no network).
 docker run --rm --network none "$image" mocap_launch launch_yaml/mobile_mocap_demo.yaml \
   --duration 5 > "$work/demo.log" 2>&1 || { tail -20 "$work/demo.log"; fail "the demo in the image"; }
-poses=$(sed -n 's/.*\[pose\]: \([0-9]*\) poses published.*/\1/p' "$work/demo.log")
+poses=$(sed -n 's/.*\[boards\]: [0-9]* arrays: \([0-9]*\) poses.*/\1/p' "$work/demo.log")
 [ "${poses:-0}" -ge 100 ] || { tail -20 "$work/demo.log"; fail "the demo in the image: ${poses:-0} poses in 5 s"; }
 echo "image: docker run ... mocap_launch launch_yaml/mobile_mocap_demo.yaml --duration 5: $poses poses"
 

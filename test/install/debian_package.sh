@@ -51,7 +51,7 @@ chroot "$root" sh -c "cd /usr/share/mocap_graph && MOCAP_DOMAIN_ID=$domain \
   timeout 120 mocap_launch launch_yaml/mobile_mocap_demo.yaml --duration 5 \
   --set viewer.port=0" > demo.log 2>&1 ||
   { cat demo.log; fail "mocap_launch from the installed package exited with $?"; }
-poses=$(sed -n 's/.*\[pose\]: \([0-9]*\) poses published.*/\1/p' demo.log)
+poses=$(sed -n 's/.*\[boards\]: [0-9]* arrays: \([0-9]*\) poses.*/\1/p' demo.log)
 [ "${poses:-0}" -ge 100 ] || { cat demo.log; fail "only ${poses:-0} poses in 5 s"; }
 grep -q "| 0 | 100.00 % |" demo.log || { cat demo.log; fail "not every frame tracked"; }
 chroot "$root" sh -c "DEBIAN_FRONTEND=noninteractive \

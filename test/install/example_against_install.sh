@@ -16,6 +16,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 prefix=$work/prefix
 cmake --install "$build_dir" --prefix "$prefix" > "$work/install.log"
 for file in bin/mocap_launch bin/mocap_topic bin/mocap_bag lib/libmocap_runtime.so \
+            lib/mocap_graph/plugins/libmocap_plugin_constellation_tracker.so \
             lib/mocap_graph/plugins/libmocap_plugin_pose_estimator.so \
             include/mocap/component.hpp include/geometry_msgs/msg/pose.hpp \
             include/mocap/calibration/camera_model.hpp include/mocap/bag/bag_reader.hpp \

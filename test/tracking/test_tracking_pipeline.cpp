@@ -86,8 +86,16 @@ std::string pipeline_launch_file(
   return dds + "groups:\n  - name: mocap\n    components:" + camera + tracking + "\n";
 }
 
-void expect_accurate(const std::filesystem::path& summary_file, int frames) {
+void expect_accurate(const std::filesystem::path& summary_file, int frames,
+                     bool with_velocities = true) {
   YAML::Node summary = YAML::LoadFile(summary_file.string());
+  // The tracker's velocities reach the evaluator (their accuracy depends on the camera keeping
+  // its rate, so tracking_accuracy_bench measures it offline); the per-frame stages have none.
+  if (with_velocities) {
+    EXPECT_GT(summary["velocity_errors"].as<int>(), frames);
+  } else {
+    EXPECT_EQ(summary["velocity_errors"].as<int>(), 0);
+  }
   EXPECT_EQ(summary["frames"].as<int>(), frames);
   EXPECT_EQ(summary["frames_lost"].as<int>(), 0);
   // demo.yaml keeps both boards in view: two per frame.
@@ -159,7 +167,7 @@ TEST(TrackingPipeline, PerFrameIdentifierAndPoseEstimator) {
   auto [code, output] = test::run_command({launcher(), (dir / "pipeline.yaml").string()}, {},
                                           std::chrono::seconds(120));
   ASSERT_EQ(code, 0) << output;
-  expect_accurate(dir / "summary.yaml", kFrames);
+  expect_accurate(dir / "summary.yaml", kFrames, false);
 }
 
 TEST(TrackingPipeline, CameraAndTrackingInTwoProcesses) {

@@ -24,6 +24,11 @@ void merge(EvaluationSummary& into, const EvaluationSummary& from) {
   into.orientation_errors_deg.insert(into.orientation_errors_deg.end(),
                                      from.orientation_errors_deg.begin(),
                                      from.orientation_errors_deg.end());
+  into.velocity_errors_mps.insert(into.velocity_errors_mps.end(), from.velocity_errors_mps.begin(),
+                                  from.velocity_errors_mps.end());
+  into.angular_velocity_errors_dps.insert(into.angular_velocity_errors_dps.end(),
+                                          from.angular_velocity_errors_dps.begin(),
+                                          from.angular_velocity_errors_dps.end());
 }
 
 }  // namespace
@@ -84,6 +89,13 @@ void PoseEvaluator::evaluate(const std::vector<ObjectPose>& truth,
     if (t->visible_markers >= options_.min_visible_markers) ++frame.tracked;
     frame.position_errors_m.push_back(position);
     frame.orientation_errors_deg.push_back(orientation);
+    if (e.linear_velocity && t->linear_velocity) {
+      frame.velocity_errors_mps.push_back((*e.linear_velocity - *t->linear_velocity).norm());
+    }
+    if (e.angular_velocity && t->angular_velocity) {
+      frame.angular_velocity_errors_dps.push_back(
+          (*e.angular_velocity - *t->angular_velocity).norm() * 180 / M_PI);
+    }
   }
   merge(total_, frame);
   merge(window_, frame);

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct ObjectPose {
   std::string name;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   int visible_markers = 0;  // truth only
+  // Linear (m/s) and angular (rad/s) velocity in the camera frame, when known: always for the
+  // truth, for an estimate once its track has measured them.
+  std::optional<Eigen::Vector3d> linear_velocity, angular_velocity;
 };
 
 // Totals over a run or a window of it.
@@ -38,6 +42,8 @@ struct EvaluationSummary {
   uint64_t false_identifications = 0;
   std::vector<double> position_errors_m;       // one per tracked object
   std::vector<double> orientation_errors_deg;  // one per tracked object
+  // Per tracked object with a measured velocity: |v - v_true| m/s, |w - w_true| deg/s.
+  std::vector<double> velocity_errors_mps, angular_velocity_errors_dps;
 
   double tracked_percent() const;
   // Quantile q in [0, 1] of a list (NaN when empty).

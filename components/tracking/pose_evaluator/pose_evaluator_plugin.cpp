@@ -16,7 +16,8 @@ namespace {
 constexpr const char* kTruth = "/camera/ir/ground_truth";
 constexpr const char* kPoses = "/mocap/poses";
 
-std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array) {
+// `truth`: the synthetic camera's, whose velocities are exact (and have no covariance).
+std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array, bool truth) {
   std::vector<ObjectPose> out;
   for (const auto& pose : array.poses()) {
     const std::optional<Eigen::Isometry3d> isometry = to_isometry(pose.pose().pose());
@@ -25,6 +26,17 @@ std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& a
     object.name = pose.name();
     object.pose = *isometry;
     object.visible_markers = static_cast<int>(pose.points_used());
+    // An estimate's velocity counts once measured: its covariance not all zeros ("unknown",
+    // as the per-frame pose estimator leaves it) and its standard deviation below 0.5 m/s (a
+    // track just started has the tracker's initial 2 m/s).
+    const auto& c = pose.velocity_covariance();
+    const double variance = c[0] + c[7] + c[14];
+    if (truth || (variance > 0 && variance < 3 * 0.5 * 0.5)) {
+      const auto& v = pose.velocity().linear();
+      const auto& w = pose.velocity().angular();
+      object.linear_velocity = Eigen::Vector3d(v.x(), v.y(), v.z());
+      object.angular_velocity = Eigen::Vector3d(w.x(), w.y(), w.z());
+    }
     out.push_back(std::move(object));
   }
   return out;
@@ -69,7 +81,7 @@ class PoseEvaluatorComponent final : public Component {
           // stop_after_frames frames however long the stop takes.
           if (stopping_) return;
           ++truth_arrays_;
-          evaluator_.add_truth(to_nanoseconds(truth.header().stamp()), objects(truth));
+          evaluator_.add_truth(to_nanoseconds(truth.header().stamp()), objects(truth, true));
           check_done();
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
@@ -77,7 +89,7 @@ class PoseEvaluatorComponent final : public Component {
           if (stopping_) return;
           latencies_s_.push_back(
               std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());
-          evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses));
+          evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses, false));
           check_done();
         });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -125,13 +137,17 @@ class PoseEvaluatorComponent final : public Component {
     };
     log().info(
         "| frames | lost | tracked | position mm (median, p95) | orientation deg "
-        "(median, p95) | false ids | latency ms (median, p99) |");
-    log().info("| {} | {} | {:.2f} % | {:.2f}, {:.2f} | {:.3f}, {:.3f} | {} | {:.2f}, {:.2f} |",
-               total.frames, total.frames_lost, total.tracked_percent(),
-               q(total.position_errors_m, 0.5) * 1e3, q(total.position_errors_m, 0.95) * 1e3,
-               q(total.orientation_errors_deg, 0.5), q(total.orientation_errors_deg, 0.95),
-               total.false_identifications, q(all_latencies_s_, 0.5) * 1e3,
-               q(all_latencies_s_, 0.99) * 1e3);
+        "(median, p95) | velocity error cm/s, deg/s (median) | false ids | latency ms (median, "
+        "p99) |");
+    log().info(
+        "| {} | {} | {:.2f} % | {:.2f}, {:.2f} | {:.3f}, {:.3f} | {:.2f}, {:.2f} | {} | {:.2f}, "
+        "{:.2f} |",
+        total.frames, total.frames_lost, total.tracked_percent(),
+        q(total.position_errors_m, 0.5) * 1e3, q(total.position_errors_m, 0.95) * 1e3,
+        q(total.orientation_errors_deg, 0.5), q(total.orientation_errors_deg, 0.95),
+        q(total.velocity_errors_mps, 0.5) * 100, q(total.angular_velocity_errors_dps, 0.5),
+        total.false_identifications, q(all_latencies_s_, 0.5) * 1e3,
+        q(all_latencies_s_, 0.99) * 1e3);
     if (summary_file_.empty()) return;
     std::ofstream out(summary_file_);
     out << "frames: " << total.frames << "\nframes_lost: " << total.frames_lost
@@ -141,6 +157,9 @@ class PoseEvaluatorComponent final : public Component {
         << "\nposition_error_p95_m: " << q(total.position_errors_m, 0.95)
         << "\norientation_error_median_deg: " << q(total.orientation_errors_deg, 0.5)
         << "\norientation_error_p95_deg: " << q(total.orientation_errors_deg, 0.95)
+        << "\nvelocity_errors: " << total.velocity_errors_mps.size()
+        << "\nvelocity_error_median_mps: " << q(total.velocity_errors_mps, 0.5)
+        << "\nangular_velocity_error_median_dps: " << q(total.angular_velocity_errors_dps, 0.5)
         << "\nlatency_median_s: " << q(all_latencies_s_, 0.5) << "\n";
     if (!out) log().error("cannot write {}", summary_file_);
   }

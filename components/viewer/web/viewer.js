@@ -488,11 +488,17 @@ function renderPoses() {
   const rows = latestPoses.poses.map((pose) => {
     const p = pose.pose.pose.position;
     const [roll, pitch, yaw] = degrees(pose.pose.pose.orientation);
+    // Speed and turn rate from the track (zero with a large covariance when just found).
+    const v = pose.velocity ? pose.velocity.linear : { x: 0, y: 0, z: 0 };
+    const w = pose.velocity ? pose.velocity.angular : { x: 0, y: 0, z: 0 };
+    const speed = Math.hypot(v.x, v.y, v.z).toFixed(2);
+    const turn = ((Math.hypot(w.x, w.y, w.z) * 180) / Math.PI).toFixed(0);
     return `<tr><td>${pose.name}</td><td>${p.x.toFixed(3)}</td><td>${p.y.toFixed(3)}</td>
       <td>${p.z.toFixed(3)}</td><td>${roll}</td><td>${pitch}</td><td>${yaw}</td>
+      <td>${speed}</td><td>${turn}</td>
       <td>${pose.points_used}</td><td>${pose.reprojection_rms_px.toFixed(2)}</td></tr>`;
   });
-  const html = rows.join("") || `<tr><td colspan="9" class="note">no constellation identified</td></tr>`;
+  const html = rows.join("") || `<tr><td colspan="11" class="note">no constellation identified</td></tr>`;
   $("poses").tBodies[0].innerHTML = html;
   state.poseReadout = $("poses").tBodies[0].textContent;
 }
