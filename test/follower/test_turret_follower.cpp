@@ -113,6 +113,39 @@ TEST(TurretFollower, AimsAtWhatItSawThenHoldsThenSearches) {
   EXPECT_EQ(follower.update(5 * kSecond, present).mode, TurretMode::Tracking);
 }
 
+TEST(TurretFollower, LeadsAMovingObjectByItsVelocity) {
+  TurretFollowerOptions options;
+  options.max_lead_s = 0.2;
+  TurretFollower follower(shipped_turret(), options);
+  const Eigen::Vector3d velocity(0.0, 1.0, 0.0);  // walking to the base's left at 1 m/s
+  auto at = [&](int64_t stamp_ns) -> Eigen::Vector3d {
+    return Eigen::Vector3d(3.0, 0.0, 1.0) + velocity * (stamp_ns * 1e-9 - 1.0);
+  };
+  // Seen every 30 ms for 0.3 s while the turret turns to follow it.
+  int64_t stamp = kSecond;
+  for (int k = 0; k <= 10; ++k, stamp += 30'000'000) {
+    const JointAngles angles{0.01 * k, 0.0};
+    follower.observe(stamp, shipped_turret().base_from_camera(angles).inverse() * at(stamp),
+                     angles);
+  }
+  const int64_t last = stamp - 30'000'000;
+  const std::optional<Eigen::Vector3d> measured = follower.velocity_in_base();
+  ASSERT_TRUE(measured.has_value());
+  EXPECT_LT((measured.value() - velocity).norm(), 1e-6);
+  // 0.1 s after its last image it is 10 cm further left: the turret aims there.
+  const JointAngles present{0.1, 0.0};
+  TurretCommand command = follower.update(last + kSecond / 10, present);
+  EXPECT_LT(shipped_turret().pointing_error(command.goal, at(last + kSecond / 10)), 1e-6);
+  EXPECT_GT(shipped_turret().pointing_error(command.goal, at(last)), kDegree);
+  // No further ahead than max_lead_s, however late the next image.
+  command = follower.update(last + kSecond / 4, present);
+  EXPECT_LT(shipped_turret().pointing_error(command.goal, at(last + kSecond / 5)), 1e-6);
+  // Found again after a loss, it has no velocity until it is measured again.
+  follower.observe(last + kSecond, shipped_turret().base_from_camera(present).inverse() * at(0),
+                   present);
+  EXPECT_FALSE(follower.velocity_in_base().has_value());
+}
+
 TEST(TurretFollower, RejectsSpeedsThatAreNotPositive) {
   TurretFollowerOptions options;
   options.pan_speed_rps = 0;

@@ -77,6 +77,11 @@ class DynamixelFollower final : public Component {
     spec.parameter("tilt_speed_rps", 1.0, "tilt speed limit, rad/s (the seed's heavy turret: 0.05)")
         .range(0.01, 11.9);
     spec.parameter("lost_after_s", 0.3, "no pose for this long: the track is lost").range(0.01, 60);
+    spec.parameter("max_lead_s", TurretFollowerOptions{}.max_lead_s,
+                   "aim at where the object's velocity (in the base frame, from its recent "
+                   "positions) has taken it since its image, at most this far ahead; 0 = where it "
+                   "was seen")
+        .range(0, 2);
     spec.parameter("hold_s", 2.0, "after losing the track, hold still this long").range(0, 3600);
     spec.parameter("search", false, "after holding, sweep the pan joint to find the object");
     spec.parameter("search_speed_rps", 0.3, "pan speed while searching, rad/s").range(0.01, 11.9);
@@ -139,6 +144,7 @@ class DynamixelFollower final : public Component {
     options.pan_speed_rps = param<double>("pan_speed_rps");
     options.tilt_speed_rps = param<double>("tilt_speed_rps");
     options.lost_after_s = param<double>("lost_after_s");
+    options.max_lead_s = param<double>("max_lead_s");
     options.hold_s = param<double>("hold_s");
     options.search = param<bool>("search");
     options.search_speed_rps = param<double>("search_speed_rps");
@@ -158,7 +164,8 @@ class DynamixelFollower final : public Component {
         ++poses_early_;  // the joints have not been read yet
         return;
       }
-      follower_.observe(stamp_ns, Eigen::Vector3d(p.x(), p.y(), p.z()), *angles);
+      const Eigen::Vector3d in_camera(p.x(), p.y(), p.z());
+      follower_.observe(stamp_ns, in_camera, *angles);
       ++poses_used_;
       return;
     }

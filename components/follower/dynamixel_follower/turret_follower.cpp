@@ -1,5 +1,6 @@
 #include "turret_follower.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -36,14 +37,42 @@ TurretFollower::TurretFollower(TurretModel turret, TurretFollowerOptions options
   require_positive(options_.tilt_speed_rps, "tilt_speed_rps");
   require_positive(options_.lost_after_s, "lost_after_s");
   require_positive(options_.search_speed_rps, "search_speed_rps");
+  require_positive(options_.velocity_window_s, "velocity_window_s");
   if (!(options_.hold_s >= 0)) throw std::invalid_argument("hold_s must not be negative");
+  if (!(options_.max_lead_s >= 0)) throw std::invalid_argument("max_lead_s must not be negative");
 }
 
 void TurretFollower::observe(int64_t stamp_ns, const Eigen::Vector3d& in_camera,
                              const JointAngles& angles) {
   if (object_in_base_ && stamp_ns < last_seen_ns_) return;  // an older image arriving late
   object_in_base_ = turret_.base_from_camera(angles) * in_camera;
+  // A track lost and found again starts its motion afresh.
+  if (!recent_.empty() && (stamp_ns - recent_.back().first) * 1e-9 > options_.lost_after_s) {
+    recent_.clear();
+  }
   last_seen_ns_ = stamp_ns;
+  recent_.emplace_back(stamp_ns, *object_in_base_);
+  const auto window_ns = static_cast<int64_t>(options_.velocity_window_s * 1e9);
+  while (stamp_ns - recent_.front().first > window_ns) recent_.pop_front();
+  velocity_in_base_.reset();
+  if (recent_.size() < 3 || (stamp_ns - recent_.front().first) * 1e-9 < 0.1) return;
+  // The least-squares line through (time, position): its slope is the velocity.
+  double mean_t = 0;
+  Eigen::Vector3d mean_p = Eigen::Vector3d::Zero();
+  for (const auto& [stamp, position] : recent_) {
+    mean_t += (stamp - stamp_ns) * 1e-9;
+    mean_p += position;
+  }
+  mean_t /= static_cast<double>(recent_.size());
+  mean_p /= static_cast<double>(recent_.size());
+  double spread = 0;
+  Eigen::Vector3d covariance = Eigen::Vector3d::Zero();
+  for (const auto& [stamp, position] : recent_) {
+    const double t = (stamp - stamp_ns) * 1e-9 - mean_t;
+    spread += t * t;
+    covariance += t * (position - mean_p);
+  }
+  velocity_in_base_ = covariance / spread;
 }
 
 TurretCommand TurretFollower::update(int64_t now_ns, const JointAngles& present) {
@@ -56,11 +85,15 @@ TurretCommand TurretFollower::update(int64_t now_ns, const JointAngles& present)
   const double since_seen_s = static_cast<double>(now_ns - last_seen_ns_) * 1e-9;
   if (since_seen_s <= options_.lost_after_s) {
     held_.reset();
-    const Aim aim = turret_.aim_at(*object_in_base_, present);
+    Eigen::Vector3d target = *object_in_base_;
+    if (velocity_in_base_) {
+      target += *velocity_in_base_ * std::clamp(since_seen_s, 0.0, options_.max_lead_s);
+    }
+    const Aim aim = turret_.aim_at(target, present);
     command.mode = TurretMode::Tracking;
     command.goal = aim.angles;
     command.out_of_reach = !aim.within_limits;
-    command.pointing_error_rad = turret_.pointing_error(present, *object_in_base_);
+    command.pointing_error_rad = turret_.pointing_error(present, target);
     return command;
   }
   if (!held_) held_ = present;

@@ -6,11 +6,17 @@
 //   TurretCommand command = follower.update(now_ns, present_angles);      // per control cycle
 //
 // The object is kept in the base frame: where it was seen, through the angles the turret had
-// at that moment (joint_history.hpp). Each cycle aims the camera at it from the present angles.
+// at that moment (joint_history.hpp). Each cycle aims the camera at it from the present angles,
+// at where it has moved since its image: its velocity in the base frame is the least-squares
+// slope of its recent positions there, so a walking person is led, not trailed. (The velocity
+// the tracker reports is in the camera frame, which turns with the turret: it holds the
+// turret's own turning, which the base frame does not.)
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <optional>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -25,6 +31,12 @@ struct TurretFollowerOptions {
   double tilt_speed_rps = 1.0;
   // No pose for this long: the track is lost.
   double lost_after_s = 0.3;
+  // A moving object is aimed at where its velocity has taken it since its image, at most this
+  // far ahead; 0 aims at where it was seen.
+  double max_lead_s = 0.2;
+  // Its velocity is measured over the positions of this last stretch of time (at least three
+  // of them, a tenth of a second apart or more).
+  double velocity_window_s = 0.25;
   // After losing the track: hold still this long, then search (when `search` is on).
   double hold_s = 2.0;
   // Searching sweeps the pan joint between its limits at search_speed_rps, tilt level.
@@ -60,6 +72,9 @@ class TurretFollower {
   // at `angles`.
   void observe(int64_t stamp_ns, const Eigen::Vector3d& in_camera, const JointAngles& angles);
 
+  // How the object moves in the base frame (m/s), once measured.
+  const std::optional<Eigen::Vector3d>& velocity_in_base() const { return velocity_in_base_; }
+
   // The command for now, the joints being at `present`.
   TurretCommand update(int64_t now_ns, const JointAngles& present);
 
@@ -72,6 +87,8 @@ class TurretFollower {
   TurretModel turret_;
   TurretFollowerOptions options_;
   std::optional<Eigen::Vector3d> object_in_base_;
+  std::optional<Eigen::Vector3d> velocity_in_base_;
+  std::deque<std::pair<int64_t, Eigen::Vector3d>> recent_;  // (stamp, base position)
   int64_t last_seen_ns_ = 0;
   std::optional<JointAngles> held_;  // where the joints stopped when the track was lost
   double search_direction_ = 1;
