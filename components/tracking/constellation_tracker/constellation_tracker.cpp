@@ -149,31 +149,32 @@ std::vector<TrackedConstellation> ConstellationTracker::update(
   std::vector<Candidate> candidates;
   follow_tracks(stamp_ns, detected, candidates, stats);
 
-  // Who holds which fiducial; a tracked board whose pose fails its check lets its go.
+  // Who holds which fiducial; a board whose pose fails its check lets its go.
   std::vector<int> owner(fiducials.size(), -1);
   auto claim = [&](size_t c) {
     for (int i : candidates[c].identified.image_point_of) {
       if (i >= 0) owner[i] = static_cast<int>(c);
     }
   };
-  for (size_t c = 0; c < candidates.size(); ++c) claim(c);
-  for (size_t c = 0; c < candidates.size(); ++c) {
-    Candidate& candidate = candidates[c];
-    candidate.rejection = verify(candidate, candidates, fiducials, owner);
-    if (candidate.rejection.empty()) continue;
-    for (int& o : owner) {
-      if (o == static_cast<int>(c)) o = -1;
+  // Candidates from `first` on claim their fiducials, then each is checked against all.
+  auto verify_from = [&](size_t first) {
+    for (size_t c = first; c < candidates.size(); ++c) claim(c);
+    for (size_t c = first; c < candidates.size(); ++c) {
+      Candidate& candidate = candidates[c];
+      candidate.rejection = verify(candidate, candidates, fiducials, owner);
+      if (candidate.rejection.empty()) continue;
+      for (int& o : owner) {
+        if (o == static_cast<int>(c)) o = -1;
+      }
     }
-  }
+  };
+  verify_from(0);
 
   std::vector<bool> claimed(fiducials.size());
   for (size_t i = 0; i < fiducials.size(); ++i) claimed[i] = owner[i] >= 0;
   const size_t tracked_count = candidates.size();
   identify_others(fiducials, claimed, candidates, stats);
-  for (size_t c = tracked_count; c < candidates.size(); ++c) {
-    claim(c);
-    candidates[c].rejection = verify(candidates[c], candidates, fiducials, owner);
-  }
+  verify_from(tracked_count);
 
   // The tracks go on with what was believed; the rest are dropped.
   std::vector<Track> next_tracks;
