@@ -41,8 +41,8 @@ std::optional<Eigen::Matrix<double, 2, 6>> image_jacobian(const calibration::Cam
   return projection * motion;
 }
 
-// Whole lines among the identified markers, with their cross-ratios measured on `ideal`
-// pixels (computed here for the lines' points only).
+// Whole lines among the identified markers, with their cross-ratios measured on the rays
+// (without the lens's distortion, as identification measures them).
 std::vector<IdentifiedLine> whole_lines(const calibration::CameraModel& camera,
                                         const ConstellationModel& model,
                                         const std::vector<int>& image_point_of,
@@ -51,20 +51,17 @@ std::vector<IdentifiedLine> whole_lines(const calibration::CameraModel& camera,
   for (size_t l = 0; l < model.lines.size(); ++l) {
     IdentifiedLine line;
     line.model_line = static_cast<int>(l);
-    std::array<Eigen::Vector2d, 4> ideal;
+    std::array<Eigen::Vector2d, 4> rays;
     bool whole = true;
     for (int k = 0; k < 4 && whole; ++k) {
       line.image_points[k] = image_point_of[model.lines[l].points[k]];
-      if (line.image_points[k] < 0) {
-        whole = false;
-        break;
-      }
-      auto ray = camera.unproject(fiducials[line.image_points[k]]);
-      if (!ray) whole = false;
-      if (ray) ideal[k] = ray->head<2>();
+      auto ray = line.image_points[k] >= 0 ? camera.unproject(fiducials[line.image_points[k]])
+                                           : std::nullopt;
+      whole = ray.has_value();
+      if (whole) rays[k] = ray->head<2>();
     }
     if (!whole) continue;
-    line.cross_ratio = constellations::cross_ratio(ideal[0], ideal[1], ideal[2], ideal[3]);
+    line.cross_ratio = constellations::cross_ratio(rays[0], rays[1], rays[2], rays[3]);
     lines.push_back(line);
   }
   return lines;
