@@ -1,6 +1,8 @@
 // The evaluator's bookkeeping and the overlay's drawing.
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
 #include <cmath>
 
 #include <mocap/calibration/pinhole_camera.hpp>
@@ -85,6 +87,19 @@ TEST(Overlay, DrawsFiducialsLinesAndAxes) {
   // No camera: no axes, the rest still drawn.
   cv::Mat without = overlay::draw_overlay(image, frame, nullptr);
   EXPECT_EQ(without.at<cv::Vec3b>(240, 345), cv::Vec3b(10, 10, 10));
+
+  // A line with its first marker hidden (NaN) runs between the markers seen, and nothing is
+  // drawn towards the image's corner.
+  const double hidden = std::nan("");
+  frame.constellations = {
+      {"board", {{"T1", {{{hidden, hidden}, {250, 400}, {300, 400}, {400, 400}}}}}}};
+  cv::Mat broken = overlay::draw_overlay(image, frame, nullptr);
+  EXPECT_GT(broken.at<cv::Vec3b>(400, 350)[1], 150);
+  EXPECT_EQ(broken.at<cv::Vec3b>(400, 220), cv::Vec3b(10, 10, 10));
+  cv::Mat green;
+  cv::inRange(broken(cv::Rect(0, 0, 200, 200)), cv::Scalar(0, 150, 0), cv::Scalar(60, 255, 60),
+              green);
+  EXPECT_EQ(cv::countNonZero(green), 0);
 }
 
 }  // namespace

@@ -31,12 +31,22 @@ cv::Mat draw_overlay(const cv::Mat& mono8, const OverlayFrame& frame,
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
     int count = 0;
     for (const auto& line : constellation.lines) {
-      cv::line(image, fixed(line.pixels[0]), fixed(line.pixels[3]), green, 1, cv::LINE_AA, kShift);
-      Eigen::Vector2d middle = (line.pixels[0] + line.pixels[3]) / 2;
+      // From its first marker seen to its last: a marker not seen (hidden, out of the
+      // picture) is NaN.
+      const Eigen::Vector2d* first = nullptr;
+      const Eigen::Vector2d* last = nullptr;
+      for (const auto& p : line.pixels) {
+        if (!p.allFinite()) continue;
+        if (first == nullptr) first = &p;
+        last = &p;
+        centre += p;
+        ++count;
+      }
+      if (first == nullptr || first == last) continue;
+      cv::line(image, fixed(*first), fixed(*last), green, 1, cv::LINE_AA, kShift);
+      const Eigen::Vector2d middle = (*first + *last) / 2;
       cv::putText(image, line.name, to_cv(middle + Eigen::Vector2d(4, -4)),
                   cv::FONT_HERSHEY_SIMPLEX, 0.4, green, 1, cv::LINE_AA);
-      for (const auto& p : line.pixels) centre += p;
-      count += 4;
     }
     if (count > 0) {
       cv::putText(image, constellation.name, to_cv(centre / count), cv::FONT_HERSHEY_SIMPLEX, 0.6,

@@ -280,7 +280,8 @@ function drawCamera() {
     let sy = 0;
     let n = 0;
     for (const sub of c.sub_constellations) {
-      const points = sub.fiducial_array.fiducials;
+      // A marker not seen (hidden, out of the picture) is NaN: the line joins the seen ones.
+      const points = sub.fiducial_array.fiducials.filter((p) => Number.isFinite(p.x) && Number.isFinite(p.y));
       if (points.length < 2) continue;
       cameraContext.beginPath();
       cameraContext.moveTo(points[0].x, points[0].y);
