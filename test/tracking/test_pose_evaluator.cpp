@@ -1,11 +1,10 @@
 // The evaluator's bookkeeping and the overlay's drawing.
 #include <gtest/gtest.h>
 
-#include <opencv2/core.hpp>
-
 #include <cmath>
 
 #include <mocap/calibration/pinhole_camera.hpp>
+#include <opencv2/core.hpp>
 
 #include "overlay_drawing.hpp"
 #include "pose_evaluation.hpp"
