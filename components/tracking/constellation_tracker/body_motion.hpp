@@ -1,5 +1,5 @@
 // How a tracked body moves between frames: a Kalman filter on SE(3) with a constant-velocity
-// model (the seed's §7.3.2 and §7.4.3 proposal of keeping what was known between frames).
+// model, so that what was known in one frame tells where to look in the next.
 //
 //   BodyMotionFilter motion(first_pose, first_covariance, stamp_ns);
 //   BodyState at_next_frame = motion.predicted(next_stamp_ns);  // where to look for it

@@ -1,6 +1,6 @@
 // Which of a body's markers the camera should see at a pose, and whether the ones it does not
-// see can be hidden: what the tracker checks before it believes a pose (the seed's §7.3.2
-// check, made to hold markers that are missing as well as the ones found).
+// see can be hidden: what the tracker checks before it believes a pose (the reprojection check
+// of the pose estimator, made to hold the markers that are missing as well as the ones found).
 #pragma once
 
 #include <vector>
