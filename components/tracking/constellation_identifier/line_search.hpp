@@ -5,8 +5,10 @@
 // The seed tried every pair of points as a line and tested every other point against it,
 // keeping each hit: O(n³) tests, each line found once per pair of its points, and 6 Hz at 38
 // points (Table A.3). Here a pair is kept only when it spans its group (no inlier lies
-// beyond either end), so each group is reported once, and the test loop stops at the first
-// point beyond an end; see bench/tracking_pipeline_bench for the figures.
+// beyond either end), so each group is reported once. Most pairs have no point between them:
+// those between a pair lie in its bounding box, so the pair first counts its neighbours along
+// the box's narrower axis (sorted once, four at a time), and only a pair with enough points
+// between them gets the full test; see bench/tracking_pipeline_bench for the figures.
 #pragma once
 
 #include <vector>
