@@ -117,6 +117,7 @@ struct ConstellationTracker::Candidate {
   pose::PlanarPose pose;
   std::vector<MarkerImage> images;  // every marker at the pose
   std::string rejection;            // why not believed; empty when it is
+  bool relocked = false;            // found by an image shift: its motion starts afresh
 };
 
 ConstellationTracker::ConstellationTracker(const constellations::ConstellationDatabase& database,
@@ -185,7 +186,13 @@ std::vector<TrackedConstellation> ConstellationTracker::update(
     const Matrix6d measured = measurement_covariance(candidate.pose);
     if (candidate.track >= 0) {
       Track track = std::move(tracks_[candidate.track]);
-      track.motion.correct(stamp_ns, candidate.pose.camera_from_object, measured);
+      if (candidate.relocked) {
+        track.motion = BodyMotionFilter(candidate.pose.camera_from_object, measured, stamp_ns,
+                                        options_.motion);
+        ++stats.relocked;
+      } else {
+        track.motion.correct(stamp_ns, candidate.pose.camera_from_object, measured);
+      }
       ++track.frames;
       next_tracks.push_back(std::move(track));
       ++stats.tracked;
@@ -231,6 +238,10 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
   for (size_t t = 0; t < tracks_.size(); ++t) {
     predicted[t] = tracks_[t].motion.predicted(stamp_ns);
   }
+  // A track whose velocity is not measured yet (one frame old, or restarted) predicts loosely:
+  // its pattern shifted by a marker's spacing can lie nearer the prediction than the true one.
+  // Its gated association is therefore weighed against the picture's shift (relock), below.
+  auto settled = [&](size_t t) { return tracks_[t].motion.corrections() > 1; };
   for (size_t t = 0; t < tracks_.size(); ++t) {
     const Eigen::Isometry3d& pose = predicted[t].camera_from_body;
     const Matrix6d pose_covariance = predicted[t].pose_covariance();
@@ -263,59 +274,68 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
   for (size_t t = 0; t < tracks_.size(); ++t) {
     image_point_of[t].assign(tracks_[t].model->points.size(), -1);
   }
+  std::vector<int> track_of_fiducial(fiducials.size(), -1);
   for (size_t p = 0; p < predictions.size(); ++p) {
     image_point_of[predicted_marker[p].first][predicted_marker[p].second] = fiducial_of[p];
+    if (fiducial_of[p] >= 0) track_of_fiducial[fiducial_of[p]] = predicted_marker[p].first;
   }
-  pose::PlanarPoseOptions pose_options = options_.pose;
-  pose_options.min_points = options_.min_tracked_markers;
+  // The markers found again by the picture's shift, and the pose they give.
+  auto find_shifted = [&](size_t t, pose::PlanarPose& pose_out, std::vector<int>& image_of) {
+    std::vector<bool> taken(fiducials.size());
+    for (size_t i = 0; i < fiducials.size(); ++i) {
+      taken[i] = track_of_fiducial[i] >= 0 && track_of_fiducial[i] != static_cast<int>(t);
+    }
+    const ConstellationModel& model = *tracks_[t].model;
+    const auto images =
+        marker_images(*camera_, model, predicted[t].camera_from_body, options_.visibility);
+    auto found = relock(model, images, fiducials, taken);
+    if (!found) return false;
+    pose::PlanarPoseOptions relock_options = options_.pose;
+    relock_options.min_points = options_.relock_min_markers;
+    IdentifiedConstellation shifted;
+    shifted.model = &model;
+    shifted.image_point_of = *found;
+    pose::PlanarPose pose = pose::estimate_planar_pose(
+        *camera_, marker_points(shifted), marker_pixels(shifted, fiducials), relock_options);
+    if (!pose.valid) return false;
+    pose_out = pose;
+    image_of = *found;
+    return true;
+  };
   for (size_t t = 0; t < tracks_.size(); ++t) {
     const ConstellationModel& model = *tracks_[t].model;
     std::vector<int>& image_of = image_point_of[t];
-    const std::vector<bool> in_fit =
-        whole_markers(model, predicted[t].camera_from_body, image_of, detected);
     Candidate candidate;
     candidate.model = &model;
     candidate.track = static_cast<int>(t);
-    // Fit, then take out the worst marker while one is further than the bound from its
-    // reprojection (a distractor taken for a hidden marker), and fit again.
-    while (true) {
-      std::vector<Eigen::Vector3d> object;
-      std::vector<Eigen::Vector2d> image;
-      std::vector<int> marker_of_pair;
-      for (size_t m = 0; m < image_of.size(); ++m) {
-        if (image_of[m] < 0 || !in_fit[m]) continue;
-        object.push_back(model.points[m]);
-        image.push_back(fiducials[image_of[m]]);
-        marker_of_pair.push_back(static_cast<int>(m));
-      }
-      if (static_cast<int>(object.size()) < options_.min_tracked_markers) {
-        candidate.pose = {};
-        candidate.pose.rejection = fmt::format("{} markers associated, {} needed", object.size(),
-                                               options_.min_tracked_markers);
-        break;
-      }
-      candidate.pose = pose::refine_planar_pose(*camera_, predicted[t].camera_from_body, object,
-                                                image, pose_options);
-      if (candidate.pose.points_used != static_cast<int>(object.size())) break;
-      int worst = -1;
-      double worst_error = options_.max_marker_error_px;
-      for (size_t k = 0; k < object.size(); ++k) {
-        auto at = camera_->project(candidate.pose.camera_from_object * object[k]);
-        const double error = at ? (*at - image[k]).norm() : std::numeric_limits<double>::infinity();
-        if (error > worst_error) {
-          worst_error = error;
-          worst = marker_of_pair[k];
-        }
-      }
-      if (worst < 0) break;
-      image_of[worst] = -1;
-    }
+    fit_associated(t, predicted[t], detected, image_of, candidate.pose);
     if (candidate.pose.valid &&
         tracks_[t].motion.surprise(stamp_ns, candidate.pose.camera_from_object,
                                    measurement_covariance(candidate.pose)) >
             options_.max_motion_surprise) {
       candidate.pose.valid = false;
       candidate.pose.rejection = "it moved further than its motion allows";
+    }
+    if (!candidate.pose.valid) {
+      // Lost by its prediction: the picture may have moved as a whole.
+      candidate.relocked = find_shifted(t, candidate.pose, image_of) && settled(t);
+    } else if (!settled(t)) {
+      // A loose prediction: the shift's markers win when they are more, or as many and fit
+      // better.
+      pose::PlanarPose shifted;
+      std::vector<int> shifted_image_of;
+      if (find_shifted(t, shifted, shifted_image_of) &&
+          (shifted.points_used > candidate.pose.points_used ||
+           (shifted.points_used == candidate.pose.points_used &&
+            shifted.reprojection_rms_px < candidate.pose.reprojection_rms_px))) {
+        candidate.pose = shifted;
+        image_of = shifted_image_of;
+      }
+    }
+    if (candidate.pose.valid) {
+      for (int i : image_of) {
+        if (i >= 0) track_of_fiducial[i] = static_cast<int>(t);
+      }
     }
     if (!candidate.pose.valid) {
       ++stats.lost;
@@ -328,6 +348,74 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
         marker_images(*camera_, model, candidate.pose.camera_from_object, options_.visibility);
     candidates.push_back(std::move(candidate));
   }
+}
+
+std::optional<std::vector<int>> ConstellationTracker::relock(
+    const ConstellationModel& model, const std::vector<MarkerImage>& images,
+    const std::vector<Eigen::Vector2d>& fiducials, const std::vector<bool>& taken) const {
+  // Every (marker, free fiducial) pair within reach names a shift; the shift most markers agree
+  // on (within the association's tolerance) is the picture's movement.
+  constexpr double kAgreementPx = 2.5;
+  struct Shift {
+    Eigen::Vector2d offset;
+    int marker, fiducial;
+  };
+  std::vector<Shift> shifts;
+  const double reach2 = options_.relock_radius_px * options_.relock_radius_px;
+  for (size_t m = 0; m < images.size(); ++m) {
+    if (images[m].sight != MarkerSight::InView) continue;
+    for (size_t i = 0; i < fiducials.size(); ++i) {
+      if (taken[i] || !fiducials[i].allFinite()) continue;
+      const Eigen::Vector2d offset = fiducials[i] - images[m].pixel;
+      if (offset.squaredNorm() <= reach2) {
+        shifts.push_back({offset, static_cast<int>(m), static_cast<int>(i)});
+      }
+    }
+  }
+  std::optional<Eigen::Vector2d> best;
+  int best_support = options_.relock_min_markers - 1;
+  std::vector<bool> marker_counted(images.size());
+  for (const Shift& candidate : shifts) {
+    std::fill(marker_counted.begin(), marker_counted.end(), false);
+    int support = 0;
+    for (const Shift& other : shifts) {
+      if (marker_counted[other.marker] ||
+          (other.offset - candidate.offset).squaredNorm() > kAgreementPx * kAgreementPx) {
+        continue;
+      }
+      marker_counted[other.marker] = true;
+      ++support;
+    }
+    if (support > best_support) {
+      best_support = support;
+      best = candidate.offset;
+    }
+  }
+  if (!best) return std::nullopt;
+  // Each marker, shifted, takes the nearest free fiducial within the tolerance.
+  std::vector<int> image_of(model.points.size(), -1);
+  std::vector<bool> used = taken;
+  int found = 0;
+  for (size_t m = 0; m < images.size(); ++m) {
+    if (images[m].sight != MarkerSight::InView) continue;
+    const Eigen::Vector2d at = images[m].pixel + *best;
+    int nearest = -1;
+    double nearest_distance = kAgreementPx;
+    for (size_t i = 0; i < fiducials.size(); ++i) {
+      if (used[i] || !fiducials[i].allFinite()) continue;
+      const double distance = (fiducials[i] - at).norm();
+      if (distance <= nearest_distance) {
+        nearest = static_cast<int>(i);
+        nearest_distance = distance;
+      }
+    }
+    if (nearest < 0) continue;
+    image_of[m] = nearest;
+    used[nearest] = true;
+    ++found;
+  }
+  if (found < options_.relock_min_markers) return std::nullopt;
+  return image_of;
 }
 
 std::vector<bool> ConstellationTracker::whole_markers(
@@ -358,6 +446,51 @@ std::vector<bool> ConstellationTracker::whole_markers(
     }
   }
   return whole;
+}
+
+void ConstellationTracker::fit_associated(size_t t, const BodyState& predicted,
+                                          const std::vector<ImageFiducial>& detected,
+                                          std::vector<int>& image_of,
+                                          pose::PlanarPose& pose) const {
+  const ConstellationModel& model = *tracks_[t].model;
+  const std::vector<Eigen::Vector2d>& fiducials = pixels_;
+  const std::vector<bool> in_fit =
+      whole_markers(model, predicted.camera_from_body, image_of, detected);
+  pose::PlanarPoseOptions options = options_.pose;
+  options.min_points = options_.min_tracked_markers;
+  // Fit, then take out the worst marker while one is further than the bound from its
+  // reprojection (a distractor taken for a hidden marker), and fit again.
+  while (true) {
+    std::vector<Eigen::Vector3d> object;
+    std::vector<Eigen::Vector2d> image;
+    std::vector<int> marker_of_pair;
+    for (size_t m = 0; m < image_of.size(); ++m) {
+      if (image_of[m] < 0 || !in_fit[m]) continue;
+      object.push_back(model.points[m]);
+      image.push_back(fiducials[image_of[m]]);
+      marker_of_pair.push_back(static_cast<int>(m));
+    }
+    if (static_cast<int>(object.size()) < options_.min_tracked_markers) {
+      pose = {};
+      pose.rejection = fmt::format("{} markers associated, {} needed", object.size(),
+                                   options_.min_tracked_markers);
+      return;
+    }
+    pose = pose::refine_planar_pose(*camera_, predicted.camera_from_body, object, image, options);
+    if (pose.points_used != static_cast<int>(object.size())) return;
+    int worst = -1;
+    double worst_error = options_.max_marker_error_px;
+    for (size_t k = 0; k < object.size(); ++k) {
+      auto at = camera_->project(pose.camera_from_object * object[k]);
+      const double error = at ? (*at - image[k]).norm() : std::numeric_limits<double>::infinity();
+      if (error > worst_error) {
+        worst_error = error;
+        worst = marker_of_pair[k];
+      }
+    }
+    if (worst < 0) return;
+    image_of[worst] = -1;
+  }
 }
 
 void ConstellationTracker::identify_others(const std::vector<Eigen::Vector2d>& fiducials,

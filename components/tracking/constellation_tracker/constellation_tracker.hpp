@@ -66,6 +66,13 @@ struct TrackerOptions {
   double max_motion_surprise = 40.0;
   // Fewest associated markers for a tracked board's pose: four fix a plane's pose.
   int min_tracked_markers = 4;
+  // A tracked board its prediction loses (a camera on a turret that starts or stops turning
+  // moves the whole picture by tens of pixels between frames, which no motion of the board
+  // foretells) is looked for again shifted: the one image shift, within this radius, that puts
+  // at least relock_min_markers of its markers on free fiducials. Its velocity starts afresh;
+  // the track goes on.
+  double relock_radius_px = 120.0;
+  int relock_min_markers = 6;
   // After the fit, an associated marker further than this from its reprojection is taken out
   // and the pose fitted again without it (a distractor next to a hidden marker).
   double max_marker_error_px = 2.5;
@@ -111,6 +118,7 @@ struct TrackedConstellation {
 // What became of one frame, for logs and benchmarks.
 struct TrackerStats {
   int tracked = 0;                      // boards followed from the previous frame
+  int relocked = 0;                     //   of them, found again by an image shift
   int identified = 0;                   // boards found by full identification
   int from_one_line = 0;                //   of them, from one line and loose markers
   int lost = 0;                         // tracked boards with too few markers associated
@@ -149,6 +157,17 @@ class ConstellationTracker {
 
   void follow_tracks(int64_t stamp_ns, const std::vector<ImageFiducial>& fiducials,
                      std::vector<Candidate>& candidates, TrackerStats& stats);
+  // The pose of track t from the fiducials associated with its markers (`image_of`, a marker
+  // left out when its fit shows it is not the marker's), refined from the prediction.
+  void fit_associated(size_t t, const BodyState& predicted,
+                      const std::vector<ImageFiducial>& detected, std::vector<int>& image_of,
+                      pose::PlanarPose& pose) const;
+  // The markers of a tracked board predicted at `pose` (in view, at `images`), found again on
+  // fiducials not `taken` by an image shift; the fiducial of each marker, or nothing.
+  std::optional<std::vector<int>> relock(const constellations::ConstellationModel& model,
+                                         const std::vector<MarkerImage>& images,
+                                         const std::vector<Eigen::Vector2d>& fiducials,
+                                         const std::vector<bool>& taken) const;
   // Per marker: whether its fiducial looks whole (not cut by an occluder, not merged) by its
   // size, judged at `pose`.
   std::vector<bool> whole_markers(const constellations::ConstellationModel& model,

@@ -105,10 +105,10 @@ class ConstellationTrackerComponent final : public Component {
 
   ~ConstellationTrackerComponent() override {
     log().info(
-        "{} arrays: {} poses ({} tracked, {} identified, {} of them from one line), {} not "
-        "believed, {} tracks lost",
-        arrays_, totals_.tracked + totals_.identified, totals_.tracked, totals_.identified,
-        totals_.from_one_line, totals_.rejected, totals_.lost);
+        "{} arrays: {} poses ({} tracked, {} of them found again by the picture's shift; {} "
+        "identified, {} of them from one line), {} not believed, {} tracks lost",
+        arrays_, totals_.tracked + totals_.identified, totals_.tracked, totals_.relocked,
+        totals_.identified, totals_.from_one_line, totals_.rejected, totals_.lost);
   }
 
  private:
@@ -122,6 +122,7 @@ class ConstellationTrackerComponent final : public Component {
     TrackerStats stats;
     const auto found = tracker_->update(to_nanoseconds(array.header().stamp()), fiducials_, &stats);
     totals_.tracked += stats.tracked;
+    totals_.relocked += stats.relocked;
     totals_.identified += stats.identified;
     totals_.from_one_line += stats.from_one_line;
     totals_.rejected += stats.rejected;
