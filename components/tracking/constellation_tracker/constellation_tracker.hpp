@@ -121,7 +121,7 @@ struct TrackerStats {
   int relocked = 0;                     //   of them, found again by an image shift
   int identified = 0;                   // boards found by full identification
   int from_one_line = 0;                //   of them, from one line and loose markers
-  int lost = 0;                         // tracked boards with too few markers associated
+  int lost = 0;                         // tracked boards not found again (too few markers)
   int rejected = 0;                     // boards whose pose could not be verified
   std::vector<std::string> rejections;  // "name: why", for the rejected and the lost
   bool identification_ran = false;      // some boards were not tracked
