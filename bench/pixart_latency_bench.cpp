@@ -52,7 +52,8 @@ int64_t steady_ns() {
 }
 
 // The clock the runtime stamps with (mocap::Clock): the bridge stamps each frame with it when
-// it reads the frame, and the localizer stamps its arrays with those stamps.
+// it reads the frame (the frames here carry no adaptor timestamps), and the localizer stamps
+// its arrays with those stamps.
 int64_t clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
       .count();
@@ -220,8 +221,10 @@ class Adaptor {
   // Sends `frames` to the bridge; returns the times taken just before the first byte went out.
   Write write(const std::vector<can::CanFrame>& frames) {
     std::string bytes;
-    for (const can::CanFrame& frame : frames) bytes += adaptor_.frame_message(frame, clock_ns());
-    // mocap::Clock first: the bridge's stamp, taken after it reads, cannot be earlier.
+    // Without the adaptor's timestamps, which the bridge asks for: their milliseconds would
+    // put a sample's stamp before its write. The bridge stamps each frame when it reads it, so
+    // a stamp taken after the write's mocap::Clock time cannot be earlier.
+    for (const can::CanFrame& frame : frames) bytes += can::encode_slcan(frame);
     Write write;
     write.clock_ns = clock_ns();
     write.steady_ns = steady_ns();

@@ -385,10 +385,10 @@ Steady::time_point start_box(ComponentHost& host, PluginLoader& loader, const st
 constexpr auto kToolStart = std::chrono::milliseconds(300);
 
 // The data file of a live recording against the board's true projections: 1 to `max_shots`
-// shots per camera. Live frames are stamped when read, so a starved CPU (the box or the tool
-// descheduled for tens of milliseconds) can split a blink: a cycle lost, or a short blink's
-// mean a little off. The log test above holds the points to 0.5 px; here a point in the wrong
-// LED's place (tens of pixels) is what must fail.
+// shots per camera. Live frames carry the adaptor's timestamps, so a tool descheduled for tens
+// of milliseconds splits no blink; a box descheduled for longer than it catches up on (0.1 s)
+// still can: a cycle lost, or a short blink's mean a little off. The log test above holds the
+// points to 0.5 px; here a point in the wrong LED's place (tens of pixels) is what must fail.
 void check_live_recording(const test::TempDir& dir, const std::string& output, size_t max_shots,
                           RecordedShots& recorded) {
   const pixart::Rig rig = ceiling_rig();

@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <random>
@@ -15,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "adaptor_clock.hpp"
 #include "can_frame.hpp"
 #include "candump_log.hpp"
 #include "serial_port.hpp"
@@ -170,13 +173,13 @@ TEST(SlcanEncode, RefusesInvalidFrames) {
 }
 
 TEST(SlcanCommands, OpenClosesSetsTheBitrateAndOpens) {
-  EXPECT_EQ(slcan_open_commands(500000), (std::vector<std::string>{"C\r", "S6\r", "O\r"}));
+  EXPECT_EQ(slcan_open_commands(500000), (std::vector<std::string>{"C\r", "S6\r", "Z1\r", "O\r"}));
   const std::vector<std::pair<int, std::string>> table = {
       {10000, "S0\r"},  {20000, "S1\r"},  {50000, "S2\r"},  {100000, "S3\r"}, {125000, "S4\r"},
       {250000, "S5\r"}, {500000, "S6\r"}, {800000, "S7\r"}, {1000000, "S8\r"}};
   for (const auto& [bitrate, command] : table) {
     const std::vector<std::string> commands = slcan_open_commands(bitrate);
-    ASSERT_EQ(commands.size(), 3u) << bitrate;
+    ASSERT_EQ(commands.size(), 4u) << bitrate;
     EXPECT_EQ(commands[1], command) << bitrate;
   }
   EXPECT_EQ(slcan_close_command(), "C\r");
@@ -225,6 +228,83 @@ TEST(SlcanParser, AcceptsLowercaseHexAndAdaptorTimestamps) {
             (std::vector<CanFrame>{make_frame(0x1AB, {0xBE, 0xEF}), make_frame(0x123, {0xDE, 0xAD}),
                                    make_frame(0x1, {}, true), make_remote(0x123, 2)}));
   EXPECT_EQ(parser.stats().errors, 0u) << parser.last_error();
+}
+
+// Frames the adaptor stamped are stamped when it received them, not when they were read.
+TEST(SlcanParser, StampsFramesWithTheAdaptorsTimeOnTheHostsClock) {
+  SlcanParser parser;
+  parser.feed("t1232DEAD0010\r", 1'000'000'000);  // received at 16 ms, read at once
+  // Two frames 4 and 8 ms later, read together 50 ms late.
+  parser.feed("t1232DEAD0014\rt1232DEAD0018\r", 1'058'000'000);
+  parser.feed("t1232DEAD\r", 1'060'000'000);  // no timestamp: when read
+  const std::vector<CanFrame> frames = parser.take_frames();
+  ASSERT_EQ(frames.size(), 4u);
+  // 4 and 8 ms after the first, give or take the drift AdaptorClock allows over 58 ms.
+  const double drift_ns = 58e6 * AdaptorClock::kMaxDrift;
+  EXPECT_EQ(frames[0].stamp_ns, 1'000'000'000);
+  EXPECT_NEAR(static_cast<double>(frames[1].stamp_ns), 1'004'000'000, drift_ns);
+  EXPECT_NEAR(static_cast<double>(frames[2].stamp_ns), 1'008'000'000, drift_ns);
+  EXPECT_EQ(frames[3].stamp_ns, 1'060'000'000);
+}
+
+// --- the adaptor's clock ---------------------------------------------------------------------
+
+constexpr int64_t kMs = 1'000'000;
+
+// A frame every 4 ms, read after delays of 0.2 to 60 ms, in bursts: every stamp is the frame's
+// time on the adaptor plus the offset of the quickest read so far.
+TEST(AdaptorClock, TheQuickestReadSetsTheOffsetAndDelaysDoNotShowInTheStamps) {
+  AdaptorClock clock;
+  std::mt19937 generator(3);
+  const int64_t host_minus_adaptor = 1'700'000'000'000'000'000 - 59'000 * kMs;
+  int64_t least_delay = std::numeric_limits<int64_t>::max();
+  int64_t read_ns = 0;
+  for (int k = 0; k < 1000; ++k) {  // 4 s from adaptor time 59 s: through the minute's wrap
+    const int64_t adaptor_ns = (59'000 + 4 * k) * kMs;
+    const auto adaptor_ms = static_cast<uint32_t>((adaptor_ns / kMs) % 60'000);
+    // The delay of a burst's first frame; the rest are read with it.
+    if (k % 10 == 0) {
+      const int64_t delay = 200'000 + static_cast<int64_t>(generator() % 60'000'000);
+      read_ns = std::max(read_ns, host_minus_adaptor + adaptor_ns + delay);
+    }
+    read_ns = std::max(read_ns, host_minus_adaptor + adaptor_ns + 200'000);
+    least_delay = std::min(least_delay, read_ns - host_minus_adaptor - adaptor_ns);
+    const int64_t stamp = clock.host_time(adaptor_ms, read_ns);
+    EXPECT_LE(stamp, read_ns) << k;
+    // The offset may have risen by the allowed drift since the quickest read (at most 4 s).
+    EXPECT_NEAR(static_cast<double>(stamp - host_minus_adaptor - adaptor_ns),
+                static_cast<double>(least_delay), 4e9 * AdaptorClock::kMaxDrift)
+        << k;
+  }
+}
+
+TEST(AdaptorClock, FollowsAnAdaptorClockSlowerThanTheHosts) {
+  AdaptorClock clock;
+  constexpr double kSlow = 500e-6;   // the adaptor counts 0.9995 s per host second
+  for (int k = 0; k <= 2000; ++k) {  // 20 s, a frame every 10 ms, each read 1 ms after it
+    const int64_t host_ns = 10 * k * kMs;
+    const auto adaptor_ms =
+        static_cast<uint32_t>(std::floor(static_cast<double>(host_ns) * (1 - kSlow) / kMs));
+    const int64_t stamp = clock.host_time(adaptor_ms % 60'000, host_ns + kMs);
+    EXPECT_LE(stamp, host_ns + kMs);
+    EXPECT_GT(stamp, host_ns - 2 * kMs) << k;  // the millisecond step and the read delay
+  }
+}
+
+TEST(AdaptorClock, StartsAfreshAfterASilenceOrAnUnbelievableStamp) {
+  AdaptorClock clock;
+  EXPECT_EQ(clock.host_time(100, 5'000 * kMs), 5'000 * kMs);
+  // 4 ms later on the adaptor, read 6 ms late: 4 ms later (give or take the drift allowed).
+  EXPECT_NEAR(clock.host_time(104, 5'010 * kMs), 5'004 * kMs, 10 * kMs * AdaptorClock::kMaxDrift);
+  // 40 s of silence: the minutes cannot be counted; the frame is stamped when read.
+  EXPECT_EQ(clock.host_time(50'000, 45'010 * kMs), 45'010 * kMs);
+  EXPECT_EQ(clock.host_time(50'010, 45'020 * kMs), 45'020 * kMs);
+  // A frozen adaptor clock: stamps fall behind the reads by at most kMaxDelay_ns.
+  for (int64_t read = 45'030; read < 47'000; read += 10) {
+    const int64_t stamp = clock.host_time(50'010, read * kMs);
+    EXPECT_LE(stamp, read * kMs);
+    EXPECT_GE(stamp, read * kMs - AdaptorClock::kMaxDelay_ns) << read;
+  }
 }
 
 TEST(SlcanParser, FramesSplitAcrossReadsComeOutTheSame) {
@@ -704,10 +784,10 @@ TEST(SerialPort, CarriesAnSlcanSessionBothWays) {
     port.write_all(command);
     commands += command;
   }
-  EXPECT_EQ(read_bytes(adaptor, commands.size()), "C\rS8\rO\r");
+  EXPECT_EQ(read_bytes(adaptor, commands.size()), "C\rS8\rZ1\rO\r");
 
   const std::vector<CanFrame> frames = random_frames(200, 23);
-  const std::string stream = "\r\r\r" + encode_all(frames);  // the replies, then traffic
+  const std::string stream = "\r\r\r\r" + encode_all(frames);  // the replies, then traffic
   std::mt19937 generator(29);
   for (size_t position = 0; position < stream.size();) {
     const size_t chunk = std::min<size_t>(1 + generator() % 100, stream.size() - position);
@@ -723,7 +803,7 @@ TEST(SerialPort, CarriesAnSlcanSessionBothWays) {
     for (const CanFrame& frame : parser.take_frames()) decoded.push_back(frame);
   }
   EXPECT_EQ(decoded, with_stamp(frames, 5));
-  EXPECT_EQ(parser.stats().replies, 3u);
+  EXPECT_EQ(parser.stats().replies, 4u);
   EXPECT_EQ(parser.stats().errors, 0u) << parser.last_error();
 }
 

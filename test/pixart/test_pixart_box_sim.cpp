@@ -554,7 +554,8 @@ TEST(SimulatedSlcanAdaptor, AnswersTheBridgesCommands) {
   std::string commands;
   for (const std::string& c : can::slcan_open_commands(1000000)) commands += c;
   EXPECT_EQ(adaptor.feed(commands.substr(0, 3)), "\r");
-  EXPECT_EQ(adaptor.feed(commands.substr(3)), "\r\r");
+  EXPECT_EQ(adaptor.feed(commands.substr(3)), "\r\r\r");
+  EXPECT_TRUE(adaptor.timestamps());
   EXPECT_TRUE(adaptor.is_open());
   EXPECT_EQ(adaptor.bitrate(), 1000000);
   EXPECT_EQ(adaptor.feed("S6\r"), "\a");  // not while open

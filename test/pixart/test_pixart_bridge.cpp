@@ -98,7 +98,7 @@ TEST(PixartBridge, SlcanFramesBecomeFiducialsAndTheAdaptorMayBeUnplugged) {
     size_t n = adaptor->read(buffer, sizeof buffer, std::chrono::milliseconds(100));
     commands.append(buffer, n);
   }
-  EXPECT_EQ(commands, "C\rS8\rO\r");
+  EXPECT_EQ(commands, "C\rS8\rZ1\rO\r");
 
   // Frames split at every byte boundary, garbage and an error bell among them.
   std::string stream = sample_of_camera_1(0) + "tZZZ\r\a" + sample_of_camera_1(1);
@@ -126,7 +126,7 @@ TEST(PixartBridge, SlcanFramesBecomeFiducialsAndTheAdaptorMayBeUnplugged) {
     size_t n = adaptor->read(buffer, sizeof buffer, std::chrono::milliseconds(100));
     commands.append(buffer, n);
   }
-  EXPECT_NE(commands.find("S8\rO\r"), std::string::npos) << commands;
+  EXPECT_NE(commands.find("S8\rZ1\rO\r"), std::string::npos) << commands;
   adaptor->write_all(sample_of_camera_1(2));
   ASSERT_TRUE(collector.wait_for(3, std::chrono::seconds(10)));
   {

@@ -22,9 +22,10 @@ class CanSource {
  public:
   virtual ~CanSource() = default;
   // The frames that arrive within `timeout` (none on a quiet bus), stamped with the time they
-  // were read; a log's frames keep their recorded stamps, as rosbag2 replays keep theirs, so
-  // a replay at any pace localizes as the live run did and pairs with what was recorded
-  // beside it (the simulator's ground truth). Throws CanSourceError when the device is gone.
+  // were read, or received if an SLCAN adaptor stamps them (AdaptorClock); a log's frames keep
+  // their recorded stamps, as rosbag2 replays keep theirs, so a replay at any pace localizes as the
+  // live run did and pairs with what was recorded beside it (the simulator's ground truth). Throws
+  // CanSourceError when the device is gone.
   virtual std::vector<CanFrame> read(std::chrono::milliseconds timeout) = 0;
   // A log that has been replayed to its end; live sources never finish.
   virtual bool finished() const { return false; }
@@ -39,9 +40,10 @@ struct SlcanSourceOptions {
   int bitrate = 1000000;  // of the CAN bus
   int baud = 115200;      // of the serial line (USB adaptors ignore it)
 };
-// Opens the device and the CAN channel (close, set the bitrate, open), and closes the channel
-// again when destroyed, so no `slcand` or set-up script is needed. Throws CanSourceError
-// when the device cannot be opened, std::invalid_argument for an unsupported bitrate or baud.
+// Opens the device and the CAN channel (close, set the bitrate, ask for timestamps, open: see
+// slcan_open_commands), and closes the channel again when destroyed, so no `slcand` or set-up
+// script is needed. Throws CanSourceError when the device cannot be opened,
+// std::invalid_argument for an unsupported bitrate or baud.
 std::unique_ptr<CanSource> open_slcan(const SlcanSourceOptions& options);
 
 // Throws CanSourceError when the interface does not exist or the kernel has no CAN support.

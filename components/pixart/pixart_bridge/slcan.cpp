@@ -1,6 +1,7 @@
 #include "slcan.hpp"
 
 #include <array>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -63,8 +64,10 @@ bool parse_hex(std::string_view digits, uint32_t& value) {
   return true;
 }
 
-// Decodes a frame message ("t1232DEAD", without terminator) into `frame`, or returns why not.
-std::string decode_frame(std::string_view message, CanFrame& frame) {
+// Decodes a frame message ("t1232DEAD", without terminator) into `frame` and the adaptor's
+// timestamp, if it has one, into `timestamp_ms`; or returns why not.
+std::string decode_frame(std::string_view message, CanFrame& frame,
+                         std::optional<uint32_t>& timestamp_ms) {
   const char type = message[0];
   frame.extended = type == 'T' || type == 'R';
   frame.remote = type == 'r' || type == 'R';
@@ -106,6 +109,8 @@ std::string decode_frame(std::string_view message, CanFrame& frame) {
     return fmt::format("timestamp 0x{:04X} is past a minute's last millisecond (0x{:04X})",
                        timestamp, kLastTimestamp);
   }
+  timestamp_ms.reset();
+  if (rest > data_digits) timestamp_ms = timestamp;
   return "";
 }
 
@@ -127,7 +132,7 @@ std::vector<std::string> slcan_open_commands(int bitrate) {
   for (const auto& [supported, code] : kBitrateCodes) {
     if (supported == bitrate) {
       return {slcan_close_command(), std::string{'S', code, kCarriageReturn},
-              std::string{'O', kCarriageReturn}};
+              std::string{'Z', '1', kCarriageReturn}, std::string{'O', kCarriageReturn}};
     }
   }
   std::string supported_list;
@@ -193,11 +198,12 @@ void SlcanParser::end_message(int64_t stamp_ns) {
     return;
   }
   CanFrame frame;
-  if (std::string error = decode_frame(message_, frame); !error.empty()) {
+  std::optional<uint32_t> timestamp_ms;
+  if (std::string error = decode_frame(message_, frame, timestamp_ms); !error.empty()) {
     reject(std::move(error));
     return;
   }
-  frame.stamp_ns = stamp_ns;
+  frame.stamp_ns = timestamp_ms ? adaptor_clock_.host_time(*timestamp_ms, stamp_ns) : stamp_ns;
   frames_.push_back(frame);
   ++stats_.frames;
 }

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "adaptor_clock.hpp"
 #include "can_frame.hpp"
 
 namespace mocap::can {
@@ -28,8 +29,10 @@ std::string encode_slcan(const CanFrame& frame);
 
 // The commands that open the CAN channel at `bitrate` (bit/s), in order: "C\r" (close, in case
 // a previous run left the channel open: the adaptor refuses "S" while open), "S<n>\r" (the
-// bitrate) and "O\r" (open). Throws std::invalid_argument naming the supported bitrates for any
-// other: 10000, 20000, 50000, 100000, 125000, 250000, 500000, 800000, 1000000.
+// bitrate), "Z1\r" (stamp received frames; an adaptor without timestamps refuses it with a
+// BELL, and its frames are stamped when read) and "O\r" (open). Throws std::invalid_argument naming
+// the supported bitrates for any other: 10000, 20000, 50000, 100000, 125000, 250000, 500000,
+// 800000, 1000000.
 std::vector<std::string> slcan_open_commands(int bitrate);
 // Closes the CAN channel: "C\r".
 std::string slcan_close_command();
@@ -58,9 +61,9 @@ class SlcanParser {
  public:
   explicit SlcanParser(SlcanParserOptions options = {});
 
-  // Parses `bytes`. Frames completed by them get `stamp_ns` as their stamp (the time the
-  // bytes were read; the adaptor's own timestamp, a millisecond within the minute, is
-  // checked and dropped) and wait in take_frames().
+  // Parses `bytes`, read at `stamp_ns`. Frames completed by them wait in take_frames(),
+  // stamped when the adaptor received them (AdaptorClock) if it stamps frames ("Z1" mode),
+  // otherwise `stamp_ns`.
   void feed(std::string_view bytes, int64_t stamp_ns = 0);
   // The frames completed since the last call, oldest first.
   std::vector<CanFrame> take_frames();
@@ -84,6 +87,7 @@ class SlcanParser {
   std::vector<CanFrame> frames_;
   SlcanStats stats_;
   std::string last_error_;
+  AdaptorClock adaptor_clock_;
 };
 
 }  // namespace mocap::can

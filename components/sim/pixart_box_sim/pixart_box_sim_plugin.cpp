@@ -11,7 +11,8 @@
 // Scene time starts when the component is created and follows the steady clock: sample k is
 // sent at start + k / rate_hz. Ground truth, truth_rate_hz times per second of scene time:
 //   - pty: on /pixart/ground_truth, stamped with the wall-clock time now() at which it was
-//     computed, so a consumer pairs it with the bridge's fiducials (stamped when read) by stamp;
+//     computed, so a consumer pairs it with the bridge's fiducials (stamped with the adaptor's
+//     timestamps, the sample's time, or when read if the host did not ask for them) by stamp;
 //   - candump: in FILE.truth.csv (candump_recording.hpp), stamped on the log's time scale, so
 //     the poses localized from a replay of FILE pair with it by stamp.
 #include <algorithm>
@@ -52,6 +53,9 @@ constexpr const char* kTruthTopic = "/pixart/ground_truth";
 constexpr const char* kTruthFrame = "world";
 // The adaptor thread checks for shutdown at least this often while nothing else wakes it.
 constexpr std::chrono::milliseconds kLongestWait{50};
+// How far behind the player, descheduled, still sends every sample when frames carry
+// timestamps (a real adaptor's buffer holds about this much of a busy bus).
+constexpr double kCatchUp_s = 0.1;
 // A host that stops reading fills the pty's buffer; the box then drops the sample instead of
 // holding up the next ones for long.
 constexpr std::chrono::milliseconds kPtyWriteTimeout{200};
@@ -124,6 +128,7 @@ class PixartBoxSim final : public Component {
                                   .seed = static_cast<uint64_t>(param<int64_t>("seed"))});
     rate_hz_ = param<double>("rate_hz");
     scene_start_ = Steady::now();
+    scene_start_wall_ns_ = wall_clock_ns();
 
     if (output_ == "candump") {
       start_log(cameras, objects);
@@ -240,8 +245,18 @@ class PixartBoxSim final : public Component {
       if (count > 0) answer_host(std::string_view(buffer, count));
       const auto due = schedule.due(scene_time(), next);
       if (!due) continue;
-      skipped_ += due->skipped;
-      send_sample(schedule.time_of(due->index));
+      // A real adaptor keeps what the bus carried while its USB link stalled and sends it
+      // late; with timestamps ("Z1") the frames still carry the bus's times, so the samples of
+      // the last kCatchUp_s are all sent. Without, a late sample would look taken when read:
+      // those in between are skipped.
+      uint64_t first = due->index;
+      if (adaptor_.timestamps()) {
+        first -= std::min(due->skipped, static_cast<uint64_t>(kCatchUp_s * rate_hz_));
+      }
+      skipped_ += first - next;
+      for (uint64_t index = first; index <= due->index; ++index) {
+        send_sample(schedule.time_of(index));
+      }
       next = due->index + 1;
     }
   }
@@ -277,7 +292,8 @@ class PixartBoxSim final : public Component {
       ++held_back_;
       return;
     }
-    const int64_t stamp_ns = wall_clock_ns();
+    const int64_t stamp_ns =
+        adaptor_.timestamps() ? scene_start_wall_ns_ + std::llround(time_s * 1e9) : wall_clock_ns();
     std::string bytes;
     for (const can::CanFrame& frame : simulator_->frames_at(time_s, stamp_ns)) {
       bytes += adaptor_.frame_message(frame, stamp_ns);
@@ -313,6 +329,7 @@ class PixartBoxSim final : public Component {
   double rate_hz_ = 270;
   int bitrate_ = 1000000;
   Steady::time_point scene_start_;
+  int64_t scene_start_wall_ns_ = 0;  // scene_start_ on the wall clock, for frame timestamps
   Publisher<mocap_msgs::msg::RobotPoseArray> truths_;
   // pty output; the adaptor and the counters belong to the worker thread until it ends.
   std::optional<serial::PseudoTerminal> pty_;
