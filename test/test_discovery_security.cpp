@@ -295,6 +295,65 @@ groups:
       << output;
 }
 
+// Whole-message protection aborts Fast DDS 2.9.1 (README's security section): the shipped
+// governance never asks for it, and a governance that does is refused under Fast DDS, by the
+// launcher's check and when a participant is made, with the file, the line and the way out.
+TEST_F(Security, FastDdsRefusesAGovernanceThatProtectsWholeMessages) {
+  const std::string shipped = test::read_file(credentials() / "governance.smime");
+  size_t settings = 0;
+  for (size_t at = shipped.find("<rtps_protection_kind>"); at != std::string::npos;
+       at = shipped.find("<rtps_protection_kind>", at + 1)) {
+    ++settings;
+    const std::string none = "<rtps_protection_kind>NONE</rtps_protection_kind>";
+    EXPECT_EQ(shipped.substr(at, none.size()), none);
+  }
+  EXPECT_GE(settings, 1u);
+
+  test::TempDir dir;
+  const fs::path folder = dir / "credentials";
+  fs::copy(credentials(), folder);
+  const size_t at = shipped.find("<rtps_protection_kind>NONE");
+  ASSERT_NE(at, std::string::npos);
+  const auto line = 1 + std::count(shipped.begin(), shipped.begin() + static_cast<long>(at), '\n');
+  const fs::path governance = folder / "governance.smime";
+  for (const std::string kind : {"ENCRYPT", "SIGN"}) {
+    std::string edited = shipped;
+    edited.replace(at + 22, 4, kind);
+    test::write_file(governance, edited);
+    const std::string problem = fmt::format(
+        "{}:{}: rtps_protection_kind {} would make Fast DDS 2.9.1 abort when a protected message "
+        "outgrows its buffer (fixed in 2.10.3); set it to NONE and protect each submessage with "
+        "metadata_protection_kind and data_protection_kind ENCRYPT, as scripts/make_security.sh "
+        "does",
+        governance.string(), line, kind);
+
+    const fs::path file = dir / "launch.yaml";
+    test::write_file(file, one_component("sink", "sequence_sink", "expect: 1",
+                                         "{security: {directory: credentials, identity: alice}}"));
+    const auto fastdds = environment(63, {{"MOCAP_DDS_IMPLEMENTATION", "fastdds"}});
+    auto [code, output] = test::run_command({launcher(), file.string(), "--check"}, fastdds);
+    EXPECT_EQ(code, 1) << output;
+    EXPECT_NE(output.find(fmt::format("{}:1: dds.security: {} (group 'sink' runs on fastdds)",
+                                      file.string(), problem)),
+              std::string::npos)
+        << output;
+    // Cyclone DDS wraps whole messages safely.
+    std::tie(code, output) =
+        test::run_command({launcher(), file.string(), "--check"},
+                          environment(63, {{"MOCAP_DDS_IMPLEMENTATION", "cyclonedds"}}));
+    EXPECT_EQ(code, 0) << output;
+
+    // The environment names the folder: refused when the participant is made.
+    test::write_file(file, one_component("sink", "sequence_sink", "expect: 1, timeout_s: 1"));
+    std::tie(code, output) = test::run_command(
+        {launcher(), file.string()}, environment(63, {{"MOCAP_DDS_IMPLEMENTATION", "fastdds"},
+                                                      {"MOCAP_SECURITY_DIRECTORY", folder.string()},
+                                                      {"MOCAP_SECURITY_IDENTITY", "alice"}}));
+    EXPECT_EQ(code, 1) << output;
+    EXPECT_NE(output.find("DDS Security: " + problem), std::string::npos) << output;
+  }
+}
+
 // Same CA, both allowed to: the stream arrives whole, over shared memory as over UDP.
 TEST_F(Security, AuthenticatedIdentitiesExchangeTheStream) {
   test::TempDir dir;

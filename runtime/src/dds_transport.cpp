@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cyclonedds_transport.hpp"
+#include "fastdds_qos.hpp"
 #include "fastdds_transport.hpp"
 
 namespace mocap {
@@ -38,6 +39,12 @@ int resolve_domain_id(int configured) {
         fmt::format("MOCAP_DOMAIN_ID='{}' is not a DDS domain id (an integer 0..232)", text));
   }
   return value;
+}
+
+std::optional<std::string> governance_problem(std::string_view implementation,
+                                              const std::filesystem::path& directory) {
+  if (implementation != "fastdds") return std::nullopt;
+  return fastdds_governance_problem(security_files(directory, "").governance);
 }
 
 std::unique_ptr<DdsTransport> make_dds_transport(const DdsOptions& options,

@@ -6,7 +6,9 @@
 // implementations in one graph exchange every message both ways.
 #pragma once
 
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,6 +43,11 @@ constexpr std::string_view kDdsImplementations = "fastdds, cyclonedds";
 // `configured` when set, else MOCAP_DDS_IMPLEMENTATION when set, else "fastdds". Throws
 // std::runtime_error naming the source of an unknown name and listing the known ones.
 std::string resolve_dds_implementation(std::string_view configured);
+
+// Why implementation `implementation` cannot take the signed governance in the security folder
+// `directory`, or nullopt: fastdds_governance_problem for "fastdds"; Cyclone DDS takes any.
+std::optional<std::string> governance_problem(std::string_view implementation,
+                                              const std::filesystem::path& directory);
 
 // MOCAP_DOMAIN_ID if set (validated), otherwise `configured`.
 int resolve_domain_id(int configured);

@@ -7,13 +7,17 @@
 #include <cctype>
 #include <charconv>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <memory>
+#include <regex>
 #include <stdexcept>
 
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/common/Locator.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/config.h>
 #include <fastrtps/utils/IPLocator.h>
 #include <fmt/format.h>
 
@@ -75,6 +79,9 @@ void set_security(const fs::path& directory, const std::string& identity,
     throw std::runtime_error(fmt::format("DDS Security: {}", problem->message));
   }
   SecurityFiles files = security_files(absolute, identity);
+  if (auto problem = fastdds_governance_problem(files.governance)) {
+    throw std::runtime_error(fmt::format("DDS Security: {}", *problem));
+  }
   auto uri = [](const fs::path& path) { return "file://" + path.string(); };
   auto& list = properties.properties();
   list.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
@@ -116,6 +123,34 @@ void apply(const Qos& qos, EndpointQos& out) {
 }
 
 }  // namespace
+
+std::optional<std::string> fastdds_governance_problem(const fs::path& governance) {
+#if FASTRTPS_VERSION_MAJOR > 2 || (FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR > 10) || \
+    (FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR == 10 && FASTRTPS_VERSION_MICRO >= 3)
+  (void)governance;
+  return std::nullopt;  // fixed in Fast DDS 2.10.3
+#else
+  std::ifstream in(governance);
+  if (!in) return std::nullopt;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  static const std::regex kSetting(
+      R"(<rtps_protection_kind>\s*([A-Za-z_]+)\s*</rtps_protection_kind>)");
+  for (auto match = std::sregex_iterator(text.begin(), text.end(), kSetting);
+       match != std::sregex_iterator(); ++match) {
+    const std::string kind = (*match)[1].str();
+    if (kind == "NONE") continue;
+    const auto line = 1 + std::count(text.begin(), text.begin() + match->position(0), '\n');
+    return fmt::format(
+        "{}:{}: rtps_protection_kind {} would make Fast DDS {}.{}.{} abort when a protected "
+        "message outgrows its buffer (fixed in 2.10.3); set it to NONE and protect each "
+        "submessage with metadata_protection_kind and data_protection_kind ENCRYPT, as "
+        "scripts/make_security.sh does",
+        governance.string(), line, kind, FASTRTPS_VERSION_MAJOR, FASTRTPS_VERSION_MINOR,
+        FASTRTPS_VERSION_MICRO);
+  }
+  return std::nullopt;
+#endif
+}
 
 dds::DataWriterQos to_writer_qos(const Qos& qos) {
   dds::DataWriterQos out;

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <optional>
 #include <string>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
@@ -22,6 +24,14 @@ constexpr uint32_t kSharedMemorySegmentBytes = 8 * 1024 * 1024;
 // Samples a reliable keep-all (volatile) writer keeps unacknowledged: its window. The depth of
 // such a topic is kept by the readers (to_writer_qos says why).
 constexpr int kWriterSamplesInFlight = 32;
+
+// Why this Fast DDS cannot take the signed governance `governance` (a governance.smime in clear
+// text), or nullopt: "PATH:LINE: rtps_protection_kind ENCRYPT ...". Fast DDS before 2.10.3
+// aborts when a whole RTPS message it protects (rtps_protection_kind ENCRYPT or SIGN) outgrows
+// the room it kept (`add_statistics_submessage: Assertion ... failed`); protecting each
+// submessage (metadata_ and data_protection_kind) encrypts as much and is safe. A file that
+// cannot be read gets nullopt: check_security names it.
+std::optional<std::string> fastdds_governance_problem(const std::filesystem::path& governance);
 
 eprosima::fastdds::dds::DataWriterQos to_writer_qos(const Qos& qos);
 eprosima::fastdds::dds::DataReaderQos to_reader_qos(const Qos& qos);

@@ -326,6 +326,14 @@ class Reader {
                                   group.name, where_chosen(group)));
       }
     }
+    if (!result_.dds.security_identity.empty()) {
+      for (const auto& [implementation, group] : first_on) {
+        if (auto problem = governance_problem(implementation, result_.dds.security_directory)) {
+          problems_.add(security_line_, fmt::format("dds.security: {} (group '{}' runs on {})",
+                                                    *problem, group->name, implementation));
+        }
+      }
+    }
     // One identity on both sides: which side starts the handshake is chance, and Fast DDS 2.9
     // starting it fails with Cyclone DDS 0.10 (launch_yaml/README.md).
     if (!result_.dds.security_identity.empty() && first_on.size() > 1) {
