@@ -19,8 +19,9 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev
   # the overlay's PNG snapshots
   zlib1g-dev
-  # the Foxglove WebSocket bridge; its browser test (Node and npm come with the machine)
-  libwebsocketpp-dev libasio-dev chromium
+  # the Foxglove WebSocket bridge (TLS by OpenSSL); its browser test (Node and npm come with the
+  # machine) and its test certificates
+  libwebsocketpp-dev libasio-dev libssl-dev openssl chromium
   # tests: GoogleTest, network namespaces for the multi-host tests, formatting check
   libgtest-dev libgmock-dev iproute2 clang-format
   # sanitizer builds and fuzzing (scripts/sanitize.sh, scripts/fuzz.sh): clang with its

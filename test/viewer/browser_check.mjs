@@ -5,10 +5,12 @@
 // it prints "WAITING_FOR_STOP", the test stops the bridge, the page must say it is gone; it
 // prints "WAITING_FOR_START", the test starts the bridge again and creates FLAG_FILE, and the
 // page must reconnect and draw new frames. With --floor (a PixArt graph, no camera) it checks
-// the floor instead: the ceiling cameras' footprints and the robots drawn. One line per check;
-// exit 0 when all passed.
+// the floor instead: the ceiling cameras' footprints and the robots drawn. With --refused (a
+// bridge asking for a token the URL lacks) it checks that the page says it is disconnected.
+// HTTPS certificates are not checked (the TLS test's is self-signed). One line per check; exit 0
+// when all passed.
 //
-//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor]
+//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused]
 import { chromium } from "playwright-core";
 import { existsSync } from "node:fs";
 
@@ -43,10 +45,22 @@ const snapshot = async (page, condition, timeout) => {
 };
 
 try {
-  const page = await browser.newPage({ viewport: { width: 1600, height: 1000 } });
+  // The TLS test's certificate is self-signed.
+  const page = await browser.newPage({ viewport: { width: 1600, height: 1000 }, ignoreHTTPSErrors: true });
   const errors = [];
   page.on("pageerror", (error) => errors.push(error.message));
   await page.goto(url);
+  if (mode === "--refused") {
+    // Served the page, refused the WebSocket (no token): the page must say so, and draw nothing.
+    await page.waitForFunction(() => /disconnected/.test(document.querySelector("#status")?.textContent ?? ""),
+      null, { timeout: 30000 });
+    const text = await page.textContent("#status");
+    check(!text.includes("token"), "the status line does not show a token");
+    check(!(await state(page)).connected, `the page without the token says: ${text.split(":")[0]}`);
+    await page.screenshot({ path: screenshot, fullPage: true });
+    await browser.close();
+    process.exit(failed ? 1 : 0);
+  }
   if (mode === "--floor") {
     await page.waitForFunction(() => window.viewerState?.footprintsDrawn > 0 && window.viewerState.robotsDrawn > 0,
       null, { timeout: 90000 });

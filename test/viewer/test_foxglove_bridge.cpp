@@ -398,5 +398,129 @@ TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
   EXPECT_NE(page.find("PASS floor: 4 footprints, 2 robots"), std::string::npos) << page;
 }
 
+// secure_client.mjs's one line: what a client of the `ws` package got.
+json secure_client(std::vector<std::string> arguments,
+                   const std::vector<std::string>& prefix = {}) {
+  std::vector<std::string> argv = prefix;
+  argv.push_back("node");
+  argv.push_back((viewer_tests() / "secure_client.mjs").string());
+  argv.insert(argv.end(), arguments.begin(), arguments.end());
+  auto [code, output] = test::run_command(argv, {}, std::chrono::seconds(60));
+  EXPECT_EQ(code, 0) << output;
+  const size_t line = output.rfind('{');
+  return line == std::string::npos ? json{{"output", output}} : json::parse(output.substr(line));
+}
+
+// The bridge alone, on `port`, with more `parameters` (YAML flow-map entries).
+std::filesystem::path bridge_launch_file(const test::TempDir& dir, int port,
+                                         const std::string& parameters = "") {
+  const std::filesystem::path file = dir / "viewer.yaml";
+  test::write_file(file, fmt::format(R"(groups:
+  - name: viewer
+    components:
+      - plugin: foxglove_bridge
+        name: viewer
+        parameters: {{port: {}{}}}
+)",
+                                     port, parameters.empty() ? "" : ", " + parameters));
+  return file;
+}
+
+// The bridge on host A of two network namespaces: by default only A itself may connect; named
+// 0.0.0.0 in the launch file, B may too, and the bridge says so once.
+TEST(FoxgloveBridgeNetwork, ListensOnThisMachineOnlyUnlessTheLaunchFileOpensIt) {
+  test::TwoHosts hosts;
+  if (!hosts.error().empty()) GTEST_SKIP() << "cannot make network namespaces: " << hosts.error();
+  test::TempDir dir;
+  const std::map<std::string, std::string> environment = {
+      {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(71))}};
+  const std::string from_b = fmt::format("ws://{}:8765", hosts.address_a());
+  const std::vector<std::string> on_a = hosts.on_a({}), on_b = hosts.on_b({});
+  {
+    test::ChildProcess graph(hosts.on_a({(test::bin_dir() / "mocap_launch").string(),
+                                         bridge_launch_file(dir, 8765).string()}),
+                             environment, dir / "closed.log");
+    ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+        << graph.output();
+    EXPECT_NE(graph.output().find("Foxglove WebSocket server on ws://127.0.0.1:8765 offering"),
+              std::string::npos)
+        << graph.output();
+    EXPECT_NE(graph.output().find("(this machine only)"), std::string::npos) << graph.output();
+    EXPECT_EQ(secure_client({"ws://127.0.0.1:8765"}, on_a)["opened"], true);
+    EXPECT_EQ(secure_client({from_b}, on_b), (json{{"opened", false}, {"error", "ECONNREFUSED"}}));
+  }
+  test::ChildProcess graph(hosts.on_a({(test::bin_dir() / "mocap_launch").string(),
+                                       bridge_launch_file(dir, 8765, "address: 0.0.0.0").string()}),
+                           environment, dir / "open.log");
+  ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+      << graph.output();
+  EXPECT_EQ(secure_client({from_b}, on_b)["op"], "serverInfo");
+  const std::string output = graph.output();
+  const std::string warning =
+      "Open to the network: any host that reaches port 8765 may connect, no token asked (see "
+      "token), unencrypted (see certificate_file)";
+  EXPECT_NE(output.find(warning), std::string::npos) << output;
+  EXPECT_EQ(output.find(warning), output.rfind(warning)) << output;  // once
+}
+
+// A token and TLS: clients without the token, or that do not trust the certificate, are
+// refused; the viewer page passes on the token it was opened with.
+TEST(FoxgloveBridgeSecurity, TokenAndTlsLetInOnlyWhoShouldComeIn) {
+  test::TempDir dir;
+  const std::string certificate = (dir / "cert.pem").string(), key = (dir / "key.pem").string();
+  auto [made, openssl] = test::run_command(
+      {"openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
+       "-nodes", "-days", "2", "-subj", "/CN=localhost", "-addext", "subjectAltName=IP:127.0.0.1",
+       "-keyout", key, "-out", certificate});
+  ASSERT_EQ(made, 0) << openssl;
+  const int port = free_port();
+  const std::string adaptor = (dir / "adaptor").string();
+  test::ChildProcess graph(
+      {(test::bin_dir() / "mocap_launch").string(),
+       (test::source_dir() / "launch_yaml" / "pixart_localization.yaml").string(), "--set",
+       "box.device_link=" + adaptor, "--set", "bridge.device=" + adaptor, "--set",
+       fmt::format("viewer.port={}", port), "--set", "viewer.token=s3cret/+token", "--set",
+       "viewer.certificate_file=" + certificate, "--set", "viewer.key_file=" + key},
+      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(72))}}, dir / "graph.log");
+  ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+      << graph.output();
+  EXPECT_NE(graph.output().find(fmt::format("on wss://127.0.0.1:{}", port)), std::string::npos)
+      << graph.output();
+  EXPECT_NE(graph.output().find(", token required; the viewer: https://127.0.0.1:"),
+            std::string::npos)
+      << graph.output();
+
+  const std::string wss = fmt::format("wss://127.0.0.1:{}/", port);
+  const std::string token = "?token=s3cret%2F%2Btoken";
+  EXPECT_EQ(secure_client({wss + token, "--ca", certificate})["op"], "serverInfo");
+  EXPECT_EQ(secure_client({wss, "--bearer", "s3cret/+token", "--ca", certificate})["op"],
+            "serverInfo");
+  EXPECT_EQ(secure_client({wss, "--ca", certificate}), (json{{"opened", false}, {"status", 401}}));
+  EXPECT_EQ(secure_client({wss + "?token=s3cret", "--ca", certificate}),
+            (json{{"opened", false}, {"status", 401}}));
+  EXPECT_EQ(secure_client({wss, "--bearer", "s3cret/+tokem", "--ca", certificate}),
+            (json{{"opened", false}, {"status", 401}}));
+  // The certificate is nobody's CA's: a client that trusts only the system's refuses it.
+  EXPECT_EQ(secure_client({wss + token}),
+            (json{{"opened", false}, {"error", "DEPTH_ZERO_SELF_SIGNED_CERT"}}));
+  // Plain WebSocket to the TLS port: no WebSocket comes of it.
+  EXPECT_EQ(secure_client({fmt::format("ws://127.0.0.1:{}/{}", port, token)})["opened"], false);
+
+  const std::string https = fmt::format("https://127.0.0.1:{}/", port);
+  auto [page_code, page] =
+      test::run_command({"node", (viewer_tests() / "browser_check.mjs").string(), https + token,
+                         (dir / "floor.png").string(), "--floor"},
+                        {}, std::chrono::seconds(90));
+  EXPECT_EQ(page_code, 0) << page;
+  EXPECT_NE(page.find("PASS floor: 4 footprints, 2 robots"), std::string::npos) << page;
+  std::tie(page_code, page) =
+      test::run_command({"node", (viewer_tests() / "browser_check.mjs").string(), https,
+                         (dir / "refused.png").string(), "--refused"},
+                        {}, std::chrono::seconds(90));
+  EXPECT_EQ(page_code, 0) << page;
+  EXPECT_NE(page.find("PASS the page without the token says: disconnected"), std::string::npos)
+      << page;
+}
+
 }  // namespace
 }  // namespace mocap

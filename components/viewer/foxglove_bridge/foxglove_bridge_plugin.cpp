@@ -53,7 +53,16 @@ class FoxgloveBridge final : public Component {
         "subprotocol foxglove.websocket.v1) to Foxglove, Lichtblick or any client of the "
         "protocol: CDR payloads with ros2idl schemas. Slow clients lose their oldest messages, "
         "never slow the graph.");
-    spec.parameter("address", std::string("0.0.0.0"), "the address to listen on");
+    spec.parameter("address", std::string("127.0.0.1"),
+                   "the address to listen on: this machine only by default; 0.0.0.0 (or one "
+                   "interface's address) serves the network");
+    spec.parameter("token", std::string(),
+                   "when set, WebSocket clients must present it (Authorization: Bearer TOKEN, or "
+                   "?token=TOKEN in the URL, as the viewer page passes on its own) or are refused "
+                   "with HTTP 401");
+    spec.parameter("certificate_file", std::string(),
+                   "with key_file: serve TLS (wss://, https://) with this PEM certificate chain");
+    spec.parameter("key_file", std::string(), "the PEM private key of certificate_file");
     spec.parameter("port", int64_t{8765}, "the TCP port (0: any free port, logged)")
         .range(0, 65535);
     spec.parameter("topics", std::string(".*"),
@@ -97,6 +106,9 @@ class FoxgloveBridge final : public Component {
     WebSocketServerOptions options;
     options.address = param<std::string>("address");
     options.port = static_cast<uint16_t>(param<int64_t>("port"));
+    options.token = param<std::string>("token");
+    options.certificate_file = param<std::string>("certificate_file");
+    options.key_file = param<std::string>("key_file");
     options.subprotocols = {std::string(kSubprotocol), std::string(kSdkSubprotocol)};
     WebSocketHandlers handlers;
     handlers.on_open = [this](ClientId client, const std::string&) { opened(client); };
@@ -114,7 +126,7 @@ class FoxgloveBridge final : public Component {
     try {
       server_ = std::make_unique<WebSocketServer>(options, handlers);
     } catch (const std::runtime_error& e) {
-      throw std::invalid_argument(std::string("address/port: ") + e.what());
+      throw std::invalid_argument(e.what());  // names the parameter at fault
     }
     create_timer(std::chrono::milliseconds(20), [this] {
       pump_all();
@@ -125,11 +137,20 @@ class FoxgloveBridge final : public Component {
       for (const std::string& name : declared_) present.push_back({name, nullptr, {}});
       update_topics(present);
     });
-    log().info(
-        "Foxglove WebSocket server on ws://{0}:{1} offering {2} topic(s){3}; the viewer: "
-        "http://{0}:{1}/",
-        options.address, server_->port(), channels_.size(),
-        client_publish_ ? ", clients may publish" : "");
+    const bool tls = !options.certificate_file.empty();
+    const std::string served = fmt::format(
+        "Foxglove WebSocket server on {0}://{1}:{2} offering {3} topic(s){4}{5}; the viewer: "
+        "{6}://{1}:{2}/",
+        tls ? "wss" : "ws", options.address, server_->port(), channels_.size(),
+        client_publish_ ? ", clients may publish" : "",
+        options.token.empty() ? "" : ", token required", tls ? "https" : "http");
+    if (server_->loopback_only()) {
+      log().info("{} (this machine only)", served);
+    } else {
+      log().warn("{}. Open to the network: any host that reaches port {} may connect{}{}", served,
+                 server_->port(), options.token.empty() ? ", no token asked (see token)" : "",
+                 tls ? "" : ", unencrypted (see certificate_file)");
+    }
   }
 
   ~FoxgloveBridge() override {

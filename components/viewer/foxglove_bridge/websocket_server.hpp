@@ -10,6 +10,9 @@
 #include <vector>
 
 namespace mocap::foxglove {
+namespace detail {
+class WebSocketBackend;
+}
 
 struct HttpResponse {
   int status = 404;
@@ -18,8 +21,15 @@ struct HttpResponse {
 };
 
 struct WebSocketServerOptions {
-  std::string address = "0.0.0.0";  // an IPv4 or IPv6 address to listen on
-  uint16_t port = 8765;             // 0: any free port (WebSocketServer::port() tells which)
+  std::string address = "127.0.0.1";  // an IPv4 or IPv6 address to listen on
+  uint16_t port = 8765;               // 0: any free port (WebSocketServer::port() tells which)
+  // Non-empty: a WebSocket client must present it ("Authorization: Bearer TOKEN", or
+  // "?token=TOKEN" in the URL) or is refused with HTTP 401. Plain HTTP requests are served
+  // without it.
+  std::string token;
+  // Both set: TLS (wss://, https://) with this certificate chain and private key (PEM files).
+  std::string certificate_file;
+  std::string key_file;
   // Accepted subprotocols, preferred first; a client offering none of them gets HTTP 400.
   std::vector<std::string> subprotocols;
   // Largest message a client may send; a larger one closes its connection.
@@ -42,7 +52,8 @@ struct WebSocketHandlers {
 class WebSocketServer {
  public:
   // Listens and starts the thread. Throws std::runtime_error naming address:port when the
-  // address cannot be bound (in use, not an address of this machine).
+  // address cannot be bound (in use, not an address of this machine), or the TLS file that
+  // cannot be used.
   WebSocketServer(WebSocketServerOptions options, WebSocketHandlers handlers);
   // Closes every connection ("server stopping") and joins the thread.
   ~WebSocketServer();
@@ -50,6 +61,8 @@ class WebSocketServer {
   WebSocketServer& operator=(const WebSocketServer&) = delete;
 
   uint16_t port() const;
+  // Whether only this machine can connect (a loopback address).
+  bool loopback_only() const;
 
   // Thread-safe. Queue a frame to a client; false when it is gone.
   bool send_text(ClientId client, const std::string& text);
@@ -62,8 +75,7 @@ class WebSocketServer {
   void close(ClientId client, const std::string& reason);
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<detail::WebSocketBackend> impl_;
 };
 
 }  // namespace mocap::foxglove

@@ -54,7 +54,9 @@ let nextSubscription = 1;
 
 function connect() {
   const url = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/`;
-  socket = new WebSocket(url, [SUBPROTOCOL]);
+  // A bridge that asks for a token gets the one this page was opened with (?token=...).
+  const token = new URLSearchParams(location.search).get("token");
+  socket = new WebSocket(token ? `${url}?token=${encodeURIComponent(token)}` : url, [SUBPROTOCOL]);
   socket.binaryType = "arraybuffer";
   socket.onopen = () => {
     state.connected = true;
