@@ -66,7 +66,10 @@ function(mocap_generate_messages target)
     set(PKG ${CMAKE_MATCH_1})
     set(TYPE ${CMAKE_MATCH_2})
     set(DIR ${PKG}/msg)
-    string(REGEX REPLACE "([a-z0-9])([A-Z])" "\\1_\\2" SNAKE ${TYPE})
+    # The header's name as rosidl makes it: an underscore before a capital that starts a word
+    # (TFMessage -> tf_message) and before one that follows a small letter or digit.
+    string(REGEX REPLACE "(.)([A-Z][a-z]+)" "\\1_\\2" SNAKE ${TYPE})
+    string(REGEX REPLACE "([a-z0-9])([A-Z])" "\\1_\\2" SNAKE ${SNAKE})
     string(TOLOWER ${SNAKE} SNAKE)
     set(IDL ${idl})
     file(READ ${idl_root}/${idl} IDL_TEXT)

@@ -2,7 +2,11 @@
 // FoxgloveClient over the `ws` package, decoding with @foxglove/ros2idl-parser and
 // @foxglove/rosmsg2-serialization from the schema the server advertised. Nothing of ours.
 //
-//   node foxglove_client.mjs URL COUNT TOPIC...
+//   node foxglove_client.mjs [--ros-definitions] URL COUNT TOPIC...
+//
+// --ros-definitions: a standard ROS 2 type (geometry_msgs, nav_msgs, tf2_msgs...) is decoded
+// with ROS 2 Humble's own definitions from @foxglove/rosmsg-msgs-common, not the advertised
+// schema ("decodedWith": "ros2humble" in its lines); other types as before.
 //
 // Subscribes to each TOPIC, prints one JSON line per decoded message ({"topic", "schemaName",
 // "message"}; typed arrays as arrays, 64-bit integers as numbers, image data as its length)
@@ -12,12 +16,14 @@ import wsProtocol from "@foxglove/ws-protocol";
 import ros2idl from "@foxglove/ros2idl-parser";
 import rosmsg2 from "@foxglove/rosmsg2-serialization";
 import WebSocket from "ws";
+import rosCommon from "@foxglove/rosmsg-msgs-common";
 
 const { FoxgloveClient } = wsProtocol;
 const { parseRos2idl } = ros2idl;
 const { MessageReader } = rosmsg2;
 
-const [url, countText, ...topics] = process.argv.slice(2);
+const rosDefinitions = process.argv[2] === "--ros-definitions";
+const [url, countText, ...topics] = process.argv.slice(rosDefinitions ? 3 : 2);
 const count = Number(countText);
 if (!url || !(count > 0) || topics.length === 0) {
   console.error("usage: node foxglove_client.mjs URL COUNT TOPIC...");
@@ -41,6 +47,28 @@ function plain(value) {
   return value;
 }
 
+// ROS 2 Humble's definition of `schemaName` ("nav_msgs/msg/Odometry") and of every type it
+// uses, root first, as MessageReader takes them; null when it is not a standard type.
+function humbleDefinitions(schemaName) {
+  const all = rosCommon.ros2humble;
+  const root = all[schemaName.replace("/msg/", "/")];
+  if (!root) return null;
+  const definitions = [root];
+  const seen = new Set([root.name]);
+  const visit = (definition) => {
+    for (const field of definition.definitions) {
+      if (!field.isComplex || seen.has(field.type)) continue;
+      const used = all[field.type];
+      if (!used) fail(`${schemaName}: ros2humble has no ${field.type}`);
+      seen.add(field.type);
+      definitions.push(used);
+      visit(used);
+    }
+  };
+  visit(root);
+  return definitions;
+}
+
 const client = new FoxgloveClient({
   ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]),
 });
@@ -59,9 +87,10 @@ client.on("advertise", (channels) => {
     if (channel.encoding !== "cdr" || channel.schemaEncoding !== "ros2idl") {
       fail(`${channel.topic}: encoding ${channel.encoding}, schema ${channel.schemaEncoding}`);
     }
-    const reader = new MessageReader(parseRos2idl(channel.schema));
+    const humble = rosDefinitions ? humbleDefinitions(channel.schemaName) : null;
+    const reader = new MessageReader(humble ?? parseRos2idl(channel.schema));
     const id = client.subscribe(channel.id);
-    bySubscription.set(id, { channel, reader });
+    bySubscription.set(id, { channel, reader, decodedWith: humble ? "ros2humble" : "schema" });
   }
   if (bySubscription.size === topics.length && !advertised) {
     advertised = true;
@@ -76,7 +105,12 @@ client.on("message", ({ subscriptionId, data }) => {
   const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
   const message = subscription.reader.readMessage(bytes);
   console.log(
-    JSON.stringify({ topic, schemaName: subscription.channel.schemaName, message: plain(message) }),
+    JSON.stringify({
+      topic,
+      schemaName: subscription.channel.schemaName,
+      decodedWith: subscription.decodedWith,
+      message: plain(message),
+    }),
   );
   received.set(topic, received.get(topic) + 1);
   if ([...received.values()].every((n) => n >= count)) process.exit(0);

@@ -91,9 +91,13 @@ class FoxgloveBridgeTest : public ::testing::Test {
   }
 
   // foxglove_client.mjs's decoded messages, by topic.
-  std::map<std::string, std::vector<json>> receive(int count, std::vector<std::string> topics) {
-    std::vector<std::string> argv = {"node", (viewer_tests() / "foxglove_client.mjs").string(),
-                                     url(), std::to_string(count)};
+  // `ros_definitions`: standard types decoded with ROS 2's own definitions (decoded_with_).
+  std::map<std::string, std::vector<json>> receive(int count, std::vector<std::string> topics,
+                                                   bool ros_definitions = false) {
+    std::vector<std::string> argv = {"node", (viewer_tests() / "foxglove_client.mjs").string()};
+    if (ros_definitions) argv.push_back("--ros-definitions");
+    argv.push_back(url());
+    argv.push_back(std::to_string(count));
     argv.insert(argv.end(), topics.begin(), topics.end());
     auto [code, output] = test::run_command(argv, {}, std::chrono::seconds(90));
     EXPECT_EQ(code, 0) << output << "\n--- graph ---\n" << graph_->output();
@@ -103,18 +107,22 @@ class FoxgloveBridgeTest : public ::testing::Test {
       if (line.empty() || line[0] != '{') continue;
       json item = json::parse(line);
       messages[item["topic"]].push_back(item["message"]);
+      decoded_with_[item["topic"]] = item["decodedWith"];
     }
     return messages;
   }
 
   test::TempDir dir_;
+  std::map<std::string, std::string> decoded_with_;  // topic -> "schema" or "ros2humble"
   int port_ = 0;
   std::unique_ptr<test::ChildProcess> graph_;
   int starts_ = 0;
 };
 
+// The advertised schema's time decodes as {sec, nsec}; ROS 2's own definition as {sec, nanosec}.
 std::pair<int64_t, int64_t> stamp_of(const json& message) {
-  return {message["header"]["stamp"]["sec"], message["header"]["stamp"]["nsec"]};
+  const json& stamp = message["header"]["stamp"];
+  return {stamp["sec"], stamp.contains("nsec") ? stamp["nsec"] : stamp["nanosec"]};
 }
 
 TEST_F(FoxgloveBridgeTest, AnIndependentClientDecodesPosesFiducialsAndImages) {
@@ -174,6 +182,76 @@ TEST_F(FoxgloveBridgeTest, AnIndependentClientDecodesPosesFiducialsAndImages) {
         0.08)
         << "max_image_rate_hz: 10";
   }
+}
+
+// pose_outputs as ROS 2 tools see it: ROS 2 Humble's own definitions (Foxglove's copy)
+// decode /tf, /mocap/board_a/pose and /mocap/board_a/odom, and each carries the pose
+// /mocap/poses has for board_a in the same frame (same stamp).
+TEST_F(FoxgloveBridgeTest, RosOwnDefinitionsDecodeTheStandardOutputs) {
+  const std::vector<std::string> standard = {"/tf", "/mocap/board_a/pose", "/mocap/board_a/odom"};
+  std::vector<std::string> topics = standard;
+  topics.push_back("/mocap/poses");
+  auto messages = receive(60, topics, true);
+  for (const std::string& topic : standard) EXPECT_EQ(decoded_with_[topic], "ros2humble") << topic;
+  EXPECT_EQ(decoded_with_["/mocap/poses"], "schema");
+
+  std::map<std::pair<int64_t, int64_t>, json> tracked;  // stamp -> board_a's ConstellationPose
+  for (const json& array : messages["/mocap/poses"]) {
+    for (const json& pose : array["poses"]) {
+      if (pose["name"] == "board_a") tracked[stamp_of(array)] = pose;
+    }
+  }
+  auto same_pose = [](const json& a, const json& b) {
+    for (const char* axis : {"x", "y", "z"}) {
+      if (std::abs(a["position"][axis].get<double>() - b["position"][axis].get<double>()) > 1e-9) {
+        return false;
+      }
+    }
+    // q and -q are one rotation.
+    double dot = 0;
+    for (const char* axis : {"x", "y", "z", "w"}) {
+      dot += a["orientation"][axis].get<double>() * b["orientation"][axis].get<double>();
+    }
+    return std::abs(std::abs(dot) - 1) < 1e-9;
+  };
+  int poses = 0, odoms = 0, transforms = 0;
+  for (const json& pose : messages["/mocap/board_a/pose"]) {
+    EXPECT_EQ(pose["header"]["frame_id"], "camera_ir_optical");
+    auto found = tracked.find(stamp_of(pose));
+    if (found == tracked.end()) continue;
+    EXPECT_TRUE(same_pose(pose["pose"], found->second["pose"]["pose"])) << pose;
+    ++poses;
+  }
+  for (const json& odom : messages["/mocap/board_a/odom"]) {
+    EXPECT_EQ(odom["child_frame_id"], "board_a");
+    auto found = tracked.find(stamp_of(odom));
+    if (found == tracked.end()) continue;
+    EXPECT_TRUE(same_pose(odom["pose"]["pose"], found->second["pose"]["pose"])) << odom;
+    // The twist turned into the board's frame keeps its length.
+    auto length = [](const json& v) {
+      return std::hypot(v["x"].get<double>(), v["y"].get<double>(), v["z"].get<double>());
+    };
+    EXPECT_NEAR(length(odom["twist"]["twist"]["linear"]),
+                length(found->second["velocity"]["linear"]), 1e-9);
+    EXPECT_EQ(odom["pose"]["covariance"].size(), 36u);
+    ++odoms;
+  }
+  for (const json& tf : messages["/tf"]) {
+    for (const json& transform : tf["transforms"]) {
+      if (transform["child_frame_id"] != "board_a") continue;
+      auto found = tracked.find(stamp_of(transform));
+      if (found == tracked.end()) continue;
+      const json as_pose = {{"position", transform["transform"]["translation"]},
+                            {"orientation", transform["transform"]["rotation"]}};
+      EXPECT_TRUE(same_pose(as_pose, found->second["pose"]["pose"])) << transform;
+      ++transforms;
+    }
+  }
+  // The per-board topics appear with the first pose, and the bridge finds them within a
+  // discovery period: they start later than /mocap/poses, and best effort may drop some.
+  EXPECT_GE(poses, 10);
+  EXPECT_GE(odoms, 10);
+  EXPECT_GE(transforms, 10);
 }
 
 TEST_F(FoxgloveBridgeTest, ClientsThatBreakTheProtocolAreClosedWithTheReason) {

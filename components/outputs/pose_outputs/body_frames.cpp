@@ -1,0 +1,49 @@
+#include "body_frames.hpp"
+
+namespace mocap::outputs {
+namespace {
+
+// The 6x6 block-diagonal rotation of a (translation, rotation) or (linear, angular) vector.
+Matrix6d twice(const Eigen::Matrix3d& rotation) {
+  Matrix6d both = Matrix6d::Zero();
+  both.topLeftCorner<3, 3>() = rotation;
+  both.bottomRightCorner<3, 3>() = rotation;
+  return both;
+}
+
+}  // namespace
+
+const Eigen::Quaterniond& optical_in_body() {
+  static const Eigen::Quaterniond rotation(0.5, -0.5, 0.5, -0.5);  // w, x, y, z
+  return rotation;
+}
+
+BodyState seen_from(const Eigen::Isometry3d& new_from_parent, const BodyState& body) {
+  const Eigen::Matrix3d rotation = new_from_parent.linear();
+  const Matrix6d both = twice(rotation);
+  BodyState seen;
+  seen.parent_from_body = new_from_parent * body.parent_from_body;
+  seen.pose_covariance = both * body.pose_covariance * both.transpose();
+  seen.linear_velocity = rotation * body.linear_velocity;
+  seen.angular_velocity = rotation * body.angular_velocity;
+  seen.velocity_covariance = both * body.velocity_covariance * both.transpose();
+  return seen;
+}
+
+BodyTwist twist_in_body(const BodyState& body) {
+  const Eigen::Matrix3d body_from_parent = body.parent_from_body.linear().transpose();
+  const Matrix6d both = twice(body_from_parent);
+  return {body_from_parent * body.linear_velocity, body_from_parent * body.angular_velocity,
+          both * body.velocity_covariance * both.transpose()};
+}
+
+Eigen::Isometry3d from_xyz_rpy(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  transform.translate(xyz);
+  transform.rotate(Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()));
+  return transform;
+}
+
+}  // namespace mocap::outputs

@@ -1,0 +1,288 @@
+// pose_outputs: the tracked boards as ROS 2 tools read them. Per board a
+// geometry_msgs/PoseStamped on /mocap/<board>/pose and a nav_msgs/Odometry on
+// /mocap/<board>/odom; every board on /tf, and the camera's mounting on /tf_static. Stamps are
+// the poses' own, the capture time of their image; rates are kept by those stamps, so a
+// replayed bag gives the live run's messages.
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/msg/pose_stamped.hpp>
+#include <mocap/component.hpp>
+#include <mocap/component_spec.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <nav_msgs/msg/odometry.hpp>
+#include <tf2_msgs/msg/tf_message.hpp>
+
+#include "body_frames.hpp"
+#include "pose_message.hpp"
+
+namespace mocap::outputs {
+namespace {
+
+using geometry_msgs::msg::PoseStamped;
+using geometry_msgs::msg::TransformStamped;
+using mocap_msgs::msg::ConstellationPose;
+using mocap_msgs::msg::ConstellationPoseArray;
+using nav_msgs::msg::Odometry;
+using tf2_msgs::msg::TFMessage;
+
+constexpr const char* kPoses = "/mocap/poses";
+constexpr const char* kPoseFamily = "/mocap/{board}/pose";
+constexpr const char* kOdomFamily = "/mocap/{board}/odom";
+constexpr const char* kTf = "/tf";
+constexpr const char* kTfStatic = "/tf_static";
+
+Matrix6d to_matrix(const std::array<double, 36>& row_major) {
+  return Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(row_major.data());
+}
+
+std::array<double, 36> to_row_major(const Matrix6d& matrix) {
+  std::array<double, 36> values{};
+  Eigen::Map<Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(values.data()) = matrix;
+  return values;
+}
+
+geometry_msgs::msg::Vector3 to_vector3(const Eigen::Vector3d& v) {
+  geometry_msgs::msg::Vector3 message;
+  message.x(v.x());
+  message.y(v.y());
+  message.z(v.z());
+  return message;
+}
+
+TransformStamped to_transform(const std_msgs::msg::Header& header, const std::string& child,
+                              const Eigen::Isometry3d& parent_from_child) {
+  TransformStamped message;
+  message.header(header);
+  message.child_frame_id(child);
+  // w >= 0, as static_transform_publisher writes it (q and -q are the same rotation).
+  Eigen::Quaterniond q(parent_from_child.linear());
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  message.transform().translation(to_vector3(parent_from_child.translation()));
+  message.transform().rotation().x(q.x());
+  message.transform().rotation().y(q.y());
+  message.transform().rotation().z(q.z());
+  message.transform().rotation().w(q.w());
+  return message;
+}
+
+// Keeps one output at most `rate_hz` per board, by the messages' stamps (0: every message).
+class StampRate {
+ public:
+  explicit StampRate(double rate_hz)
+      : period_ns_(rate_hz > 0 ? static_cast<int64_t>(std::llround(1e9 / rate_hz)) : 0) {}
+
+  bool due(const std::string& board, int64_t stamp_ns) {
+    if (period_ns_ == 0) return true;
+    auto [last, first] = last_ns_.try_emplace(board, stamp_ns);
+    // A 1 % allowance: a 30 Hz camera's frames, 33.3 ms apart, all pass a 30 Hz output.
+    if (!first && stamp_ns - last->second < period_ns_ - period_ns_ / 100) return false;
+    last->second = stamp_ns;
+    return true;
+  }
+
+ private:
+  int64_t period_ns_;
+  std::map<std::string, int64_t> last_ns_;
+};
+
+class PoseOutputs final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "The tracked boards as ROS 2 tools read them: per board geometry_msgs/PoseStamped on "
+        "/mocap/<board>/pose and nav_msgs/Odometry (pose and twist with covariances, twist in "
+        "the board's frame) on /mocap/<board>/odom, every board on /tf, the camera's mounting "
+        "on /tf_static. Frames follow REP 103/105; stamps are the images' capture times.");
+    spec.parameter("parent", std::string("camera"),
+                   "frame of the poses: camera (the camera's optical frame, as /mocap/poses) or "
+                   "world (through camera_in_world)");
+    spec.parameter("world_frame", std::string("world"), "name of the world frame");
+    spec.parameter("camera_frame", std::string("camera_ir"),
+                   "name of the camera's REP 103 body frame (x forward, y left, z up)");
+    spec.parameter("optical_frame", std::string("camera_ir_optical"),
+                   "name of the camera's optical frame (z forward, x right, y down), the frame "
+                   "of /mocap/poses; poses whose header names another are counted and skipped");
+    spec.parameter("camera_in_world", std::vector<double>{0, 0, 0, 0, 0, 0},
+                   "camera_frame in world_frame: x, y, z (m), roll, pitch, yaw (rad)");
+    spec.parameter("child_frame_prefix", std::string(),
+                   "prefix of the boards' frame names (the board's name follows)");
+    spec.parameter("pose_rate_hz", 0.0, "most PoseStamped a second per board (0: every frame)")
+        .min(0);
+    spec.parameter("odom_rate_hz", 0.0, "most Odometry a second per board (0: every frame)").min(0);
+    spec.parameter("tf_rate_hz", 0.0, "most /tf transforms a second per board (0: every frame)")
+        .min(0);
+    spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
+                                            "the tracked boards in the camera's optical frame");
+    spec.publishes<PoseStamped>(kPoseFamily, Qos::sensor_data(), "each board's pose");
+    spec.publishes<Odometry>(kOdomFamily, Qos::sensor_data(),
+                             "each board's pose and velocity with their covariances");
+    // tf2's own QoS: its listeners are reliable readers, which a best-effort writer never meets.
+    spec.publishes<TFMessage>(kTf, Qos::reliable(), "the boards in the parent frame");
+    spec.publishes<TFMessage>(kTfStatic, Qos::latched(),
+                              "world -> camera_frame -> optical_frame, once");
+  }
+
+  explicit PoseOutputs(Context& context)
+      : Component(context),
+        in_world_(param<std::string>("parent") == "world"),
+        world_frame_(param<std::string>("world_frame")),
+        optical_frame_(param<std::string>("optical_frame")),
+        child_prefix_(param<std::string>("child_frame_prefix")),
+        pose_rate_(param<double>("pose_rate_hz")),
+        odom_rate_(param<double>("odom_rate_hz")),
+        tf_rate_(param<double>("tf_rate_hz")) {
+    const std::string parent = param<std::string>("parent");
+    if (parent != "camera" && parent != "world") {
+      throw std::invalid_argument("parent: '" + parent + "'; expected camera or world");
+    }
+    const std::string camera_frame = param<std::string>("camera_frame");
+    for (const auto& [name, value] : {std::pair{"world_frame", world_frame_},
+                                      {"camera_frame", camera_frame},
+                                      {"optical_frame", optical_frame_}}) {
+      if (value.empty()) throw std::invalid_argument(std::string(name) + " is empty");
+    }
+    const auto mounting = param<std::vector<double>>("camera_in_world");
+    if (mounting.size() != 6) {
+      throw std::invalid_argument(
+          "camera_in_world: expected 6 numbers (x, y, z, roll, pitch, "
+          "yaw), got " +
+          std::to_string(mounting.size()));
+    }
+    const Eigen::Isometry3d world_from_camera = from_xyz_rpy(
+        {mounting[0], mounting[1], mounting[2]}, {mounting[3], mounting[4], mounting[5]});
+    Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
+    camera_from_optical.linear() = optical_in_body().toRotationMatrix();
+    world_from_optical_ = world_from_camera * camera_from_optical;
+
+    tf_ = create_publisher<TFMessage>(kTf);
+    create_subscription<ConstellationPoseArray>(
+        kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
+
+    // Latched: a tf2 listener that starts later still gets the camera's place.
+    TFMessage mounted;
+    std_msgs::msg::Header header;
+    header.stamp(to_time_msg(now()));
+    header.frame_id(world_frame_);
+    mounted.transforms().push_back(to_transform(header, camera_frame, world_from_camera));
+    header.frame_id(camera_frame);
+    mounted.transforms().push_back(to_transform(header, optical_frame_, camera_from_optical));
+    create_publisher<TFMessage>(kTfStatic).publish(mounted);
+
+    log().info(
+        "boards of {} in frame {} on /mocap/<board>/pose, /mocap/<board>/odom and /tf; "
+        "{} -> {} -> {} on /tf_static",
+        kPoses, in_world_ ? world_frame_ : optical_frame_, world_frame_, camera_frame,
+        optical_frame_);
+  }
+
+  ~PoseOutputs() override {
+    log().info(
+        "{} pose arrays: {} boards published; {} poses in another frame than {}, {} "
+        "invalid, {} boards without per-board topics",
+        arrays_, boards_published_, wrong_frame_, optical_frame_, invalid_, unpublishable_.size());
+  }
+
+ private:
+  struct BoardOutputs {
+    Publisher<PoseStamped> pose;
+    Publisher<Odometry> odom;
+  };
+
+  void on_poses(const ConstellationPoseArray& poses) {
+    ++arrays_;
+    TFMessage transforms;
+    for (const ConstellationPose& pose : poses.poses()) {
+      std_msgs::msg::Header header = pose.pose().header();
+      if (header.frame_id().empty()) header.frame_id(poses.header().frame_id());
+      if (header.frame_id().empty()) header.frame_id(optical_frame_);
+      if (header.frame_id() != optical_frame_) {
+        if (wrong_frame_++ == 0) {
+          log().warn("a pose in frame '{}', not optical_frame '{}': skipped (and counted)",
+                     header.frame_id(), optical_frame_);
+        }
+        continue;
+      }
+      std::optional<Eigen::Isometry3d> optical_from_board = to_isometry(pose.pose().pose());
+      if (!optical_from_board) {
+        ++invalid_;
+        continue;
+      }
+      BodyState board{*optical_from_board, to_matrix(pose.covariance()),
+                      Eigen::Vector3d(pose.velocity().linear().x(), pose.velocity().linear().y(),
+                                      pose.velocity().linear().z()),
+                      Eigen::Vector3d(pose.velocity().angular().x(), pose.velocity().angular().y(),
+                                      pose.velocity().angular().z()),
+                      to_matrix(pose.velocity_covariance())};
+      if (in_world_) {
+        board = seen_from(world_from_optical_, board);
+        header.frame_id(world_frame_);
+      }
+      const int64_t stamp_ns = to_nanoseconds(header.stamp());
+      const std::string child = child_prefix_ + pose.name();
+      ++boards_published_;
+      if (tf_rate_.due(pose.name(), stamp_ns)) {
+        transforms.transforms().push_back(to_transform(header, child, board.parent_from_body));
+      }
+      BoardOutputs* outputs = outputs_of(pose.name());
+      if (outputs == nullptr) continue;
+      if (pose_rate_.due(pose.name(), stamp_ns)) {
+        PoseStamped message;
+        message.header(header);
+        message.pose(to_pose_message(board.parent_from_body));
+        outputs->pose.publish(message);
+      }
+      if (odom_rate_.due(pose.name(), stamp_ns)) {
+        const BodyTwist twist = twist_in_body(board);
+        Odometry message;
+        message.header(header);
+        message.child_frame_id(child);
+        message.pose().pose(to_pose_message(board.parent_from_body));
+        message.pose().covariance(to_row_major(board.pose_covariance));
+        message.twist().twist().linear(to_vector3(twist.linear));
+        message.twist().twist().angular(to_vector3(twist.angular));
+        message.twist().covariance(to_row_major(twist.covariance));
+        outputs->odom.publish(message);
+      }
+    }
+    if (!transforms.transforms().empty()) tf_.publish(transforms);
+  }
+
+  // The board's publishers, made when it is first seen; null when its name makes no topic
+  // name (it is still on /tf).
+  BoardOutputs* outputs_of(const std::string& board) {
+    if (auto found = outputs_.find(board); found != outputs_.end()) return &found->second;
+    if (unpublishable_.count(board) > 0) return nullptr;
+    try {
+      BoardOutputs outputs{create_publisher<PoseStamped>("/mocap/" + board + "/pose"),
+                           create_publisher<Odometry>("/mocap/" + board + "/odom")};
+      return &outputs_.emplace(board, std::move(outputs)).first->second;
+    } catch (const std::exception& e) {
+      unpublishable_.insert(board);
+      log().warn("board '{}' gets no /mocap/<board>/pose or /odom (still on /tf): {}", board,
+                 e.what());
+      return nullptr;
+    }
+  }
+
+  const bool in_world_;
+  const std::string world_frame_;
+  const std::string optical_frame_;
+  const std::string child_prefix_;
+  Eigen::Isometry3d world_from_optical_ = Eigen::Isometry3d::Identity();
+  StampRate pose_rate_, odom_rate_, tf_rate_;
+  Publisher<TFMessage> tf_;
+  std::map<std::string, BoardOutputs> outputs_;
+  std::set<std::string> unpublishable_;
+  uint64_t arrays_ = 0, boards_published_ = 0, wrong_frame_ = 0, invalid_ = 0;
+};
+
+}  // namespace
+}  // namespace mocap::outputs
+
+MOCAP_REGISTER_COMPONENT(mocap::outputs::PoseOutputs, "pose_outputs")
