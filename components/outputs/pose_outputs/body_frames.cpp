@@ -37,6 +37,24 @@ BodyTwist twist_in_body(const BodyState& body) {
           both * body.velocity_covariance * both.transpose()};
 }
 
+BodyState attached(const BodyState& body, const Eigen::Isometry3d& body_from_attached) {
+  // The lever arm from the body's origin to the attached one, in the parent frame. With the
+  // rotation perturbed on the left, R = exp(δθ) R̂: r = exp(δθ) r̂, so ∂r/∂δθ = -[r]x; with
+  // the angular velocity, ∂(ω x r)/∂ω = -[r]x.
+  const Eigen::Vector3d arm = body.parent_from_body.linear() * body_from_attached.translation();
+  Eigen::Matrix3d arm_cross;
+  arm_cross << 0, -arm.z(), arm.y(), arm.z(), 0, -arm.x(), -arm.y(), arm.x(), 0;
+  Matrix6d lever = Matrix6d::Identity();
+  lever.topRightCorner<3, 3>() = -arm_cross;
+  BodyState result;
+  result.parent_from_body = body.parent_from_body * body_from_attached;
+  result.pose_covariance = lever * body.pose_covariance * lever.transpose();
+  result.linear_velocity = body.linear_velocity + body.angular_velocity.cross(arm);
+  result.angular_velocity = body.angular_velocity;
+  result.velocity_covariance = lever * body.velocity_covariance * lever.transpose();
+  return result;
+}
+
 Eigen::Isometry3d from_xyz_rpy(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy) {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
   transform.translate(xyz);

@@ -44,6 +44,11 @@ struct BodyTwist {
 };
 BodyTwist twist_in_body(const BodyState& body);
 
+// A body rigidly attached to `body` (a drone carrying the board), `body_from_attached` its
+// place on it: pose composed; its origin's velocity gains the lever arm's ω × r; both
+// covariances carried through the lever arm (to first order).
+BodyState attached(const BodyState& body, const Eigen::Isometry3d& body_from_attached);
+
 // The rigid transform of x, y, z (m) and roll, pitch, yaw (rad, about fixed x, then y, then
 // z: ROS's convention, R = Rz(yaw) Ry(pitch) Rx(roll)).
 Eigen::Isometry3d from_xyz_rpy(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy);

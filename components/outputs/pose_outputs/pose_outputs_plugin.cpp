@@ -91,6 +91,14 @@ class StampRate {
   std::map<std::string, int64_t> last_ns_;
 };
 
+// tf2_ros's TransformBroadcaster: reliable, volatile, the last 100 kept.
+Qos tf_qos() {
+  Qos qos = Qos::reliable();
+  qos.history = History::KeepLast;
+  qos.depth = 100;
+  return qos;
+}
+
 class PoseOutputs final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
@@ -123,7 +131,7 @@ class PoseOutputs final : public Component {
     spec.publishes<Odometry>(kOdomFamily, Qos::sensor_data(),
                              "each board's pose and velocity with their covariances");
     // tf2's own QoS: its listeners are reliable readers, which a best-effort writer never meets.
-    spec.publishes<TFMessage>(kTf, Qos::reliable(), "the boards in the parent frame");
+    spec.publishes<TFMessage>(kTf, tf_qos(), "the boards in the parent frame");
     spec.publishes<TFMessage>(kTfStatic, Qos::latched(),
                               "world -> camera_frame -> optical_frame, once");
   }

@@ -1,0 +1,191 @@
+// px4_odometry: one tracked board, carried by a PX4 vehicle, as px4_msgs/VehicleOdometry on
+// /fmu/in/vehicle_visual_odometry, the topic PX4's uXRCE-DDS agent forwards to the flight
+// controller's external-vision input (remap it to /fmu/in/vehicle_mocap_odometry for PX4's
+// motion-capture input). Frames converted to PX4's (px4_frames.hpp); rate kept by the poses'
+// capture stamps.
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <mocap/component.hpp>
+#include <mocap/component_spec.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <px4_msgs/msg/vehicle_odometry.hpp>
+
+#include "body_frames.hpp"
+#include "pose_message.hpp"
+#include "px4_frames.hpp"
+
+namespace mocap::outputs {
+namespace {
+
+using mocap_msgs::msg::ConstellationPose;
+using mocap_msgs::msg::ConstellationPoseArray;
+using px4_msgs::msg::VehicleOdometry;
+
+constexpr const char* kPoses = "/mocap/poses";
+constexpr const char* kOdometry = "/fmu/in/vehicle_visual_odometry";
+
+// What PX4's ROS 2 examples publish with: reliable, the last 10 kept. A reliable writer meets
+// the agent's reader whichever reliability it asks for; keep-last never holds the graph up.
+Qos px4_qos() {
+  Qos qos = Qos::reliable();
+  qos.history = History::KeepLast;
+  qos.depth = 10;
+  return qos;
+}
+
+Eigen::Isometry3d transform_parameter(const std::vector<double>& values, const char* name) {
+  if (values.size() != 6) {
+    throw std::invalid_argument(std::string(name) +
+                                ": expected 6 numbers (x, y, z, roll, pitch, yaw), got " +
+                                std::to_string(values.size()));
+  }
+  return from_xyz_rpy({values[0], values[1], values[2]}, {values[3], values[4], values[5]});
+}
+
+Matrix6d to_matrix(const std::array<double, 36>& row_major) {
+  return Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(row_major.data());
+}
+
+template <size_t N>
+std::array<float, N> to_floats(const Eigen::Matrix<double, N, 1>& v) {
+  std::array<float, N> values{};
+  for (size_t i = 0; i < N; ++i) values[i] = static_cast<float>(v[static_cast<Eigen::Index>(i)]);
+  return values;
+}
+
+uint64_t microseconds(int64_t nanoseconds) { return static_cast<uint64_t>(nanoseconds / 1000); }
+
+class Px4OdometryComponent final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "One tracked board carried by a PX4 vehicle as px4_msgs/VehicleOdometry (PX4 v1.14 to "
+        "v1.18) for PX4's uXRCE-DDS bridge: position, attitude, velocities and variances in "
+        "PX4's frames (world NED or FRD, body FRD), at rate_hz by capture stamps.");
+    spec.parameter("board", std::string(), "the board the vehicle carries (required)");
+    spec.parameter("pose_frame", std::string("frd"),
+                   "frd: our world (z up) has any heading, PX4 gets FRD; ned: our world is ENU "
+                   "(x east, y north, z up), PX4 gets NED");
+    spec.parameter("camera_in_world", std::vector<double>{0, 0, 0, 0, 0, 0},
+                   "the camera's REP 103 body frame in the world: x, y, z (m), roll, pitch, yaw "
+                   "(rad)");
+    spec.parameter("vehicle_in_board", std::vector<double>{0, 0, 0, 0, 0, 0},
+                   "the vehicle's FLU body frame (x forward, y left, z up) in the board's frame: "
+                   "x, y, z (m), roll, pitch, yaw (rad)");
+    spec.parameter("optical_frame", std::string("camera_ir_optical"),
+                   "the frame of /mocap/poses; poses in another are counted and skipped");
+    spec.parameter("rate_hz", 50.0,
+                   "most messages a second, by the poses' capture stamps (PX4 wants 30-50; 0: "
+                   "every frame)")
+        .min(0);
+    spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
+                                            "the tracked boards in the camera's optical frame");
+    spec.publishes<VehicleOdometry>(kOdometry, px4_qos(), "the vehicle's odometry");
+  }
+
+  explicit Px4OdometryComponent(Context& context)
+      : Component(context),
+        board_(param<std::string>("board")),
+        optical_frame_(param<std::string>("optical_frame")) {
+    if (board_.empty()) throw std::invalid_argument("board: name the board the vehicle carries");
+    const std::string frame = param<std::string>("pose_frame");
+    if (frame != "frd" && frame != "ned") {
+      throw std::invalid_argument("pose_frame: '" + frame + "'; expected frd or ned");
+    }
+    frame_ = frame == "ned" ? Px4Frame::Ned : Px4Frame::Frd;
+    Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
+    camera_from_optical.linear() = optical_in_body().toRotationMatrix();
+    world_from_optical_ =
+        transform_parameter(param<std::vector<double>>("camera_in_world"), "camera_in_world") *
+        camera_from_optical;
+    board_from_vehicle_ =
+        transform_parameter(param<std::vector<double>>("vehicle_in_board"), "vehicle_in_board");
+    const double rate = param<double>("rate_hz");
+    period_ns_ = rate > 0 ? std::llround(1e9 / rate) : 0;
+    publisher_ = create_publisher<VehicleOdometry>(kOdometry);
+    create_subscription<ConstellationPoseArray>(
+        kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
+    log().info("{} as PX4 odometry ({} world, FRD body) at {} on {}", board_,
+               frame == "ned" ? "NED" : "FRD",
+               rate > 0 ? fmt::format("{} Hz at most", rate) : std::string("every frame"),
+               kOdometry);
+  }
+
+  ~Px4OdometryComponent() override {
+    log().info("{} messages sent; {} poses of {} skipped for the rate, {} in another frame", sent_,
+               skipped_for_rate_, board_, wrong_frame_);
+  }
+
+ private:
+  void on_poses(const ConstellationPoseArray& poses) {
+    for (const ConstellationPose& pose : poses.poses()) {
+      if (pose.name() != board_) continue;
+      std::string frame_id = pose.pose().header().frame_id();
+      if (frame_id.empty()) frame_id = poses.header().frame_id();
+      if (!frame_id.empty() && frame_id != optical_frame_) {
+        if (wrong_frame_++ == 0) {
+          log().warn("{} in frame '{}', not optical_frame '{}': skipped (and counted)", board_,
+                     frame_id, optical_frame_);
+        }
+        continue;
+      }
+      auto optical_from_board = to_isometry(pose.pose().pose());
+      if (!optical_from_board) continue;
+      const int64_t stamp_ns = to_nanoseconds(pose.pose().header().stamp());
+      if (period_ns_ > 0 && last_ns_ && stamp_ns - *last_ns_ < period_ns_ - period_ns_ / 100) {
+        ++skipped_for_rate_;
+        continue;
+      }
+      last_ns_ = stamp_ns;
+      const auto& v = pose.velocity();
+      const BodyState board{*optical_from_board, to_matrix(pose.covariance()),
+                            Eigen::Vector3d(v.linear().x(), v.linear().y(), v.linear().z()),
+                            Eigen::Vector3d(v.angular().x(), v.angular().y(), v.angular().z()),
+                            to_matrix(pose.velocity_covariance())};
+      const Px4Odometry odometry =
+          to_px4(attached(seen_from(world_from_optical_, board), board_from_vehicle_), frame_);
+
+      VehicleOdometry message;
+      message.timestamp(microseconds(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                         std::chrono::system_clock::now().time_since_epoch())
+                                         .count()));
+      message.timestamp_sample(microseconds(stamp_ns));
+      message.pose_frame(static_cast<uint8_t>(odometry.frame));
+      message.position(to_floats<3>(odometry.position));
+      message.q(to_floats<4>(
+          Eigen::Vector4d(odometry.q[0], odometry.q[1], odometry.q[2], odometry.q[3])));
+      message.velocity_frame(static_cast<uint8_t>(odometry.frame));
+      message.velocity(to_floats<3>(odometry.velocity));
+      message.angular_velocity(to_floats<3>(odometry.angular_velocity));
+      message.position_variance(to_floats<3>(odometry.position_variance));
+      message.orientation_variance(to_floats<3>(odometry.orientation_variance));
+      message.velocity_variance(to_floats<3>(odometry.velocity_variance));
+      message.reset_counter(0);
+      message.quality(100);  // unused by PX4; 0 would say "invalid"
+      publisher_.publish(message);
+      ++sent_;
+    }
+  }
+
+  const std::string board_;
+  const std::string optical_frame_;
+  Px4Frame frame_ = Px4Frame::Frd;
+  Eigen::Isometry3d world_from_optical_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d board_from_vehicle_ = Eigen::Isometry3d::Identity();
+  int64_t period_ns_ = 0;
+  std::optional<int64_t> last_ns_;
+  Publisher<VehicleOdometry> publisher_;
+  uint64_t sent_ = 0, skipped_for_rate_ = 0, wrong_frame_ = 0;
+};
+
+}  // namespace
+}  // namespace mocap::outputs
+
+MOCAP_REGISTER_COMPONENT(mocap::outputs::Px4OdometryComponent, "px4_odometry")
