@@ -27,9 +27,10 @@ case "$mode" in
     # The runtime's unit tests (executor, timers, component host, intra-process and shared
     # memory transports, shutdown), the graph and DDS tests on both implementations (each
     # process a multi-threaded executor), the bag tools' record, play and stop tests and
-    # the bag recorder and player components in a running pipeline, and the recorder's
-    # forced-exit hook, which runs beside its writer thread.
-    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort)|Launcher|BagPipeline|BagRecorderComponent)'
+    # the bag recorder and player components in a running pipeline, the recorder's
+    # forced-exit hook, which runs beside its writer thread, and the VRPN tracker server's
+    # thread beside the reports of the pose outputs.
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry)'
     ;;
   *)
     echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2

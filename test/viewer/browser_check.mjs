@@ -6,11 +6,12 @@
 // prints "WAITING_FOR_START", the test starts the bridge again and creates FLAG_FILE, and the
 // page must reconnect and draw new frames. With --floor (a PixArt graph, no camera) it checks
 // the floor instead: the ceiling cameras' footprints and the robots drawn. With --refused (a
-// bridge asking for a token the URL lacks) it checks that the page says it is disconnected.
+// bridge asking for a token the URL lacks) it checks that the page says it is disconnected;
+// with --tf (a bridge offering /tf but not /mocap/poses), that the top view draws the boards.
 // HTTPS certificates are not checked (the TLS test's is self-signed). One line per check; exit 0
 // when all passed.
 //
-//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused]
+//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused | --tf]
 import { chromium } from "playwright-core";
 import { existsSync } from "node:fs";
 
@@ -50,6 +51,16 @@ try {
   const errors = [];
   page.on("pageerror", (error) => errors.push(error.message));
   await page.goto(url);
+  if (mode === "--tf") {
+    // A bridge offering /tf but not /mocap/poses: the top view draws the boards from tf2.
+    const seen = await snapshot(page, (s) => s?.transformsUsed >= 30 && s.boardsOnTop > 0, 90000);
+    check(true, `top view: ${seen.boardsOnTop} board(s) from ${seen.transformsUsed} /tf transforms`);
+    check(seen.poseReadout === "", "no /mocap/poses reached the page");
+    await page.screenshot({ path: screenshot, fullPage: true });
+    check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+    await browser.close();
+    process.exit(failed ? 1 : 0);
+  }
   if (mode === "--refused") {
     // Served the page, refused the WebSocket (no token): the page must say so, and draw nothing.
     await page.waitForFunction(() => /disconnected/.test(document.querySelector("#status")?.textContent ?? ""),

@@ -390,6 +390,25 @@ TEST_F(FoxgloveBridgeTest, ClientsPublishOnAllowedTopicsWhenClientPublishIsOn) {
   echo.signal(SIGTERM);
 }
 
+// A bridge that offers /tf but not /mocap/poses (as a ROS 2 graph's would): the page draws the
+// boards of pose_outputs' /tf in its top view. Screenshot: MOCAP_VIEWER_SCREENSHOT with "_tf"
+// before its extension, else the test's folder.
+TEST_F(FoxgloveBridgeTest, ThePageDrawsTheBoardsFromTf) {
+  start_graph({"viewer.topics=(?!/mocap/poses$).*"});
+  std::filesystem::path screenshot = dir_ / "tf.png";
+  if (const char* wanted = std::getenv("MOCAP_VIEWER_SCREENSHOT")) {
+    screenshot = std::filesystem::path(wanted);
+    screenshot.replace_filename(screenshot.stem().string() + "_tf" +
+                                screenshot.extension().string());
+  }
+  auto [code, page] =
+      test::run_command({"node", (viewer_tests() / "browser_check.mjs").string(),
+                         fmt::format("http://127.0.0.1:{}/", port_), screenshot.string(), "--tf"},
+                        {}, std::chrono::seconds(120));
+  EXPECT_EQ(code, 0) << page << "\n--- graph ---\n" << graph_->output();
+  EXPECT_NE(page.find("PASS top view: 1 board(s) from "), std::string::npos) << page;
+}
+
 // The built-in viewer in Debian's chromium (headless, playwright-core): frames drawn with one
 // circle per fiducial the tracker found, a changing pose readout, a screenshot
 // (MOCAP_VIEWER_SCREENSHOT, else the test's folder: docs/viewer.png is made this way), and the

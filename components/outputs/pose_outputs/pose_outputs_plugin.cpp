@@ -18,8 +18,9 @@
 #include <nav_msgs/msg/odometry.hpp>
 #include <tf2_msgs/msg/tf_message.hpp>
 
-#include "body_frames.hpp"
+#include "body_state_message.hpp"
 #include "pose_message.hpp"
+#include "stamp_rate.hpp"
 
 namespace mocap::outputs {
 namespace {
@@ -36,10 +37,6 @@ constexpr const char* kPoseFamily = "/mocap/{board}/pose";
 constexpr const char* kOdomFamily = "/mocap/{board}/odom";
 constexpr const char* kTf = "/tf";
 constexpr const char* kTfStatic = "/tf_static";
-
-Matrix6d to_matrix(const std::array<double, 36>& row_major) {
-  return Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(row_major.data());
-}
 
 std::array<double, 36> to_row_major(const Matrix6d& matrix) {
   std::array<double, 36> values{};
@@ -70,26 +67,6 @@ TransformStamped to_transform(const std_msgs::msg::Header& header, const std::st
   message.transform().rotation().w(q.w());
   return message;
 }
-
-// Keeps one output at most `rate_hz` per board, by the messages' stamps (0: every message).
-class StampRate {
- public:
-  explicit StampRate(double rate_hz)
-      : period_ns_(rate_hz > 0 ? static_cast<int64_t>(std::llround(1e9 / rate_hz)) : 0) {}
-
-  bool due(const std::string& board, int64_t stamp_ns) {
-    if (period_ns_ == 0) return true;
-    auto [last, first] = last_ns_.try_emplace(board, stamp_ns);
-    // A 1 % allowance: a 30 Hz camera's frames, 33.3 ms apart, all pass a 30 Hz output.
-    if (!first && stamp_ns - last->second < period_ns_ - period_ns_ / 100) return false;
-    last->second = stamp_ns;
-    return true;
-  }
-
- private:
-  int64_t period_ns_;
-  std::map<std::string, int64_t> last_ns_;
-};
 
 // tf2_ros's TransformBroadcaster: reliable, volatile, the last 100 kept.
 Qos tf_qos() {
@@ -155,15 +132,8 @@ class PoseOutputs final : public Component {
                                       {"optical_frame", optical_frame_}}) {
       if (value.empty()) throw std::invalid_argument(std::string(name) + " is empty");
     }
-    const auto mounting = param<std::vector<double>>("camera_in_world");
-    if (mounting.size() != 6) {
-      throw std::invalid_argument(
-          "camera_in_world: expected 6 numbers (x, y, z, roll, pitch, "
-          "yaw), got " +
-          std::to_string(mounting.size()));
-    }
-    const Eigen::Isometry3d world_from_camera = from_xyz_rpy(
-        {mounting[0], mounting[1], mounting[2]}, {mounting[3], mounting[4], mounting[5]});
+    const Eigen::Isometry3d world_from_camera =
+        from_xyz_rpy(param<std::vector<double>>("camera_in_world"), "camera_in_world");
     Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
     camera_from_optical.linear() = optical_in_body().toRotationMatrix();
     world_from_optical_ = world_from_camera * camera_from_optical;
@@ -216,17 +186,12 @@ class PoseOutputs final : public Component {
         }
         continue;
       }
-      std::optional<Eigen::Isometry3d> optical_from_board = to_isometry(pose.pose().pose());
-      if (!optical_from_board) {
+      std::optional<BodyState> measured = body_state(pose);
+      if (!measured) {
         ++invalid_;
         continue;
       }
-      BodyState board{*optical_from_board, to_matrix(pose.covariance()),
-                      Eigen::Vector3d(pose.velocity().linear().x(), pose.velocity().linear().y(),
-                                      pose.velocity().linear().z()),
-                      Eigen::Vector3d(pose.velocity().angular().x(), pose.velocity().angular().y(),
-                                      pose.velocity().angular().z()),
-                      to_matrix(pose.velocity_covariance())};
+      BodyState board = *measured;
       if (in_world_) {
         board = seen_from(world_from_optical_, board);
         header.frame_id(world_frame_);

@@ -17,9 +17,9 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <px4_msgs/msg/vehicle_odometry.hpp>
 
-#include "body_frames.hpp"
-#include "pose_message.hpp"
+#include "body_state_message.hpp"
 #include "px4_frames.hpp"
+#include "stamp_rate.hpp"
 
 namespace mocap::outputs {
 namespace {
@@ -38,19 +38,6 @@ Qos px4_qos() {
   qos.history = History::KeepLast;
   qos.depth = 10;
   return qos;
-}
-
-Eigen::Isometry3d transform_parameter(const std::vector<double>& values, const char* name) {
-  if (values.size() != 6) {
-    throw std::invalid_argument(std::string(name) +
-                                ": expected 6 numbers (x, y, z, roll, pitch, yaw), got " +
-                                std::to_string(values.size()));
-  }
-  return from_xyz_rpy({values[0], values[1], values[2]}, {values[3], values[4], values[5]});
-}
-
-Matrix6d to_matrix(const std::array<double, 36>& row_major) {
-  return Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(row_major.data());
 }
 
 template <size_t N>
@@ -93,22 +80,19 @@ class Px4OdometryComponent final : public Component {
   explicit Px4OdometryComponent(Context& context)
       : Component(context),
         board_(param<std::string>("board")),
-        optical_frame_(param<std::string>("optical_frame")) {
+        optical_frame_(param<std::string>("optical_frame")),
+        rate_(param<double>("rate_hz")) {
     if (board_.empty()) throw std::invalid_argument("board: name the board the vehicle carries");
     const std::string frame = param<std::string>("pose_frame");
     if (frame != "frd" && frame != "ned") {
       throw std::invalid_argument("pose_frame: '" + frame + "'; expected frd or ned");
     }
     frame_ = frame == "ned" ? Px4Frame::Ned : Px4Frame::Frd;
-    Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
-    camera_from_optical.linear() = optical_in_body().toRotationMatrix();
-    world_from_optical_ =
-        transform_parameter(param<std::vector<double>>("camera_in_world"), "camera_in_world") *
-        camera_from_optical;
+    world_from_optical_ = world_from_optical(
+        from_xyz_rpy(param<std::vector<double>>("camera_in_world"), "camera_in_world"));
     board_from_vehicle_ =
-        transform_parameter(param<std::vector<double>>("vehicle_in_board"), "vehicle_in_board");
+        from_xyz_rpy(param<std::vector<double>>("vehicle_in_board"), "vehicle_in_board");
     const double rate = param<double>("rate_hz");
-    period_ns_ = rate > 0 ? std::llround(1e9 / rate) : 0;
     publisher_ = create_publisher<VehicleOdometry>(kOdometry);
     create_subscription<ConstellationPoseArray>(
         kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
@@ -136,21 +120,15 @@ class Px4OdometryComponent final : public Component {
         }
         continue;
       }
-      auto optical_from_board = to_isometry(pose.pose().pose());
-      if (!optical_from_board) continue;
+      const std::optional<BodyState> board = body_state(pose);
+      if (!board) continue;
       const int64_t stamp_ns = to_nanoseconds(pose.pose().header().stamp());
-      if (period_ns_ > 0 && last_ns_ && stamp_ns - *last_ns_ < period_ns_ - period_ns_ / 100) {
+      if (!rate_.due(board_, stamp_ns)) {
         ++skipped_for_rate_;
         continue;
       }
-      last_ns_ = stamp_ns;
-      const auto& v = pose.velocity();
-      const BodyState board{*optical_from_board, to_matrix(pose.covariance()),
-                            Eigen::Vector3d(v.linear().x(), v.linear().y(), v.linear().z()),
-                            Eigen::Vector3d(v.angular().x(), v.angular().y(), v.angular().z()),
-                            to_matrix(pose.velocity_covariance())};
       const Px4Odometry odometry =
-          to_px4(attached(seen_from(world_from_optical_, board), board_from_vehicle_), frame_);
+          to_px4(attached(seen_from(world_from_optical_, *board), board_from_vehicle_), frame_);
 
       VehicleOdometry message;
       message.timestamp(microseconds(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -179,8 +157,7 @@ class Px4OdometryComponent final : public Component {
   Px4Frame frame_ = Px4Frame::Frd;
   Eigen::Isometry3d world_from_optical_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d board_from_vehicle_ = Eigen::Isometry3d::Identity();
-  int64_t period_ns_ = 0;
-  std::optional<int64_t> last_ns_;
+  StampRate rate_;
   Publisher<VehicleOdometry> publisher_;
   uint64_t sent_ = 0, skipped_for_rate_ = 0, wrong_frame_ = 0;
 };

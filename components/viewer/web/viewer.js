@@ -14,6 +14,7 @@ const BASE = "/base/pose";
 const ROBOTS = "/pixart/robots";
 const TURRET = "/turret/joint_states";
 const FOOTPRINTS = "/pixart/camera_footprints";
+const TF = "/tf";
 // Large and drawn by the overlay component already: not subscribed.
 const SKIPPED = new Set(["/mocap/overlay"]);
 
@@ -28,6 +29,8 @@ const state = (window.viewerState = {
   posesInFrame: 0,  // the poses estimated from it
   footprintsDrawn: 0,  // on the floor
   robotsDrawn: 0,
+  boardsOnTop: 0,  // boards drawn in the top view
+  transformsUsed: 0,  // /tf transforms drawn there, when /mocap/poses does not come
   poseReadout: "",
   latencyMs: null,
   // Each drawn image's age when drawn (ms, page clock minus capture stamp): the last 1000.
@@ -146,6 +149,15 @@ let latestPoses = null;
 let turret = null;  // {pan, tilt} in radians
 let footprints = [];
 const trails = new Map();  // pose name -> [{x, z}]
+let posesAt = 0;  // page time of the last /mocap/poses
+
+// A board's place in the camera's optical frame, seen from above (x right, z forward).
+function addToTrail(name, position) {
+  const trail = trails.get(name) ?? [];
+  trail.push({ x: position.x, z: position.z });
+  if (trail.length > 150) trail.shift();
+  trails.set(name, trail);
+}
 let base = null;
 let robots = [];
 const alerts = [];
@@ -179,15 +191,21 @@ const handlers = {
     remember(recentPoses, stampKey(message.header), message.poses);
     dirty.camera = true;
     state.latencyMs = Date.now() - stampSeconds(message.header) * 1000;
-    for (const pose of message.poses) {
-      const p = pose.pose.pose.position;
-      const trail = trails.get(pose.name) ?? [];
-      trail.push({ x: p.x, z: p.z });
-      if (trail.length > 150) trail.shift();
-      trails.set(pose.name, trail);
-    }
+    posesAt = Date.now();
+    for (const pose of message.poses) addToTrail(pose.name, pose.pose.pose.position);
     dirty.side = true;
     renderPoses();
+  },
+  // The boards as tf2 has them (pose_outputs, or any ROS 2 graph's /tf), drawn when
+  // /mocap/poses does not come: those whose parent is a camera's optical frame.
+  [TF](message) {
+    if (Date.now() - posesAt < 2000) return;
+    for (const t of message.transforms) {
+      if (!t.header.frame_id.endsWith("_optical")) continue;
+      addToTrail(t.child_frame_id, t.transform.translation);
+      state.transformsUsed++;
+      dirty.side = true;
+    }
   },
   [BASE](message) {
     base = message.pose;
@@ -404,6 +422,7 @@ function drawTop() {
   context.fillStyle = "#d8dee6";
   context.fillRect(ox - 6, oy - 4, 12, 8);
   let k = 0;
+  state.boardsOnTop = trails.size;
   for (const [name, trail] of trails) {
     const colour = COLOURS[k++ % COLOURS.length];
     context.strokeStyle = colour;

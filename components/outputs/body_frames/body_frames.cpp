@@ -1,5 +1,8 @@
 #include "body_frames.hpp"
 
+#include <stdexcept>
+#include <string>
+
 namespace mocap::outputs {
 namespace {
 
@@ -62,6 +65,21 @@ Eigen::Isometry3d from_xyz_rpy(const Eigen::Vector3d& xyz, const Eigen::Vector3d
                    Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
                    Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()));
   return transform;
+}
+
+Eigen::Isometry3d from_xyz_rpy(const std::vector<double>& xyz_rpy, std::string_view parameter) {
+  if (xyz_rpy.size() != 6) {
+    throw std::invalid_argument(std::string(parameter) +
+                                ": expected 6 numbers (x, y, z, roll, pitch, yaw), got " +
+                                std::to_string(xyz_rpy.size()));
+  }
+  return from_xyz_rpy({xyz_rpy[0], xyz_rpy[1], xyz_rpy[2]}, {xyz_rpy[3], xyz_rpy[4], xyz_rpy[5]});
+}
+
+Eigen::Isometry3d world_from_optical(const Eigen::Isometry3d& world_from_camera) {
+  Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
+  camera_from_optical.linear() = optical_in_body().toRotationMatrix();
+  return world_from_camera * camera_from_optical;
 }
 
 }  // namespace mocap::outputs

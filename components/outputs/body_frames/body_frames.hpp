@@ -8,6 +8,9 @@
 // in the body's own frame (child_frame_id).
 #pragma once
 
+#include <string_view>
+#include <vector>
+
 #include <Eigen/Geometry>
 
 namespace mocap::outputs {
@@ -52,5 +55,11 @@ BodyState attached(const BodyState& body, const Eigen::Isometry3d& body_from_att
 // The rigid transform of x, y, z (m) and roll, pitch, yaw (rad, about fixed x, then y, then
 // z: ROS's convention, R = Rz(yaw) Ry(pitch) Rx(roll)).
 Eigen::Isometry3d from_xyz_rpy(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy);
+// The same from a parameter's six numbers. Throws std::invalid_argument naming `parameter`
+// unless there are six: "camera_in_world: expected 6 numbers (x, y, z, roll, pitch, yaw), got 3".
+Eigen::Isometry3d from_xyz_rpy(const std::vector<double>& xyz_rpy, std::string_view parameter);
+
+// The camera's optical frame in the world, from its REP 103 body frame in the world.
+Eigen::Isometry3d world_from_optical(const Eigen::Isometry3d& world_from_camera);
 
 }  // namespace mocap::outputs
