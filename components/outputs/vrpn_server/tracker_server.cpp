@@ -252,7 +252,7 @@ struct TrackerServer::Impl {
       for (auto& client : clients) {
         if (client->state != Client::State::Connecting) write_out(*client);
       }
-      std::erase_if(clients, [this](const std::unique_ptr<Client>& client) {
+      std::erase_if(clients, [](const std::unique_ptr<Client>& client) {
         if (!client->closing) return false;
         ::close(client->fd);
         return true;
