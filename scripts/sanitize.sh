@@ -61,10 +61,12 @@ if [ "$mode" = address ]; then
   filter=(-LE install -E "^($left_out)\$")
 else
   # The threaded parts: the runtime and both transports with their tests, the bag library
-  # and tools, and the components the graph tests start in threads.
+  # and tools, the components the graph tests start in threads, and the pose outputs with the
+  # VRPN server's thread.
   cmake --build "$build" --parallel "$(nproc)" --target mocap_unit_tests \
     mocap_integration_tests mocap_test_bag_tools mocap_test_bag_pipeline \
-    mocap_plugin_bag_recorder mocap_plugin_bag_player
+    mocap_plugin_bag_recorder mocap_plugin_bag_player mocap_test_pose_outputs \
+    mocap_test_px4_odometry mocap_test_vrpn_server
   # Not the two slow-subscriber loads (about a minute each, per implementation): their
   # publisher blocks and wakes as under the stalling subscriber, which runs.
   filter=(-R "$tsan_tests" -E "LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber ")

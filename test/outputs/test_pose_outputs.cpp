@@ -19,6 +19,7 @@
 #include <tf2_msgs/msg/tf_message.hpp>
 
 #include "body_frames.hpp"
+#include "outputs/pose_feeder.hpp"
 #include "plugin_loader.hpp"
 #include "pose_message.hpp"
 #include "test_support.hpp"
@@ -135,16 +136,7 @@ using mocap_msgs::msg::ConstellationPoseArray;
 using nav_msgs::msg::Odometry;
 using tf2_msgs::msg::TFMessage;
 
-class Feeder final : public Component {
- public:
-  static void declare(ComponentSpec& spec) {
-    spec.publishes<ConstellationPoseArray>("/mocap/poses", Qos::reliable(), "");
-  }
-  explicit Feeder(Context& context) : Component(context) {
-    publisher = create_publisher<ConstellationPoseArray>("/mocap/poses");
-  }
-  Publisher<ConstellationPoseArray> publisher;
-};
+using Feeder = test::PoseFeeder;
 
 class Collector final : public Component {
  public:

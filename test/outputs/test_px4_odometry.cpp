@@ -18,6 +18,7 @@
 #include <px4_msgs/msg/vehicle_odometry.hpp>
 
 #include "body_frames.hpp"
+#include "outputs/pose_feeder.hpp"
 #include "plugin_loader.hpp"
 #include "pose_message.hpp"
 #include "px4_frames.hpp"
@@ -188,16 +189,7 @@ TEST(Px4Odometry, TheBytesFollowPx4MsgsLayout) {
 using mocap_msgs::msg::ConstellationPoseArray;
 using px4_msgs::msg::VehicleOdometry;
 
-class Feeder final : public Component {
- public:
-  static void declare(ComponentSpec& spec) {
-    spec.publishes<ConstellationPoseArray>("/mocap/poses", Qos::reliable(), "");
-  }
-  explicit Feeder(Context& context) : Component(context) {
-    publisher = create_publisher<ConstellationPoseArray>("/mocap/poses");
-  }
-  Publisher<ConstellationPoseArray> publisher;
-};
+using Feeder = test::PoseFeeder;
 
 class Collector final : public Component {
  public:
