@@ -22,11 +22,10 @@ constexpr uint16_t kDefaultPort = 3883;
 constexpr size_t kCookieSize = 24;
 constexpr size_t kHeaderSize = 24;
 
-// The system message types.
+// The system message types this server reads or writes (-3, a UDP port, and -4, logging
+// requests, it ignores: it sends over TCP only and logs nothing).
 constexpr int32_t kSenderDescription = -1;
 constexpr int32_t kTypeDescription = -2;
-constexpr int32_t kUdpDescription = -3;
-constexpr int32_t kLogDescription = -4;
 
 // The type names of the messages this server sends or answers.
 constexpr std::string_view kPosQuatType = "vrpn_Tracker Pos_Quat";
