@@ -440,19 +440,35 @@ TEST_F(FoxgloveBridgeTest, TheViewerDrawsInARealBrowserAndSurvivesTheBridgeGoing
   EXPECT_GT(std::filesystem::file_size(screenshot), 10000u);
 }
 
+// launch_yaml/pixart_localization.yaml as shipped, its simulated adaptor in `dir`, its viewer
+// on `port` (of this machine), with `settings` (--set NAME=VALUE) more, on test domain `slot`.
+test::ChildProcess pixart_graph(const test::TempDir& dir, int port, int slot,
+                                const std::vector<std::string>& settings) {
+  const std::string adaptor = (dir / "adaptor").string();
+  std::vector<std::string> argv = {
+      (test::bin_dir() / "mocap_launch").string(),
+      (test::source_dir() / "launch_yaml" / "pixart_localization.yaml").string(),
+      "--set",
+      "box.device_link=" + adaptor,
+      "--set",
+      "bridge.device=" + adaptor,
+      "--set",
+      fmt::format("viewer.port={}", port)};
+  for (const std::string& setting : settings) {
+    argv.push_back("--set");
+    argv.push_back(setting);
+  }
+  return test::ChildProcess(argv, {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))}},
+                            dir / "graph.log");
+}
+
 // launch_yaml/pixart_localization.yaml as shipped: the localizer's latched camera footprints
 // reach a client that subscribes long after they were published, with each camera's view of the
 // LED plane centred under it, and the built-in page draws them with the robots.
 TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
   test::TempDir dir;
   const int port = free_port();
-  const std::string adaptor = (dir / "adaptor").string();
-  test::ChildProcess graph(
-      {(test::bin_dir() / "mocap_launch").string(),
-       (test::source_dir() / "launch_yaml" / "pixart_localization.yaml").string(), "--set",
-       "box.device_link=" + adaptor, "--set", "bridge.device=" + adaptor, "--set",
-       "viewer.address=127.0.0.1", "--set", fmt::format("viewer.port={}", port)},
-      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(62))}}, dir / "graph.log");
+  test::ChildProcess graph = pixart_graph(dir, port, 62, {});
   ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
       << graph.output();
   ::usleep(2'000'000);  // the footprints were published two seconds before anyone subscribed
@@ -571,14 +587,10 @@ TEST(FoxgloveBridgeSecurity, TokenAndTlsLetInOnlyWhoShouldComeIn) {
        "-keyout", key, "-out", certificate});
   ASSERT_EQ(made, 0) << openssl;
   const int port = free_port();
-  const std::string adaptor = (dir / "adaptor").string();
-  test::ChildProcess graph(
-      {(test::bin_dir() / "mocap_launch").string(),
-       (test::source_dir() / "launch_yaml" / "pixart_localization.yaml").string(), "--set",
-       "box.device_link=" + adaptor, "--set", "bridge.device=" + adaptor, "--set",
-       fmt::format("viewer.port={}", port), "--set", "viewer.token=s3cret/+token", "--set",
-       "viewer.certificate_file=" + certificate, "--set", "viewer.key_file=" + key},
-      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(72))}}, dir / "graph.log");
+  test::ChildProcess graph =
+      pixart_graph(dir, port, 72,
+                   {"viewer.token=s3cret/+token", "viewer.certificate_file=" + certificate,
+                    "viewer.key_file=" + key});
   ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
       << graph.output();
   EXPECT_NE(graph.output().find(fmt::format("on wss://127.0.0.1:{}", port)), std::string::npos)
