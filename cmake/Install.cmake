@@ -1,13 +1,14 @@
 # `cmake --install build --prefix P`:
 #
 #   P/bin/                         mocap_launch, mocap_topic, mocap_bag, mocap_calibrate,
-#                                  mocap_calibration_record
+#                                  mocap_calibration_record; mocap_msg_to_idl (dev)
 #   P/lib/                         the runtime, message and bag libraries; calibration archives
 #   P/lib/mocap_graph/plugins/     every shipped plugin (mocap_launch's default search path)
 #   P/include/                     component API, messages, camera models and calibration, bags
 #   P/share/mocap_graph/config/    the shipped configuration (plugins' default files)
 #   P/share/mocap_graph/launch_yaml/  the shipped launch files (their ../config paths hold)
-#   P/share/mocap_graph/idl/       the shipped IDL files, for your own messages to include
+#   P/share/mocap_graph/idl/       the shipped messages as IDL and .msg files, for your own
+#                                  messages to use
 #   P/share/mocap_graph/scripts/   scenario.sh: one host of the multi-host scenario;
 #                                  healthcheck.sh: a container's HEALTHCHECK
 #   P/lib/cmake/mocap_graph/       find_package(mocap_graph): imported targets mocap_graph::*,

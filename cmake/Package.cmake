@@ -47,8 +47,8 @@ set(CPACK_COMPONENT_DEV_DEPENDS runtime)
 set(CPACK_COMPONENT_DEV_DESCRIPTION
     "mocap-graph: build your own components and messages
  Headers (component API, messages, camera models, calibration, bags), the calibration archives,
- the shipped IDL files and the CMake package: find_package(mocap_graph), mocap_add_plugin,
- mocap_generate_messages.")
+ the shipped messages (IDL and ROS 2 .msg files) and the CMake package: find_package(mocap_graph),
+ mocap_add_plugin, mocap_generate_messages (with mocap_msg_to_idl for .msg files).")
 # What find_package(mocap_graph) finds (cmake/mocap_graphConfig.cmake.in) and fastddsgen, which
 # mocap_generate_messages runs.
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS

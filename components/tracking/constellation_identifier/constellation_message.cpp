@@ -38,9 +38,9 @@ mocap_msgs::msg::Constellation to_constellation_message(
       ++seen;
     }
     if (seen == 0) continue;
-    sub.Cx(cx / seen);
-    sub.Cy(cy / seen);
-    sub.Cz(0);
+    sub.cx(cx / seen);
+    sub.cy(cy / seen);
+    sub.cz(0);
     // How far the measured cross-ratio is from the database's; NaN for a broken line.
     float difference = std::numeric_limits<float>::quiet_NaN();
     for (const IdentifiedLine& line : found.lines) {
