@@ -6,8 +6,11 @@
 # Watch it live at http://localhost:8765/ (the built-in viewer), or from Foxglove/Lichtblick.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install_deps.sh
-[ -f build/build.ninja ] || cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
+# What building and running need, nothing else (no test tools, no Docker); a fresh build/
+# leaves the tests and benchmarks out (scripts/test.sh turns them on).
+scripts/install_deps.sh build run
+[ -f build/build.ninja ] || cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DMOCAP_BUILD_TESTS=OFF -DMOCAP_BUILD_BENCHMARKS=OFF > /dev/null
 cmake --build build --parallel "$(nproc)" --target mocap_launch mocap_plugins
 echo "demo: open http://localhost:8765/ to watch (or ws://localhost:8765 in Foxglove/Lichtblick)"
 exec build/bin/mocap_launch launch_yaml/follower_demo.yaml --duration 40 "$@"

@@ -92,11 +92,16 @@ if [ $# -eq 0 ]; then
   how="compiled in the container"
   # A built tree (scripts/test.sh's build/): its package goes into the image as it is, the
   # binaries the tests ran, instead of a second compilation in the container.
+  # The package the install test made from the same build (test/install/debian_package.sh)
+  # serves when it is newer than the build's last step; otherwise cpack makes it.
   if [ -f build/CMakeCache.txt ]; then
-    rm -f build/mocap-graph_*_amd64.deb
-    (cd build && cpack -G DEB -D CPACK_COMPONENTS_ALL=runtime) > "$work/cpack.log" 2>&1 ||
-      { tail -20 "$work/cpack.log"; fail "cpack in build/"; }
-    deb=$(ls build/mocap-graph_*_amd64.deb)
+    deb=$(ls build/mocap-graph_*_amd64.deb 2> /dev/null | head -1)
+    if [ -z "$deb" ] || [ ! "$deb" -nt build/.ninja_log ]; then
+      rm -f build/mocap-graph_*_amd64.deb
+      (cd build && cpack -G DEB -D CPACK_COMPONENTS_ALL=runtime) > "$work/cpack.log" 2>&1 ||
+        { tail -20 "$work/cpack.log"; fail "cpack in build/"; }
+      deb=$(ls build/mocap-graph_*_amd64.deb)
+    fi
     build_args=(--build-arg "MOCAP_DEB=$deb")
     how="from $deb"
   fi

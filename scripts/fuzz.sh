@@ -7,8 +7,10 @@
 #
 # The fuzzers come from build-asan/ (scripts/sanitize.sh address builds it; this script builds
 # just the fuzzers if it is missing). Each starts from its seed corpus, fuzz/corpus/NAME/, and
-# the inputs that once broke it, fuzz/regressions/NAME/; what it finds goes to
-# build-asan/fuzz/work/NAME/ and never into the repository. An input that crashes, leaks, hangs
+# the inputs that once broke it, fuzz/regressions/NAME/, and the corpus it grew in earlier runs
+# on this machine: MOCAP_FUZZ_CORPUS/NAME/ (default /var/cache/mocap-graph/fuzz, or
+# build-asan/fuzz/work when that cannot be made), outside the clone, so that each run goes
+# deeper instead of starting over; nothing found goes into the repository. An input that crashes, leaks, hangs
 # (over 10 s) or runs out of memory (over 2 GB) is kept in build-asan/fuzz/found/NAME/ and fails
 # the run: reproduce it with `build-asan/fuzz/fuzz_NAME FILE`, fix it, and keep the file in
 # fuzz/regressions/NAME/ (ctest replays it in every build).
@@ -43,7 +45,7 @@ done
 
 run_one() {
   local name=$1 seconds=$2 build=$3
-  local work=$build/fuzz/work/$name found=$build/fuzz/found/$name log=$build/fuzz/logs/$name.log
+  local work=$corpus_root/$name found=$build/fuzz/found/$name log=$build/fuzz/logs/$name.log
   mkdir -p "$work" "$found" "$(dirname "$log")"
   local inputs=(fuzz/corpus/"$name")
   [ -d fuzz/regressions/"$name" ] && inputs+=(fuzz/regressions/"$name")
@@ -53,6 +55,9 @@ run_one() {
   echo $? > "$log.status"
   set -e
 }
+corpus_root=${MOCAP_FUZZ_CORPUS:-/var/cache/mocap-graph/fuzz}
+mkdir -p "$corpus_root" 2> /dev/null && [ -w "$corpus_root" ] || corpus_root=$build/fuzz/work
+export corpus_root
 export -f run_one
 printf '%s\n' "${names[@]}" | xargs -P "$(nproc)" -I{} bash -c "run_one {} $seconds $build"
 

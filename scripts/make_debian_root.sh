@@ -14,16 +14,27 @@ if [ "${1:-}" = "--slim" ]; then
   shift
 fi
 root="${1:?usage: make_debian_root.sh [--slim] DIR}"
-mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -1)
-log=$(mktemp)
-if ! debootstrap --variant=minbase bookworm "$root" "${mirror:-http://deb.debian.org/debian}" \
-  > "$log" 2>&1; then
-  tail -20 "$log" >&2
+# debootstrap runs once a week: its root is kept as a tar file outside the clone
+# (MOCAP_CACHE_DIR, default /var/cache/mocap-graph) and unpacked for every later use.
+cache=${MOCAP_CACHE_DIR:-/var/cache/mocap-graph}/debian-bookworm-minbase.tar
+if [ -n "$(find "$cache" -mtime -7 2> /dev/null)" ]; then
+  mkdir -p "$root"
+  tar -C "$root" -xf "$cache"
+else
+  mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/debian.sources 2>/dev/null | head -1)
+  log=$(mktemp)
+  if ! debootstrap --variant=minbase bookworm "$root" "${mirror:-http://deb.debian.org/debian}" \
+    > "$log" 2>&1; then
+    tail -20 "$log" >&2
+    rm -f "$log"
+    echo "make_debian_root.sh: debootstrap into $root failed" >&2
+    exit 1
+  fi
   rm -f "$log"
-  echo "make_debian_root.sh: debootstrap into $root failed" >&2
-  exit 1
+  if mkdir -p "$(dirname "$cache")" 2> /dev/null; then
+    tar -C "$root" -cf "$cache.$$" . && mv "$cache.$$" "$cache" || rm -f "$cache.$$"
+  fi
 fi
-rm -f "$log"
 [ $slim -eq 1 ] || exit 0
 
 cat > "$root/etc/dpkg/dpkg.cfg.d/slim" << 'DPKG'

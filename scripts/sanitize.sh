@@ -26,11 +26,14 @@ case "$mode" in
     build=build-tsan
     # The runtime's unit tests (executor, timers, component host, intra-process and shared
     # memory transports, shutdown), the graph and DDS tests on both implementations (each
-    # process a multi-threaded executor), the bag tools' record, play and stop tests and
-    # the bag recorder and player components in a running pipeline, the recorder's
-    # forced-exit hook, which runs beside its writer thread, and the VRPN tracker server's
-    # thread beside the reports of the pose outputs.
-    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry)'
+    # process a multi-threaded executor), DDS security and mixed Fast DDS / Cyclone DDS graphs,
+    # the bag tools' record, play and stop tests and the bag recorder and player components in
+    # a running pipeline, the recorder's forced-exit hook, which runs beside its writer thread,
+    # the VRPN tracker server's thread beside the reports of the pose outputs; the viewer's
+    # WebSocket server thread and its client queues, pixart_bridge's serial reader and the
+    # simulated PixArt box, the Dynamixel follower's worker and the simulated AX-12 chain, and
+    # camera_source's capture thread.
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer|Security)|MixedDds|SecurityAcrossImplementations|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)
     echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2
@@ -45,28 +48,18 @@ cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=
   -DMOCAP_WERROR=ON -DMOCAP_BUILD_TESTS=ON -DMOCAP_BUILD_BENCHMARKS=OFF > /dev/null
 if [ "$mode" = address ]; then
   cmake --build "$build" --parallel "$(nproc)"
-  # All but the two packaging tests (label install): they check what the plain build installs
-  # and packages, and a sanitized build is never installed or packaged. And all but four tests
-  # that assume real-time speed, which AddressSanitizer takes several times from: the follower
-  # demo's pointing bounds, the browser's frame drawn with its fiducials and the independent
-  # client's poses with their truth (the pipeline keeping up with the camera's 30 Hz), and the
-  # calibration recorder's Ctrl-C in the third LED cycle (the simulated CAN adaptor skips the
-  # samples it is late for; under load a camera missed a whole cycle in 1 of 8 runs).
-  # Nor the two slow-subscriber loads, as under ThreadSanitizer (below): paced by the slow
-  # subscriber, about a minute each per implementation, and their publisher blocks and wakes
-  # as under the stalling subscriber, which runs.
-  left_out='FollowerDemo\.TurretCentresBase.*|FoxgloveBridgeTest\.(TheViewerDraws|AnIndependentClient).*'
-  left_out+='|CalibrationRecordTool\.CtrlCStopsTheLiveRecording.*'
-  left_out+='|(cyclonedds\.)?Dds/ReliableUnderLoad\.LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber( .*)?'
-  filter=(-LE install -E "^($left_out)\$")
+  # Every test but those only the plain build runs (scripts/test_lists.sh).
+  source scripts/test_lists.sh
+  filter=(-E "^($plain_only_tests)\$")
 else
-  # The threaded parts: the runtime and both transports with their tests, the bag library
-  # and tools, the components the graph tests start in threads, and the pose outputs with the
-  # VRPN server's thread.
+  # The threaded parts and their tests (above), and only those.
   cmake --build "$build" --parallel "$(nproc)" --target mocap_unit_tests \
     mocap_integration_tests mocap_test_bag_tools mocap_test_bag_pipeline \
     mocap_plugin_bag_recorder mocap_plugin_bag_player mocap_test_pose_outputs \
-    mocap_test_px4_odometry mocap_test_vrpn_server
+    mocap_test_px4_odometry mocap_test_vrpn_server mocap_test_client_queue \
+    mocap_test_foxglove_bridge mocap_test_pixart_bridge mocap_test_pixart_box_sim \
+    mocap_test_can_io mocap_test_ax12_sim mocap_test_dynamixel_bus mocap_test_turret_follower \
+    mocap_test_camera_source
   # Not the two slow-subscriber loads (about a minute each, per implementation): their
   # publisher blocks and wakes as under the stalling subscriber, which runs.
   filter=(-R "$tsan_tests" -E "LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber ")
@@ -74,5 +67,4 @@ fi
 $build_only && exit 0
 # The tests' independent clients and readers (pinned in test/package-lock.json).
 npm ci --prefix test --no-audit --no-fund --loglevel=error
-cd "$build"
-ctest --output-on-failure --parallel "$(nproc)" "${filter[@]}" "$@"
+scripts/run_tests.sh "$build" "$mode sanitizer" "${filter[@]}" "$@"
