@@ -26,14 +26,16 @@ case "$mode" in
     build=build-tsan
     # The runtime's unit tests (executor, timers, component host, intra-process and shared
     # memory transports, shutdown), the graph and DDS tests on both implementations (each
-    # process a multi-threaded executor), DDS security and mixed Fast DDS / Cyclone DDS graphs,
-    # the bag tools' record, play and stop tests and the bag recorder and player components in
-    # a running pipeline, the recorder's forced-exit hook, which runs beside its writer thread,
+    # process a multi-threaded executor), Discovery Servers and mixed Fast DDS / Cyclone DDS
+    # graphs (not the DDS security tests: Fast DDS 2.9.1 races with itself in the secure
+    # handshake, two receive threads writing one ReaderProxyData under different locks, seen
+    # with Cyclone DDS starting it), the bag tools' record, play and stop tests and the bag
+    # recorder and player components in a running pipeline, the recorder's forced-exit hook, which runs beside its writer thread,
     # the VRPN tracker server's thread beside the reports of the pose outputs; the viewer's
     # WebSocket server thread and its client queues, pixart_bridge's serial reader and the
     # simulated PixArt box, the Dynamixel follower's worker and the simulated AX-12 chain, and
     # camera_source's capture thread.
-    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer|Security)|MixedDds|SecurityAcrossImplementations|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)
     echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2
@@ -60,9 +62,10 @@ else
     mocap_test_foxglove_bridge mocap_test_pixart_bridge mocap_test_pixart_box_sim \
     mocap_test_can_io mocap_test_ax12_sim mocap_test_dynamixel_bus mocap_test_turret_follower \
     mocap_test_camera_source
-  # Not the two slow-subscriber loads (about a minute each, per implementation): their
-  # publisher blocks and wakes as under the stalling subscriber, which runs.
-  filter=(-R "$tsan_tests" -E "LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber ")
+  # Not the tests only the plain build runs (scripts/test_lists.sh: real-time speed, slow
+  # subscribers, packaging).
+  source scripts/test_lists.sh
+  filter=(-R "$tsan_tests" -E "^($plain_only_tests)\$")
 fi
 $build_only && exit 0
 # The tests' independent clients and readers (pinned in test/package-lock.json).
