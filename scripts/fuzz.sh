@@ -8,7 +8,7 @@
 # The fuzzers come from build-asan/ (scripts/sanitize.sh address builds it; this script builds
 # just the fuzzers if it is missing). Each starts from its seed corpus, fuzz/corpus/NAME/, and
 # the inputs that once broke it, fuzz/regressions/NAME/, and the corpus it grew in earlier runs
-# on this machine: MOCAP_FUZZ_CORPUS/NAME/ (default /var/cache/mocap-graph/fuzz, or
+# on this machine: MOCAP_CACHE_DIR/fuzz/NAME/ (default /var/cache/mocap-graph/fuzz, or
 # build-asan/fuzz/work when that cannot be made), outside the clone, so that each run goes
 # deeper instead of starting over; nothing found goes into the repository. An input that crashes, leaks, hangs
 # (over 10 s) or runs out of memory (over 2 GB) is kept in build-asan/fuzz/found/NAME/ and fails
@@ -55,7 +55,7 @@ run_one() {
   echo $? > "$log.status"
   set -e
 }
-corpus_root=${MOCAP_FUZZ_CORPUS:-/var/cache/mocap-graph/fuzz}
+corpus_root=${MOCAP_CACHE_DIR:-/var/cache/mocap-graph}/fuzz
 mkdir -p "$corpus_root" 2> /dev/null && [ -w "$corpus_root" ] || corpus_root=$build/fuzz/work
 export corpus_root
 export -f run_one
