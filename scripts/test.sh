@@ -21,7 +21,8 @@ for part in "${parts[@]}"; do
       scripts/check_format.sh
       # The tests' independent clients and readers (pinned in test/package-lock.json).
       npm ci --prefix test --no-audit --no-fund --loglevel=error
-      scripts/run_tests.sh build plain -R "^($plain_only_tests)\$"
+      MOCAP_TEST_PARALLEL=1 scripts/run_tests.sh build "plain, real time" -R "^($realtime_tests)\$"
+      scripts/run_tests.sh build plain -R "^($plain_only_tests)\$" -E "^($realtime_tests)\$"
       ;;
     address) scripts/sanitize.sh address ;;
     *)
