@@ -2,10 +2,11 @@
 # Builds the tests under sanitizers with clang and runs them; any report fails the run.
 #
 #   scripts/sanitize.sh address [CTEST ARGS]  AddressSanitizer, LeakSanitizer and
-#       UndefinedBehaviorSanitizer in build-asan/: every test, and the fuzzers
-#       (scripts/fuzz.sh runs them from this build).
-#   scripts/sanitize.sh thread [CTEST ARGS]   ThreadSanitizer in build-tsan/: the runtime,
-#       transports, executor, bag recorder and the tests that run components in threads.
+#       UndefinedBehaviorSanitizer in build-asan/: every test but the few only the plain
+#       build runs (scripts/test_lists.sh), and the fuzzers (scripts/fuzz.sh runs them from
+#       this build).
+#   scripts/sanitize.sh thread [CTEST ARGS]   ThreadSanitizer in build-tsan/: the threaded
+#       parts (below) and their tests, and only those.
 #   scripts/sanitize.sh MODE --build-only     builds, runs nothing.
 #
 # Both build at -O1 with line tables only: stack traces name file and line, and the build
@@ -30,11 +31,11 @@ case "$mode" in
     # graphs (not the DDS security tests: Fast DDS 2.9.1 races with itself in the secure
     # handshake, two receive threads writing one ReaderProxyData under different locks, seen
     # with Cyclone DDS starting it), the bag tools' record, play and stop tests and the bag
-    # recorder and player components in a running pipeline, the recorder's forced-exit hook, which runs beside its writer thread,
-    # the VRPN tracker server's thread beside the reports of the pose outputs; the viewer's
-    # WebSocket server thread and its client queues, pixart_bridge's serial reader and the
-    # simulated PixArt box, the Dynamixel follower's worker and the simulated AX-12 chain, and
-    # camera_source's capture thread.
+    # recorder and player components in a running pipeline, the recorder's forced-exit hook,
+    # which runs beside its writer thread, the VRPN tracker server's thread beside the reports
+    # of the pose outputs; the viewer's WebSocket server thread and its client queues,
+    # pixart_bridge's serial reader and the simulated PixArt box, the Dynamixel follower's
+    # worker and the simulated AX-12 chain, and camera_source's capture thread.
     tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)
