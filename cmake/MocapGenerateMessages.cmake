@@ -27,7 +27,7 @@
 # mocap_topic and mocap_bag load every libmocap_messages_*.so so that they know your types.
 # Sets in the caller's scope, one entry per file: <target>_CLASSES (pkg::msg::Type),
 # <target>_HEADERS (pkg/msg/type.hpp) and <target>_DDS_SOURCES (fastddsgen's Fast DDS type
-# supports, for programs that use Fast DDS directly).
+# supports, for programs that use Fast DDS directly; fastddsgen's code, so compile them with -w).
 include_guard(GLOBAL)
 include(${CMAKE_CURRENT_LIST_DIR}/MocapAddPlugin.cmake)
 
@@ -197,10 +197,16 @@ function(mocap_generate_messages target)
     list(APPEND classes ${PKG}::msg::${TYPE})
     list(APPEND headers ${DIR}/${SNAKE}.hpp)
   endforeach()
-  # fastddsgen's code is not ours to keep warning-free.
-  set_source_files_properties(${type_sources} ${dds_sources} PROPERTIES COMPILE_OPTIONS "-w")
-
-  add_library(${target} SHARED ${type_sources} ${support_sources})
+  # fastddsgen's classes, with warnings off (not our code to keep warning-free), compiled as
+  # unity files like the type supports: each type's file is small and its headers are the same,
+  # so one compile parses Fast CDR and the standard headers for several types.
+  add_library(${target}_classes OBJECT ${type_sources})
+  target_compile_options(${target}_classes PRIVATE -w)
+  target_include_directories(${target}_classes SYSTEM PRIVATE ${generated})
+  target_link_libraries(${target}_classes PRIVATE fastcdr)
+  set_target_properties(${target}_classes PROPERTIES UNITY_BUILD ON POSITION_INDEPENDENT_CODE ON)
+  add_library(${target} SHARED $<TARGET_OBJECTS:${target}_classes> ${support_sources})
+  set_target_properties(${target} PROPERTIES UNITY_BUILD ON)
   target_include_directories(${target} SYSTEM PUBLIC $<BUILD_INTERFACE:${generated}>)
   target_link_libraries(${target} PUBLIC mocap_graph::runtime fastcdr ${dependency_targets})
   set_target_properties(${target} PROPERTIES MOCAP_IDL_ROOT ${idl_root})

@@ -19,3 +19,7 @@ realtime_tests='FollowerDemo\.TurretCentresBase.*|FoxgloveBridgeTest\.(TheViewer
 realtime_tests+='|CalibrationRecordTool\.CtrlCStopsTheLiveRecording.*'
 plain_only_tests="Install\\..*|$realtime_tests"
 plain_only_tests+='|(cyclonedds\.)?Dds/ReliableUnderLoad\.LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber( .*)?'
+# Of those, the loads that keep every core busy, which scripts/test.sh runs after the others.
+busy_core_tests='(cyclonedds\.)?Dds/ReliableUnderLoad\.LosesNothingAcrossTenThousandMessages/BusyCoresAndSlowSubscriber( .*)?'
+# The executables these tests are in: test/CMakeLists.txt's mocap_plain_tests target, which the
+# plain build compiles (a test named above from another executable must be added there).
