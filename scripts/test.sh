@@ -16,6 +16,11 @@ parts=("$@")
 [ ${#parts[@]} -gt 0 ] || parts=(plain address)
 scripts/install_deps.sh all
 source scripts/test_lists.sh
+# Pauses (STOP) or resumes (CONT) the process group MOCAP_BACKGROUND_PGID names, if any.
+background() {
+  [ -z "${MOCAP_BACKGROUND_PGID:-}" ] || kill -"$1" -- "-$MOCAP_BACKGROUND_PGID" 2> /dev/null || true
+}
+trap 'background CONT' EXIT
 for part in "${parts[@]}"; do
   case "$part" in
     plain)
@@ -25,7 +30,10 @@ for part in "${parts[@]}"; do
       scripts/check_format.sh
       # The tests' independent clients and readers (pinned in test/package-lock.json).
       npm ci --prefix test --no-audit --no-fund --loglevel=error
+      # Nothing beside them: CI's builds in the background (.ci/run) are paused meanwhile.
+      background STOP
       MOCAP_TEST_PARALLEL=1 scripts/run_tests.sh build "plain, real time" -R "^($realtime_tests)\$"
+      background CONT
       # Side by side: the slow-subscriber loads are paced by their subscribers and the package
       # tests wait on dpkg and a compiler; then the loads that keep every core busy.
       MOCAP_TEST_PARALLEL=4 scripts/run_tests.sh build plain -R "^($plain_only_tests)\$" \
