@@ -1,8 +1,9 @@
 // The viewer's own CDR decoder (components/viewer/web/cdr.js) against
 // @foxglove/rosmsg2-serialization on the same bytes, for every topic the bridge offers: the
 // two must agree field for field. Prints one line per topic; exits 0 once every topic that
-// carries messages has agreed on at least COUNT of them (topics silent for 10 s are reported,
-// not waited for), 1 on any disagreement.
+// carries messages has agreed on at least COUNT of them, or on fewer and then gone quiet for
+// 5 s (a topic that publishes on events, /alerts); topics silent for 10 s are reported, not
+// waited for; 1 on any disagreement.
 //
 //   node viewer_decoder_check.mjs URL COUNT
 import wsProtocol from "@foxglove/ws-protocol";
@@ -42,6 +43,7 @@ function same(a, b) {
 const client = new FoxgloveClient({ ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
 const subscriptions = new Map();
 const agreed = new Map();
+const lastMessage = new Map();
 setTimeout(() => {
   for (const [topic, n] of agreed) console.log(`${topic}: ${n} message(s) agreed`);
   console.error("viewer_decoder_check: timed out");
@@ -68,14 +70,18 @@ client.on("message", ({ subscriptionId, data }) => {
     process.exit(1);
   }
   agreed.set(channel.topic, agreed.get(channel.topic) + 1);
+  lastMessage.set(channel.topic, Date.now());
 });
 const started = Date.now();
 setInterval(() => {
-  const carrying = [...agreed.values()].filter((n) => n > 0);
-  const elapsed = Date.now() - started;
-  // Done when every topic that carries messages has carried `count`, or after 40 s: a topic
-  // that publishes rarely (/alerts) may have carried fewer by then, and each one agreed.
-  const enough = carrying.length > 0 && carrying.every((n) => n >= count);
+  const now = Date.now();
+  const carrying = [...agreed].filter(([, n]) => n > 0);
+  const elapsed = now - started;
+  // Done when every topic that carries messages has carried `count`, or fewer and nothing for
+  // 5 s (one that publishes on events, each message of which agreed), or after 40 s.
+  const enough =
+    carrying.length > 0 &&
+    carrying.every(([topic, n]) => n >= count || now - lastMessage.get(topic) > 5000);
   if (elapsed < 10000 || (!enough && elapsed < 40000)) return;
   for (const [topic, n] of agreed) console.log(`${topic}: ${n > 0 ? `${n} message(s) agreed` : "silent"}`);
   process.exit(0);
