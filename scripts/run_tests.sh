@@ -27,11 +27,13 @@ while IFS= read -r name; do
     /^[0-9]+\/[0-9]+ Test: / { inside = substr($0, index($0, "Test: ") + 6) == test; next }
     inside && /: Skipped$/ { getline; print; exit }' "$build/Testing/Temporary/LastTest.log")
   if [[ "$reason" =~ $hardware_skip ]]; then
-    echo "$part: skipped $name (missing hardware: $reason)"
+    line="$part: skipped $name (missing hardware: $reason)"
   else
-    echo "$part: skipped $name: ${reason:-no reason given} -- only missing hardware may skip" >&2
+    line="$part: skipped $name: ${reason:-no reason given} -- only missing hardware may skip"
     status=1
   fi
+  echo "$line" >&2
+  [ -z "${MOCAP_TEST_SUMMARY:-}" ] || echo "$line" >> "$MOCAP_TEST_SUMMARY"
 done <<< "$skipped"
 # ctest counts a skipped test among the passed ones.
 line="$part: $((${total:-0} - count)) tests run, $count skipped"
