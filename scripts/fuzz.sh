@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
-# Runs every fuzzer of fuzz/ for SECONDS each (default 60), two at a time, under
-# AddressSanitizer and UndefinedBehaviorSanitizer, and prints a table: executions, coverage
-# (libFuzzer's edges "cov" and features "ft"), corpus size and the verdict.
+# Runs every fuzzer of fuzz/ for SECONDS of processor time each (default 60), two at a time,
+# under AddressSanitizer and UndefinedBehaviorSanitizer, and prints a table: executions,
+# coverage (libFuzzer's edges "cov" and features "ft"), corpus size and the verdict.
 #
-#   scripts/fuzz.sh [SECONDS] [NAME...]
+#   scripts/fuzz.sh [--no-build] [SECONDS] [NAME...]
+#
+# Processor time, not time on the clock: a fuzzer that shares the machine (CI runs them at the
+# lowest priority beside its tests) goes as deep as one alone; on a quiet machine the two are
+# the same. When a fuzzer has had its SECONDS it is asked to stop (SIGUSR1: libFuzzer finishes
+# the input at hand and prints its statistics).
 #
 # The fuzzers come from build-asan/ (scripts/sanitize.sh address builds it; this script builds
-# just the fuzzers if it is missing). Each starts from its seed corpus, fuzz/corpus/NAME/, and
+# just the fuzzers, or the tree if it is missing, unless --no-build says they are built). Each starts from its seed corpus, fuzz/corpus/NAME/, and
 # the inputs that once broke it, fuzz/regressions/NAME/, and the corpus it grew in earlier runs
 # on this machine: MOCAP_CACHE_DIR/fuzz/NAME/ (default /var/cache/mocap-graph/fuzz, or
 # build-asan/fuzz/work when that cannot be made), outside the clone, so that each run goes
@@ -17,6 +22,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=60
+build_fuzzers=true
+if [ "${1:-}" = --no-build ]; then
+  build_fuzzers=false
+  shift
+fi
 if [ $# -gt 0 ] && [[ "$1" =~ ^[0-9]+$ ]]; then
   seconds=$1
   shift
@@ -24,7 +34,9 @@ fi
 build=build-asan
 source scripts/sanitizer_env.sh
 
-if [ ! -f "$build/CMakeCache.txt" ]; then
+if ! $build_fuzzers; then
+  :
+elif [ ! -f "$build/CMakeCache.txt" ]; then
   scripts/sanitize.sh address --build-only
 else
   cmake --build "$build" --parallel "$(nproc)" --target mocap_fuzzers
@@ -49,11 +61,22 @@ run_one() {
   mkdir -p "$work" "$found" "$(dirname "$log")"
   local inputs=(fuzz/corpus/"$name")
   [ -d fuzz/regressions/"$name" ] && inputs+=(fuzz/regressions/"$name")
-  set +e
-  "$build/fuzz/fuzz_$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-    -print_final_stats=1 -artifact_prefix="$found/" "$work" "${inputs[@]}" > "$log" 2>&1
-  echo $? > "$log.status"
-  set -e
+  local start=$SECONDS budget ticks
+  budget=$((seconds * $(getconf CLK_TCK)))
+  "$build/fuzz/fuzz_$name" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -artifact_prefix="$found/" "$work" "${inputs[@]}" > "$log" 2>&1 &
+  local pid=$!
+  # Its user and system time: fields 14 and 15 of /proc/PID/stat (12 and 13 after the name),
+  # until it has had its budget or has ended (state Z until waited for).
+  while ticks=$(awk '{ sub(/^.*\) /, ""); if ($1 != "Z") print $12 + $13 }' "/proc/$pid/stat" \
+    2> /dev/null) && [ -n "$ticks" ] && [ "$ticks" -lt "$budget" ]; do
+    sleep 0.5
+  done
+  kill -USR1 "$pid" 2> /dev/null
+  local status=0
+  wait "$pid" || status=$?
+  echo $status > "$log.status"
+  echo $((SECONDS - start)) > "$log.wall"
 }
 corpus_root=${MOCAP_CACHE_DIR:-/var/cache/mocap-graph}/fuzz
 mkdir -p "$corpus_root" 2> /dev/null && [ -w "$corpus_root" ] || corpus_root=$build/fuzz/work
@@ -63,13 +86,13 @@ printf '%s\n' "${names[@]}" | xargs -P "$(nproc)" -I{} bash -c "run_one {} $seco
 
 failed=0
 echo
-echo "| fuzzer | seconds | executions | exec/s | cov (edges) | ft (features) | corpus | verdict |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| fuzzer | processor s | clock s | executions | exec per processor s | cov (edges) | ft (features) | corpus | verdict |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for name in "${names[@]}"; do
   log=$build/fuzz/logs/$name.log
   status=$(cat "$log.status")
   executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  rate=$([ -z "$executions" ] || echo $((executions / seconds)))
   # The last status line ("#N DONE cov: C ft: F corp: K/...") or, after a crash, the last one
   # printed before it.
   last=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1)
@@ -81,7 +104,7 @@ for name in "${names[@]}"; do
     verdict="FAIL (exit $status, see $log)"
     failed=1
   fi
-  echo "| $name | $seconds | ${executions:-?} | ${rate:-?} | ${cov:-?} | ${ft:-?} | ${corpus:-?} | $verdict |"
+  echo "| $name | $seconds | $(cat "$log.wall") | ${executions:-?} | ${rate:-?} | ${cov:-?} | ${ft:-?} | ${corpus:-?} | $verdict |"
 done
 if [ $failed -ne 0 ]; then
   for name in "${names[@]}"; do

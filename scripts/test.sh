@@ -30,7 +30,7 @@ for part in "${parts[@]}"; do
       scripts/check_format.sh
       # The tests' independent clients and readers (pinned in test/package-lock.json).
       npm ci --prefix test --no-audit --no-fund --loglevel=error
-      # Nothing beside them: CI's builds in the background (.ci/run) are paused meanwhile.
+      # Nothing beside them: what CI runs in the background (.ci/run) is paused meanwhile.
       background STOP
       MOCAP_TEST_PARALLEL=1 scripts/run_tests.sh build "plain, real time" -R "^($realtime_tests)\$"
       background CONT
