@@ -5,9 +5,9 @@
 #
 #   scripts/fuzz.sh [--no-build] [SECONDS] [NAME...]
 #
-# Processor time, not time on the clock: a fuzzer that shares the machine (CI runs them at the
-# lowest priority beside its tests) goes as deep as one alone; on a quiet machine the two are
-# the same. When a fuzzer has had its SECONDS it is asked to stop (SIGUSR1: libFuzzer finishes
+# Processor time, not time on the clock: a fuzzer that shares the machine (CI runs them beside
+# its soak and container test) goes as deep as one alone; on a quiet machine the two are the
+# same. When a fuzzer has had its SECONDS it is asked to stop (SIGUSR1: libFuzzer finishes
 # the input at hand and prints its statistics).
 #
 # The fuzzers come from build-asan/ (scripts/sanitize.sh address builds it; this script builds

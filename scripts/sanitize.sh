@@ -36,7 +36,7 @@ case "$mode" in
     # of the pose outputs; the viewer's WebSocket server thread and its client queues,
     # pixart_bridge's serial reader and the simulated PixArt box, the Dynamixel follower's
     # worker and the simulated AX-12 chain, and camera_source's capture thread.
-    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|ShutdownSignal|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds(\.|/MixedTracking\.)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)
     echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2
