@@ -11,13 +11,14 @@
 # the input at hand and prints its statistics).
 #
 # The fuzzers come from build-asan/ (scripts/sanitize.sh address builds it; this script builds
-# just the fuzzers, or the tree if it is missing, unless --no-build says they are built). Each starts from its seed corpus, fuzz/corpus/NAME/, and
-# the inputs that once broke it, fuzz/regressions/NAME/, and the corpus it grew in earlier runs
-# on this machine: MOCAP_CACHE_DIR/fuzz/NAME/ (default /var/cache/mocap-graph/fuzz, or
-# build-asan/fuzz/work when that cannot be made), outside the clone, so that each run goes
-# deeper instead of starting over; nothing found goes into the repository. An input that crashes, leaks, hangs
-# (over 10 s) or runs out of memory (over 2 GB) is kept in build-asan/fuzz/found/NAME/ and fails
-# the run: reproduce it with `build-asan/fuzz/fuzz_NAME FILE`, fix it, and keep the file in
+# just the fuzzers, or the tree if it is missing, unless --no-build says they are built). Each
+# starts from its seed corpus, fuzz/corpus/NAME/, and the inputs that once broke it,
+# fuzz/regressions/NAME/, and the corpus it grew in earlier runs on this machine:
+# MOCAP_CACHE_DIR/fuzz/NAME/ (default /var/cache/mocap-graph/fuzz, or build-asan/fuzz/work when
+# that cannot be made), outside the clone, so that each run goes deeper instead of starting
+# over; nothing found goes into the repository. An input that crashes, leaks, hangs (over 10 s)
+# or runs out of memory (over 2 GB) is kept in build-asan/fuzz/found/NAME/ and fails the run:
+# reproduce it with `build-asan/fuzz/fuzz_NAME FILE`, fix it, and keep the file in
 # fuzz/regressions/NAME/ (ctest replays it in every build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,11 +35,9 @@ fi
 build=build-asan
 source scripts/sanitizer_env.sh
 
-if ! $build_fuzzers; then
-  :
-elif [ ! -f "$build/CMakeCache.txt" ]; then
+if $build_fuzzers && [ ! -f "$build/CMakeCache.txt" ]; then
   scripts/sanitize.sh address --build-only
-else
+elif $build_fuzzers; then
   cmake --build "$build" --parallel "$(nproc)" --target mocap_fuzzers
 fi
 
