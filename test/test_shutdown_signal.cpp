@@ -49,6 +49,25 @@ pid_t start_child(const std::filesystem::path& hook_file,
   return pid;
 }
 
+// The child, killed and reaped at the end of the test if it has not exited: a failed test must
+// not leave behind a process that holds ctest's output pipe open (ctest waits for it to close).
+class Child {
+ public:
+  explicit Child(pid_t pid) : pid_(pid) {}
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  ~Child() {
+    if (waitpid(pid_, nullptr, WNOHANG) == 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_;
+};
+
 // The child's exit status, 128 + N for signal N, or nullopt if it runs past `timeout`.
 std::optional<int> exit_status(pid_t pid, std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
@@ -64,30 +83,30 @@ std::optional<int> exit_status(pid_t pid, std::chrono::milliseconds timeout) {
 
 TEST(ShutdownSignal, OneSignalStopsGracefully) {
   test::TempDir dir;
-  pid_t child = start_child(dir / "hook", 200ms);
-  kill(child, SIGTERM);
-  EXPECT_EQ(exit_status(child, 10s), 0);
+  Child child(start_child(dir / "hook", 200ms));
+  kill(child.pid(), SIGTERM);
+  EXPECT_EQ(exit_status(child.pid(), 10s), 0);
   EXPECT_FALSE(std::filesystem::exists(dir / "hook"));
 }
 
 TEST(ShutdownSignal, TwoSignalsInTheSameInstantAreOneStopRequest) {
   test::TempDir dir;
-  pid_t child = start_child(dir / "hook", 300ms);
-  kill(child, SIGTERM);
-  kill(child, SIGTERM);
-  kill(child, SIGINT);
-  EXPECT_EQ(exit_status(child, 10s), 0) << "the graceful stop ran to its end";
+  Child child(start_child(dir / "hook", 300ms));
+  kill(child.pid(), SIGTERM);
+  kill(child.pid(), SIGTERM);
+  kill(child.pid(), SIGINT);
+  EXPECT_EQ(exit_status(child.pid(), 10s), 0) << "the graceful stop ran to its end";
   EXPECT_FALSE(std::filesystem::exists(dir / "hook"));
 }
 
 TEST(ShutdownSignal, ASecondSignalAfterTheDelayForcesTheExitAfterTheHooks) {
   test::TempDir dir;
-  pid_t child = start_child(dir / "hook", std::nullopt);  // a graceful stop that hangs
-  kill(child, SIGINT);
-  kill(child, SIGINT);  // Ctrl-C with a supervisor that forwards it: one request
-  EXPECT_EQ(exit_status(child, ShutdownSignal::kEscalationDelay + 500ms), std::nullopt);
-  kill(child, SIGINT);  // well after: forced
-  EXPECT_EQ(exit_status(child, 10s), 130);
+  Child child(start_child(dir / "hook", std::nullopt));  // a graceful stop that hangs
+  kill(child.pid(), SIGINT);
+  kill(child.pid(), SIGINT);  // Ctrl-C with a supervisor that forwards it: one request
+  EXPECT_EQ(exit_status(child.pid(), ShutdownSignal::kEscalationDelay + 500ms), std::nullopt);
+  kill(child.pid(), SIGINT);  // well after: forced
+  EXPECT_EQ(exit_status(child.pid(), 10s), 130);
   EXPECT_TRUE(std::filesystem::exists(dir / "hook"));
 }
 
