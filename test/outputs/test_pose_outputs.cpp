@@ -141,8 +141,12 @@ using Feeder = test::PoseFeeder;
 class Collector final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
-    spec.subscribes<PoseStamped>("/mocap/board_a/pose", Qos::sensor_data(), "");
-    spec.subscribes<Odometry>("/mocap/board_a/odom", Qos::sensor_data(), "");
+    // As the outputs publish (best effort), with room for every sample of a test: a collector
+    // slowed by a sanitizer must not drop what it counts.
+    Qos sensor_data = Qos::sensor_data();
+    sensor_data.depth = 1000;
+    spec.subscribes<PoseStamped>("/mocap/board_a/pose", sensor_data, "");
+    spec.subscribes<Odometry>("/mocap/board_a/odom", sensor_data, "");
     spec.subscribes<TFMessage>("/tf", Qos::reliable(), "");
     spec.subscribes<TFMessage>("/tf_static", Qos::latched(), "");
   }
