@@ -25,19 +25,19 @@ case "$mode" in
   address) build=build-asan ;;
   thread)
     build=build-tsan
-    # The runtime's unit tests (executor, timers, component host, intra-process and shared
-    # memory transports; not ShutdownSignal's: they fork a child that starts a thread, which
+    # The runtime's unit tests (executor, timers, component host, intra-process and shared memory
+    # transports; not ShutdownSignal's: they fork a child that starts a thread, which
     # ThreadSanitizer does not support after a fork, and there the child twice missed its stop
-    # requests; ASan runs them, and the graph tests below signal whole processes), the graph and DDS tests on both implementations (each
-    # process a multi-threaded executor), Discovery Servers and mixed Fast DDS / Cyclone DDS
-    # graphs (not the DDS security tests: Fast DDS 2.9.1 races with itself in the secure
-    # handshake, two receive threads writing one ReaderProxyData under different locks, seen
-    # with Cyclone DDS starting it), the bag tools' record, play and stop tests and the bag
-    # recorder and player components in a running pipeline, the recorder's forced-exit hook,
-    # which runs beside its writer thread, the VRPN tracker server's thread beside the reports
-    # of the pose outputs; the viewer's WebSocket server thread and its client queues,
-    # pixart_bridge's serial reader and the simulated PixArt box, the Dynamixel follower's
-    # worker and the simulated AX-12 chain, and camera_source's capture thread.
+    # requests; ASan runs them, and the graph tests below signal whole processes), the graph and DDS
+    # tests on both implementations (each process a multi-threaded executor), Discovery Servers and
+    # mixed Fast DDS / Cyclone DDS graphs (not the DDS security tests: Fast DDS 2.9.1 races with
+    # itself in the secure handshake, two receive threads writing one ReaderProxyData under
+    # different locks, seen with Cyclone DDS starting it), the bag tools' record, play and stop
+    # tests and the bag recorder and player components in a running pipeline, the recorder's
+    # forced-exit hook, which runs beside its writer thread, the VRPN tracker server's thread beside
+    # the reports of the pose outputs; the viewer's WebSocket server thread and its client queues,
+    # pixart_bridge's serial reader and the simulated PixArt box, the Dynamixel follower's worker
+    # and the simulated AX-12 chain, and camera_source's capture thread.
     tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds(\.|/MixedTracking\.)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)

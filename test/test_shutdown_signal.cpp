@@ -21,10 +21,29 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// The child, killed and reaped at the end of the test if it has not exited: a failed test must
+// not leave behind a process that holds ctest's output pipe open (ctest waits for it to close).
+class Child {
+ public:
+  explicit Child(pid_t pid) : pid_(pid) {}
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  ~Child() {
+    if (waitpid(pid_, nullptr, WNOHANG) == 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_;
+};
+
 // A child that installs the handlers, registers a forced-exit hook writing `hook_file`, says it
 // is ready through a pipe, waits for a stop request and then spends `stopping` on its graceful
 // stop (forever when nullopt) before exiting with 0.
-pid_t start_child(const std::filesystem::path& hook_file,
+Child start_child(const std::filesystem::path& hook_file,
                   std::optional<std::chrono::milliseconds> stopping) {
   int ready[2];
   EXPECT_EQ(pipe(ready), 0);
@@ -46,27 +65,8 @@ pid_t start_child(const std::filesystem::path& hook_file,
   char byte = 0;
   EXPECT_EQ(read(ready[0], &byte, 1), 1);
   close(ready[0]);
-  return pid;
+  return Child(pid);
 }
-
-// The child, killed and reaped at the end of the test if it has not exited: a failed test must
-// not leave behind a process that holds ctest's output pipe open (ctest waits for it to close).
-class Child {
- public:
-  explicit Child(pid_t pid) : pid_(pid) {}
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-  ~Child() {
-    if (waitpid(pid_, nullptr, WNOHANG) == 0) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  pid_t pid() const { return pid_; }
-
- private:
-  pid_t pid_;
-};
 
 // The child's exit status, 128 + N for signal N, or nullopt if it runs past `timeout`.
 std::optional<int> exit_status(pid_t pid, std::chrono::milliseconds timeout) {
@@ -83,7 +83,7 @@ std::optional<int> exit_status(pid_t pid, std::chrono::milliseconds timeout) {
 
 TEST(ShutdownSignal, OneSignalStopsGracefully) {
   test::TempDir dir;
-  Child child(start_child(dir / "hook", 200ms));
+  Child child = start_child(dir / "hook", 200ms);
   kill(child.pid(), SIGTERM);
   EXPECT_EQ(exit_status(child.pid(), 10s), 0);
   EXPECT_FALSE(std::filesystem::exists(dir / "hook"));
@@ -91,7 +91,7 @@ TEST(ShutdownSignal, OneSignalStopsGracefully) {
 
 TEST(ShutdownSignal, TwoSignalsInTheSameInstantAreOneStopRequest) {
   test::TempDir dir;
-  Child child(start_child(dir / "hook", 300ms));
+  Child child = start_child(dir / "hook", 300ms);
   kill(child.pid(), SIGTERM);
   kill(child.pid(), SIGTERM);
   kill(child.pid(), SIGINT);
@@ -101,7 +101,7 @@ TEST(ShutdownSignal, TwoSignalsInTheSameInstantAreOneStopRequest) {
 
 TEST(ShutdownSignal, ASecondSignalAfterTheDelayForcesTheExitAfterTheHooks) {
   test::TempDir dir;
-  Child child(start_child(dir / "hook", std::nullopt));  // a graceful stop that hangs
+  Child child = start_child(dir / "hook", std::nullopt);  // a graceful stop that hangs
   kill(child.pid(), SIGINT);
   kill(child.pid(), SIGINT);  // Ctrl-C with a supervisor that forwards it: one request
   EXPECT_EQ(exit_status(child.pid(), ShutdownSignal::kEscalationDelay + 500ms), std::nullopt);
