@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -51,6 +52,22 @@ std::string dds_implementation() {
 }
 
 int test_domain(int slot) { return (dds_implementation() == "cyclonedds" ? 0 : 100) + slot; }
+
+int unshared_domain() {
+  // 232: the highest domain whose ports (7400 + 250 x domain + offsets) fit in 16 bits.
+  static const int domain = [] {
+    for (int candidate = 200; candidate <= 232; ++candidate) {
+      const fs::path lock =
+          fs::temp_directory_path() / ("mocap_test_domain_" + std::to_string(candidate) + ".lock");
+      const int fd = open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+      if (fd < 0) throw std::runtime_error("cannot open " + lock.string());
+      if (flock(fd, LOCK_EX | LOCK_NB) == 0) return candidate;  // fd stays open: the lock held
+      close(fd);
+    }
+    throw std::runtime_error("every DDS domain of 200..232 is held by another test process");
+  }();
+  return domain;
+}
 
 ChildProcess::ChildProcess(std::vector<std::string> argv,
                            std::map<std::string, std::string> environment, fs::path output_file)

@@ -41,6 +41,12 @@ std::string dds_implementation();
 // 0..99 under Cyclone DDS (MOCAP_DDS_IMPLEMENTATION), so the two runs of a test do not meet.
 int test_domain(int slot);
 
+// A DDS domain (200..232, beyond every slot's) that no other test process holds while this one
+// runs: for the tests of one fixture that may run at the same time, which share a set-up and
+// so cannot each name a slot. Held through a lock file in the temporary directory until the
+// process ends; the same domain on every call.
+int unshared_domain();
+
 // A child process whose stdout and stderr go to a file. Stopped (SIGTERM, then SIGKILL after
 // 10 s) if still running when destroyed.
 class ChildProcess {

@@ -86,7 +86,7 @@ class FoxgloveBridgeTest : public ::testing::Test {
 
   std::string url() const { return fmt::format("ws://127.0.0.1:{}", port_); }
   static std::map<std::string, std::string> domain() {
-    return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(61))},
+    return {{"MOCAP_DOMAIN_ID", std::to_string(test::unshared_domain())},
             {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}};
   }
 
