@@ -45,16 +45,28 @@ struct Record {
   }
 } record;
 
+// The one-parameter settings of the test components below.
+struct Count {
+  int count = 50;
+};
+struct Expect {
+  int expect = 50;
+};
+const ParameterList<Count> kCount =
+    ParameterList<Count>().add("count", "messages to publish", &Count::count).min(1);
+const ParameterList<Expect> kExpect =
+    ParameterList<Expect>().add("expect", "messages before shutdown", &Expect::expect).min(1);
+
 class Source final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
-    spec.parameter("count", 50, "messages to publish").min(1);
+    kCount.declare(spec);
     spec.publishes<Array>("/numbers", Qos::reliable(), "");
   }
   explicit Source(Context& context) : Component(context) {
     publisher_ = create_publisher<Array>("/numbers");
-    create_timer(std::chrono::milliseconds(1), [this] {
-      if (publisher_.matched_subscribers() == 0 || sent_ == param<int>("count")) return;
+    create_timer(std::chrono::milliseconds(1), [this, count = read(kCount).count] {
+      if (publisher_.matched_subscribers() == 0 || sent_ == count) return;
       auto message = std::make_shared<Array>();
       message->header().stamp().sec(sent_++);
       {
@@ -73,15 +85,16 @@ class Source final : public Component {
 class Sink final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
-    spec.parameter("expect", 50, "messages before shutdown").min(1);
+    kExpect.declare(spec);
     spec.subscribes<Array>("/numbers", Qos::reliable(), "");
   }
   explicit Sink(Context& context) : Component(context) {
-    create_subscription<Array>("/numbers", [this](const std::shared_ptr<const Array>& m) {
-      std::lock_guard lock(record.mutex);
-      record.received.push_back(m.get());
-      if (static_cast<int>(record.received.size()) == param<int>("expect")) request_shutdown(0);
-    });
+    create_subscription<Array>(
+        "/numbers", [this, expect = read(kExpect).expect](const std::shared_ptr<const Array>& m) {
+          std::lock_guard lock(record.mutex);
+          record.received.push_back(m.get());
+          if (static_cast<int>(record.received.size()) == expect) request_shutdown(0);
+        });
   }
 };
 
@@ -111,15 +124,21 @@ TEST_F(ComponentHostTest, RemapsConnectTopics) {
   EXPECT_EQ(record.received.size(), 50u);  // all from "sink"
 }
 
+struct Camera {
+  std::string camera = "left";
+};
+const ParameterList<Camera> kCamera =
+    ParameterList<Camera>().add("camera", "which topic of the family", &Camera::camera);
+
 // Publishes on one topic of the family /cameras/{camera}/numbers, chosen by a parameter.
 class FamilySource final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
-    spec.parameter("camera", std::string("left"), "which topic of the family");
+    kCamera.declare(spec);
     spec.publishes<Array>("/cameras/{camera}/numbers", Qos::reliable(), "");
   }
   explicit FamilySource(Context& context) : Component(context) {
-    publisher_ = create_publisher<Array>("/cameras/" + param<std::string>("camera") + "/numbers");
+    publisher_ = create_publisher<Array>("/cameras/" + read(kCamera).camera + "/numbers");
     create_timer(std::chrono::milliseconds(1), [this] {
       if (publisher_.matched_subscribers() == 0 || sent_ == 50) return;
       auto message = std::make_shared<Array>();
@@ -341,13 +360,17 @@ TEST_F(ComponentHostTest, ConfigurationErrors) {
             "component 'other' (sink): remap target 'numbers' is not a topic name (like /a/b_c)");
 }
 
+struct Fail {
+  bool fail = false;
+};
+const ParameterList<Fail> kFail =
+    ParameterList<Fail>().add("fail", "throw from every other tick", &Fail::fail);
+
 class Ticker final : public Component {
  public:
-  static void declare(ComponentSpec& spec) {
-    spec.parameter("fail", false, "throw from every other tick");
-  }
+  static void declare(ComponentSpec& spec) { kFail.declare(spec); }
   explicit Ticker(Context& context) : Component(context) {
-    bool fail = param<bool>("fail");
+    bool fail = read(kFail).fail;
     for (int timer = 0; timer < 3; ++timer) {
       create_timer(std::chrono::microseconds(200), [this, fail] {
         // Callbacks of one component never overlap, however many threads there are.
@@ -385,10 +408,23 @@ struct BurstRecord {
   std::mutex mutex;
 } burst;
 
+struct BurstCount {
+  int count = 500;
+};
+struct BurstExpect {
+  int expect = 500;
+};
+const ParameterList<BurstCount> kBurstCount =
+    ParameterList<BurstCount>().add("count", "messages in the burst", &BurstCount::count).min(1);
+const ParameterList<BurstExpect> kBurstExpect =
+    ParameterList<BurstExpect>()
+        .add("expect", "messages before shutdown", &BurstExpect::expect)
+        .min(1);
+
 class Burst final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
-    spec.parameter("count", 500, "messages in the burst").min(1);
+    kBurstCount.declare(spec);
     spec.publishes<Array>("/burst", Qos::reliable(), "");
   }
   explicit Burst(Context& context) : Component(context) {
@@ -397,7 +433,7 @@ class Burst final : public Component {
       if (sent_ || publisher_.matched_subscribers() == 0) return;
       sent_ = true;
       int ticks_before = record.ticks;
-      for (int i = 0; i < param<int>("count"); ++i) {
+      for (int i = 0; i < count_; ++i) {
         Array message;
         message.header().stamp().sec(i);
         publisher_.publish(std::move(message));
@@ -410,22 +446,25 @@ class Burst final : public Component {
 
  private:
   Publisher<Array> publisher_;
+  const int count_ = read(kBurstCount).count;
   bool sent_ = false;
 };
 
 class SlowSink final : public Component {
  public:
   static void declare(ComponentSpec& spec) {
-    spec.parameter("expect", 500, "messages before shutdown").min(1);
+    kBurstExpect.declare(spec);
     spec.subscribes<Array>("/burst", Qos::reliable(), "");
   }
   explicit SlowSink(Context& context) : Component(context) {
-    create_subscription<Array>("/burst", [this](const Array& message) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      std::lock_guard lock(burst.mutex);
-      burst.received.push_back(message.header().stamp().sec());
-      if (static_cast<int>(burst.received.size()) == param<int>("expect")) request_shutdown(0);
-    });
+    create_subscription<Array>("/burst",
+                               [this, expect = read(kBurstExpect).expect](const Array& message) {
+                                 std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                                 std::lock_guard lock(burst.mutex);
+                                 burst.received.push_back(message.header().stamp().sec());
+                                 if (static_cast<int>(burst.received.size()) == expect)
+                                   request_shutdown(0);
+                               });
   }
 };
 

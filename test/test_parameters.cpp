@@ -5,6 +5,7 @@
 
 #include <mocap/component_spec.hpp>
 #include <mocap/parameter.hpp>
+#include <mocap/parameter_list.hpp>
 
 #include "yaml_value.hpp"
 
@@ -110,16 +111,100 @@ TEST(Parameters, ReadingUndeclaredOrAsAnotherTypeIsABug) {
   }
 }
 
-TEST(ComponentSpec, DeclarationsAndTheirErrors) {
+// Settings as a component's: an algorithm's options as the base, a part several components
+// share, and the component's own fields.
+struct Lens {
+  double ratio = 0.5;
+  unsigned count = 3;
+};
+struct Files {
+  std::string file = "a.yaml";
+};
+struct Settings : Lens {
+  Lens second{.ratio = 0.25, .count = 7};  // initialized here: these are its defaults
+  Files files;
+  std::vector<int> ids = {1, 2};
+  float gain = 1.5F;
+  bool on = true;
+};
+
+const ParameterList<Files> kFiles =
+    ParameterList<Files>().add("file", "a file", &Files::file).path();
+const ParameterList<Settings> kSettings =
+    ParameterList<Settings>()
+        .add("ratio", "a ratio", &Settings::ratio)
+        .range(0, 1)
+        .add("count", "a count", &Settings::count)
+        .add("second_ratio", "another ratio", &Settings::second, &Lens::ratio)
+        .add("second_count", "another count", &Settings::second, &Lens::count)
+        .max(100)
+        .include(&Settings::files, kFiles)
+        .add("ids", "servo ids", &Settings::ids)
+        .add("gain", "a gain", &Settings::gain)
+        .add("on", "a switch", &Settings::on);
+
+TEST(ParameterList, DeclaresTheSettingsInitialValuesAsDefaults) {
   ComponentSpec spec;
-  spec.parameter("rate_hz", 30.0, "frames per second").range(1, 120);
-  spec.parameter("device", "/dev/video0", "camera device");
-  spec.parameter("ids", std::vector<int>{1, 2}, "servo ids");
-  ASSERT_EQ(spec.parameters().size(), 3u);
-  EXPECT_EQ(spec.find_parameter("rate_hz")->type_description(), "double in [1, 120]");
-  EXPECT_EQ(spec.find_parameter("device")->type(), ParameterType::String);
-  EXPECT_EQ(spec.find_parameter("ids")->type(), ParameterType::IntList);
-  EXPECT_THROW(spec.parameter("rate_hz", 1, "again"), std::logic_error);
+  kSettings.declare(spec);
+  std::vector<std::string> names;
+  for (const ParameterSpec& p : spec.parameters()) names.push_back(p.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"ratio", "count", "second_ratio", "second_count",
+                                             "file", "ids", "gain", "on"}));
+  auto declared = [&](const char* name) { return *spec.find_parameter(name); };
+  EXPECT_EQ(declared("ratio").default_value, ParameterValue(0.5));
+  EXPECT_EQ(declared("ratio").type_description(), "double in [0, 1]");
+  // Unsigned members take no negative values.
+  EXPECT_EQ(declared("count").default_value, ParameterValue(int64_t{3}));
+  EXPECT_EQ(declared("count").type_description(), "int >= 0");
+  // A member of a member, and its default as the outer struct initializes it.
+  EXPECT_EQ(declared("second_ratio").default_value, ParameterValue(0.25));
+  EXPECT_EQ(declared("second_count").default_value, ParameterValue(int64_t{7}));
+  EXPECT_EQ(declared("second_count").type_description(), "int in [0, 100]");
+  EXPECT_EQ(declared("file").default_value, ParameterValue(std::string("a.yaml")));
+  EXPECT_TRUE(declared("file").is_path);
+  EXPECT_EQ(declared("ids").default_value, ParameterValue(std::vector<int64_t>{1, 2}));
+  EXPECT_EQ(declared("gain").default_value, ParameterValue(1.5));
+  EXPECT_EQ(declared("on").default_value, ParameterValue(true));
+}
+
+TEST(ParameterList, ReadsValuesIntoTheMembersTheyAreBoundTo) {
+  ComponentSpec spec;
+  kSettings.declare(spec);
+  std::map<std::string, ParameterValue, std::less<>> values;
+  for (const ParameterSpec& p : spec.parameters()) values[p.name] = p.default_value;
+  // The defaults read back as the struct's own initial values.
+  const Settings defaults = kSettings.read(Parameters(values));
+  EXPECT_EQ(defaults.second.count, 7u);
+  EXPECT_EQ(defaults.files.file, "a.yaml");
+
+  values["ratio"] = 0.75;
+  values["count"] = int64_t{9};
+  values["second_ratio"] = 0.125;
+  values["file"] = std::string("/b.yaml");
+  values["ids"] = std::vector<int64_t>{4};
+  values["gain"] = 2.5;
+  values["on"] = false;
+  const Settings read = kSettings.read(Parameters(values));
+  EXPECT_EQ(read.ratio, 0.75);
+  EXPECT_EQ(read.count, 9u);
+  EXPECT_EQ(read.second.ratio, 0.125);
+  EXPECT_EQ(read.second.count, 7u);
+  EXPECT_EQ(read.files.file, "/b.yaml");
+  EXPECT_EQ(read.ids, std::vector<int>{4});
+  EXPECT_EQ(read.gain, 2.5F);
+  EXPECT_FALSE(read.on);
+}
+
+TEST(ParameterList, DeclarationErrorsAreTheComponentsBugs) {
+  struct Two {
+    int a = 1;
+    int b = 2;
+  };
+  ComponentSpec spec;
+  EXPECT_THROW(ParameterList<Two>().add("a", "", &Two::a).add("a", "again", &Two::b).declare(spec),
+               std::logic_error);
+  ComponentSpec other;
+  EXPECT_THROW(ParameterList<Two>().add("a", "", &Two::a).path().declare(other), std::logic_error);
   EXPECT_EQ(to_string(ParameterValue(std::vector<std::string>{"a", "b\""})), "[\"a\", \"b\\\"\"]");
 }
 

@@ -8,34 +8,6 @@
 
 namespace mocap {
 
-ParameterSpec& ComponentSpec::ParameterDeclaration::parameter() {
-  return spec_.parameters_[index_];
-}
-
-ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::range(double min,
-                                                                                double max) {
-  return this->min(min).max(max);
-}
-
-ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::min(double min) {
-  parameter().min = min;
-  return *this;
-}
-
-ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::max(double max) {
-  parameter().max = max;
-  return *this;
-}
-
-ComponentSpec::ParameterDeclaration& ComponentSpec::ParameterDeclaration::path() {
-  if (parameter().type() != ParameterType::String) {
-    throw std::logic_error(
-        fmt::format("parameter '{}': only a string parameter can be a path", parameter().name));
-  }
-  parameter().is_path = true;
-  return *this;
-}
-
 const ParameterSpec* ComponentSpec::find_parameter(std::string_view name) const {
   for (const ParameterSpec& p : parameters_) {
     if (p.name == name) return &p;
@@ -50,15 +22,15 @@ const TopicSpec* ComponentSpec::find_topic(std::string_view topic) const {
   return nullptr;
 }
 
-ComponentSpec::ParameterDeclaration ComponentSpec::add_parameter(std::string name,
-                                                                 ParameterValue default_value,
-                                                                 std::string description) {
-  if (find_parameter(name) != nullptr) {
-    throw std::logic_error(fmt::format("parameter '{}' is declared twice", name));
+void ComponentSpec::parameter(ParameterSpec declared) {
+  if (find_parameter(declared.name) != nullptr) {
+    throw std::logic_error(fmt::format("parameter '{}' is declared twice", declared.name));
   }
-  parameters_.push_back({std::move(name), std::move(default_value), std::move(description),
-                         std::nullopt, std::nullopt});
-  return ParameterDeclaration(*this, parameters_.size() - 1);
+  if (declared.is_path && declared.type() != ParameterType::String) {
+    throw std::logic_error(
+        fmt::format("parameter '{}': only a string parameter can be a path", declared.name));
+  }
+  parameters_.push_back(std::move(declared));
 }
 
 const TopicSpec* ComponentSpec::find_any_topic(TopicDirection direction) const {

@@ -4,12 +4,21 @@
 
 namespace {
 
+#if defined(BROKEN_DECLARATION)
+struct Settings {
+  int first = 1;
+  int second = 2;
+};
+#endif
+
 class Nothing final : public mocap::Component {
  public:
   static void declare(mocap::ComponentSpec& spec) {
 #if defined(BROKEN_DECLARATION)
-    spec.parameter("twice", 1, "declared");
-    spec.parameter("twice", 2, "declared again");
+    mocap::ParameterList<Settings>()
+        .add("twice", "declared", &Settings::first)
+        .add("twice", "declared again", &Settings::second)
+        .declare(spec);
 #else
     (void)spec;
 #endif

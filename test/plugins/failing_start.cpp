@@ -6,13 +6,21 @@
 
 namespace {
 
+struct Settings {
+  std::string device = "/dev/ttyUSB9";
+};
+
+const mocap::ParameterList<Settings> kParameters = mocap::ParameterList<Settings>().add(
+    "device", "the device that is not there", &Settings::device);
+
 class FailingStart final : public mocap::Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
-  static void declare(mocap::ComponentSpec& spec) {
-    spec.parameter("device", "/dev/ttyUSB9", "the device that is not there");
-  }
+  static void declare(mocap::ComponentSpec& spec) { kParameters.declare(spec); }
   explicit FailingStart(mocap::Context& context) : Component(context) {
-    throw std::runtime_error("cannot open " + param<std::string>("device"));
+    throw std::runtime_error("cannot open " + settings_.device);
   }
 };
 

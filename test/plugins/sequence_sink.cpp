@@ -11,46 +11,73 @@
 namespace mocap::test {
 namespace {
 
+struct Settings {
+  int expect = 1000;
+  std::string summary_file;
+  double timeout_s = 60.0;
+  int log_every = 0;
+  int finish_at = -1;
+  bool stop_when_done = true;
+  double work_s = 0.0;
+  int stall_every = 0;
+  double stall_s = 1.0;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("expect",
+             "messages after which the summary is written and the process "
+             "stops; 0 for never",
+             &Settings::expect)
+        .min(0)
+        .add("summary_file", "where the summary goes (YAML)", &Settings::summary_file)
+        .add("timeout_s", "give up after this long: summary, then exit code 3",
+             &Settings::timeout_s)
+        .min(0.1)
+        .add("log_every", "log 'received N' every N messages; 0 for never", &Settings::log_every)
+        .min(0)
+        .add("finish_at",
+             "finish when this sequence number arrives, however many came before it; -1 "
+             "for never",
+             &Settings::finish_at)
+        .min(-1)
+        .add("stop_when_done", "stop the process once the summary is written",
+             &Settings::stop_when_done)
+        .add("work_s", "seconds each message keeps the sink busy (a slow subscriber)",
+             &Settings::work_s)
+        .range(0.0, 1.0)
+        .add("stall_every", "every this many messages, the sink stalls; 0 for never",
+             &Settings::stall_every)
+        .min(0)
+        .add("stall_s", "seconds each stall lasts", &Settings::stall_s)
+        .range(0.0, 60.0);
+
 class SequenceSink final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Test sink: checks the numbered stream, writes a summary, then stops.");
-    spec.parameter("expect", 1000,
-                   "messages after which the summary is written and the process "
-                   "stops; 0 for never")
-        .min(0);
-    spec.parameter("summary_file", std::string(), "where the summary goes (YAML)");
-    spec.parameter("timeout_s", 60.0, "give up after this long: summary, then exit code 3")
-        .min(0.1);
-    spec.parameter("log_every", 0, "log 'received N' every N messages; 0 for never").min(0);
-    spec.parameter("finish_at", -1,
-                   "finish when this sequence number arrives, however many came before it; -1 "
-                   "for never")
-        .min(-1);
-    spec.parameter("stop_when_done", true, "stop the process once the summary is written");
-    spec.parameter("work_s", 0.0, "seconds each message keeps the sink busy (a slow subscriber)")
-        .range(0.0, 1.0);
-    spec.parameter("stall_every", 0, "every this many messages, the sink stalls; 0 for never")
-        .min(0);
-    spec.parameter("stall_s", 1.0, "seconds each stall lasts").range(0.0, 60.0);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::FiducialArray>(kSequenceTopic, Qos::reliable(),
                                                     "the numbered stream");
   }
 
   explicit SequenceSink(Context& context) : Component(context) {
-    expect_ = param<int64_t>("expect");
-    log_every_ = param<int64_t>("log_every");
-    summary_file_ = param<std::string>("summary_file");
-    stop_when_done_ = param<bool>("stop_when_done");
-    finish_at_ = param<int64_t>("finish_at");
-    work_ = std::chrono::duration<double>(param<double>("work_s"));
-    stall_every_ = param<int64_t>("stall_every");
-    stall_ = std::chrono::duration<double>(param<double>("stall_s"));
+    expect_ = settings_.expect;
+    log_every_ = settings_.log_every;
+    summary_file_ = settings_.summary_file;
+    stop_when_done_ = settings_.stop_when_done;
+    finish_at_ = settings_.finish_at;
+    work_ = std::chrono::duration<double>(settings_.work_s);
+    stall_every_ = settings_.stall_every;
+    stall_ = std::chrono::duration<double>(settings_.stall_s);
     create_subscription<mocap_msgs::msg::FiducialArray>(
         kSequenceTopic,
         [this](const std::shared_ptr<const mocap_msgs::msg::FiducialArray>& m) { receive(m); });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::duration<double>(param<double>("timeout_s"))),
+                     std::chrono::duration<double>(settings_.timeout_s)),
                  [this] { finish(3); });
   }
 

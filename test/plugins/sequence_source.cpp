@@ -10,30 +10,52 @@
 namespace mocap::test {
 namespace {
 
+struct Settings {
+  int count = 1000;
+  int batch = 10;
+  double period_s = 0.01;
+  int subscribers = 1;
+  std::string summary_file;
+  bool stop_when_done = false;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("count", "messages to publish; 0 for no end", &Settings::count)
+        .min(0)
+        .add("batch", "messages per tick", &Settings::batch)
+        .min(1)
+        .add("period_s", "seconds between ticks", &Settings::period_s)
+        .range(1e-5, 60)
+        .add("subscribers", "matched subscribers to wait for before publishing",
+             &Settings::subscribers)
+        .min(0)
+        .add("summary_file", "where the publisher's figures go (YAML) once `count` are published",
+             &Settings::summary_file)
+        .add("stop_when_done", "stop the process once `count` are published",
+             &Settings::stop_when_done);
+
 class SequenceSource final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Test stream: numbered FiducialArrays whose content a sink can check.");
-    spec.parameter("count", 1000, "messages to publish; 0 for no end").min(0);
-    spec.parameter("batch", 10, "messages per tick").min(1);
-    spec.parameter("period_s", 0.01, "seconds between ticks").range(1e-5, 60);
-    spec.parameter("subscribers", 1, "matched subscribers to wait for before publishing").min(0);
-    spec.parameter("summary_file", std::string(),
-                   "where the publisher's figures go (YAML) once `count` are published");
-    spec.parameter("stop_when_done", false, "stop the process once `count` are published");
+    kParameters.declare(spec);
     spec.publishes<mocap_msgs::msg::FiducialArray>(kSequenceTopic, Qos::reliable(),
                                                    "the numbered stream");
   }
 
   explicit SequenceSource(Context& context) : Component(context) {
-    count_ = param<int>("count");
-    batch_ = param<int>("batch");
-    subscribers_ = param<size_t>("subscribers");
-    summary_file_ = param<std::string>("summary_file");
-    stop_when_done_ = param<bool>("stop_when_done");
+    count_ = settings_.count;
+    batch_ = settings_.batch;
+    subscribers_ = settings_.subscribers;
+    summary_file_ = settings_.summary_file;
+    stop_when_done_ = settings_.stop_when_done;
     publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kSequenceTopic);
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::duration<double>(param<double>("period_s"))),
+                     std::chrono::duration<double>(settings_.period_s)),
                  [this] { tick(); });
   }
 

@@ -18,41 +18,57 @@
 namespace mocap::bag {
 namespace {
 
+// Playback's options with what only the plugin reads.
+struct Settings : PlaybackOptions {
+  std::string bag;
+  double start_delay_s = 0.5;
+  double exit_after_s = -1;  // negative: run on
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("bag", "the bag directory, or one .mcap or .db3 file", &Settings::bag)
+        .path()
+        .add("rate", "pace relative to the recording; 0: as fast as possible", &Settings::rate)
+        .min(0)
+        .add("loop", "start again after the last message", &Settings::loop)
+        .add("topics", "topics to play (empty: all)", &Settings::topics)
+        .add("start_delay_s",
+             "seconds to wait before the first message, for subscribers in other processes to "
+             "be discovered",
+             &Settings::start_delay_s)
+        .range(0, 3600)
+        .add("exit_after_s",
+             "offline runs: end the process (exit status 0) this many seconds after the last "
+             "message, the time the graph needs to finish with it; negative: run on",
+             &Settings::exit_after_s)
+        .range(-1, 3600);
+
 class BagPlayer final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
-        "Plays a bag (rosbag2 sqlite3) into the deployment at its recorded pace times `rate` "
+        "Plays a rosbag2 bag (MCAP or sqlite3) into the deployment at its recorded pace times "
+        "`rate` "
         "(0: as fast as subscribers take them, in order; reliable subscribers are never "
         "overrun). Message stamps are the recorded ones.");
-    spec.parameter("bag", std::string(), "the bag directory, or one .mcap or .db3 file").path();
-    spec.parameter("rate", 1.0, "pace relative to the recording; 0: as fast as possible").min(0);
-    spec.parameter("loop", false, "start again after the last message");
-    spec.parameter("topics", std::vector<std::string>{}, "topics to play (empty: all)");
-    spec.parameter("start_delay_s", 0.5,
-                   "seconds to wait before the first message, for subscribers in other "
-                   "processes to be discovered")
-        .range(0, 3600);
-    spec.parameter("exit_after_s", -1.0,
-                   "offline runs: end the process (exit status 0) this many seconds after the "
-                   "last message, the time the graph needs to finish with it; negative: run on")
-        .range(-1, 3600);
+    kParameters.declare(spec);
     spec.publishes_any("the bag's topics, with their recorded types");
   }
 
   explicit BagPlayer(Context& context) : Component(context) {
-    const std::string path = param<std::string>("bag");
+    const std::string path = settings_.bag;
     if (path.empty())
       throw std::invalid_argument("bag: give the bag directory, or one .mcap or .db3 file");
     reader_ = std::make_unique<BagReader>(path);
     for (const std::string& problem : reader_->problems()) log().warn("{}", problem);
-    options_.rate = param<double>("rate");
-    options_.loop = param<bool>("loop");
-    options_.topics = param<std::vector<std::string>>("topics");
 
     for (const BagTopic& topic : reader_->metadata().topics) {
-      if (!options_.topics.empty() && std::find(options_.topics.begin(), options_.topics.end(),
-                                                topic.name) == options_.topics.end()) {
+      if (!settings_.topics.empty() && std::find(settings_.topics.begin(), settings_.topics.end(),
+                                                 topic.name) == settings_.topics.end()) {
         continue;
       }
       if (topic.type.empty()) {
@@ -76,8 +92,8 @@ class BagPlayer final : public Component {
     }
     // Timers tick only once the process runs, when every component of it subscribes: the
     // first tick starts the playback thread.
-    const double delay = std::max(param<double>("start_delay_s"), 1e-3);
-    const double exit_after = param<double>("exit_after_s");
+    const double delay = std::max(settings_.start_delay_s, 1e-3);
+    const double exit_after = settings_.exit_after_s;
     create_timer(
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(delay)),
         [this, exit_after] {
@@ -99,7 +115,7 @@ class BagPlayer final : public Component {
   void run(double exit_after) {
     uint64_t dropped = 0;
     const PlaybackStats stats = play(
-        *reader_, options_,
+        *reader_, settings_,
         [&](const BagMessage& message) {
           auto topic = topics_.find(message.topic->name);
           if (topic == topics_.end()) return;
@@ -117,7 +133,7 @@ class BagPlayer final : public Component {
         stop_);
     log().info("played {} message(s){}", stats.published,
                dropped ? fmt::format(", {} dropped (not deserializable)", dropped) : "");
-    if (exit_after < 0 || options_.loop) return;
+    if (exit_after < 0 || settings_.loop) return;
     const auto end = std::chrono::steady_clock::now() +
                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                          std::chrono::duration<double>(exit_after));
@@ -128,7 +144,6 @@ class BagPlayer final : public Component {
   }
 
   std::unique_ptr<BagReader> reader_;
-  PlaybackOptions options_;
   std::vector<std::unique_ptr<RawMessageType>> raw_types_;
   std::map<std::string, Topic> topics_;
   std::atomic<bool> stop_{false};

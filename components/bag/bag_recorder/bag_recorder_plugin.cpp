@@ -1,6 +1,6 @@
-// bag_recorder: records topics of the deployment into a rosbag2 sqlite3 bag from inside a
-// launch file. Messages of this process arrive by pointer and are serialized only by the
-// writer thread; the others arrive over DDS. Storage and crash safety: mocap/bag/recorder.hpp.
+// bag_recorder: records topics of the deployment into a rosbag2 bag (MCAP or sqlite3) from
+// inside a launch file. Messages of this process arrive by pointer and are serialized only by
+// the writer thread; the others arrive over DDS. Storage and crash safety: mocap/bag/recorder.hpp.
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -21,32 +21,50 @@ int64_t stamp_ns(Clock::time_point time) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count();
 }
 
+struct Settings {
+  std::string output;               // empty: bag_YYYY_MM_DD-HH_MM_SS
+  std::vector<std::string> topics;  // empty: every topic a component publishes
+  // Not BagWriterOptions' sqlite3 (what the library writes when asked nothing): a recording
+  // made from a launch file is a new one, and ROS 2 has written MCAP by default since Iron.
+  std::string storage = "mcap";
+  int64_t commit_interval_ms = 100;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("output", "the bag directory to create (empty: bag_YYYY_MM_DD-HH_MM_SS)",
+             &Settings::output)
+        .path()
+        .add("topics",
+             "topics to record (empty: every topic a component of the launch file publishes)",
+             &Settings::topics)
+        .add("storage",
+             "mcap (one .mcap file, zstd-compressed chunks; ROS 2's default since Iron) "
+             "or sqlite3 (a .db3 database, ROS 2 Humble's default)",
+             &Settings::storage)
+        .add("commit_interval_ms",
+             "the most a kill can lose: messages are committed at least this often",
+             &Settings::commit_interval_ms)
+        .range(1, 60000);
+
 class BagRecorder final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
-        "Records topics of the deployment into a bag (rosbag2 sqlite3 layout), each message "
+        "Records topics of the deployment into a rosbag2 bag (MCAP or sqlite3), each message "
         "stamped with its receive time. Topics are those the launch file's components declare; "
         "messages of this process are serialized only when written.");
-    spec.parameter("output", std::string(),
-                   "the bag directory to create (empty: bag_YYYY_MM_DD-HH_MM_SS)")
-        .path();
-    spec.parameter(
-        "topics", std::vector<std::string>{},
-        "topics to record (empty: every topic a component of the launch file publishes)");
-    spec.parameter("storage", std::string("mcap"),
-                   "mcap (one .mcap file, zstd-compressed chunks; ROS 2's default since Iron) "
-                   "or sqlite3 (a .db3 database, ROS 2 Humble's default)");
-    spec.parameter("commit_interval_ms", int64_t{100},
-                   "the most a kill can lose: messages are committed at least this often")
-        .range(1, 60000);
+    kParameters.declare(spec);
     spec.subscribes_any("the recorded topics, with their declared types");
   }
 
   explicit BagRecorder(Context& context) : Component(context) {
-    std::string output = param<std::string>("output");
+    std::string output = settings_.output;
     if (output.empty()) output = default_bag_directory();
-    const std::vector<std::string> wanted = param<std::vector<std::string>>("topics");
+    const std::vector<std::string> wanted = settings_.topics;
     const std::vector<KnownTopic> known = context.known_topics();
 
     std::vector<const KnownTopic*> recorded;
@@ -73,13 +91,12 @@ class BagRecorder final : public Component {
     }
 
     RecorderOptions options;
-    options.writer.storage = param<std::string>("storage");
+    options.writer.storage = settings_.storage;
     if (options.writer.storage != "mcap" && options.writer.storage != "sqlite3") {
       throw std::invalid_argument(
           fmt::format("storage: '{}' is not mcap or sqlite3", options.writer.storage));
     }
-    options.writer.commit_interval =
-        std::chrono::milliseconds(param<int64_t>("commit_interval_ms"));
+    options.writer.commit_interval = std::chrono::milliseconds(settings_.commit_interval_ms);
     recorder_ = std::make_unique<Recorder>(output, options);
     // A forced exit destroys nothing: metadata.yaml is written from what is committed.
     metadata_first_.emplace([recorder = recorder_.get()] {

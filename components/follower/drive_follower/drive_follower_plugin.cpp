@@ -47,40 +47,69 @@ double steady_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// The follower's options with what only the plugin reads.
+struct Settings : FollowerOptions {
+  std::string turret = mocap::config_file("turret.yaml");
+  std::string constellation;  // empty: the first of each pose array
+  std::string pan_joint = "pan";
+  std::string tilt_joint = "tilt";
+  double rate_hz = 20;  // control_period_s is its inverse
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("turret", "the turret's kinematic chain: where the camera is on the base",
+             &Settings::turret)
+        .path()
+        .add("constellation", "the constellation to follow; empty: the first of each pose array",
+             &Settings::constellation)
+        .add("pan_joint", "the pan joint's name in the joint states", &Settings::pan_joint)
+        .add("tilt_joint", "the tilt joint's name in the joint states", &Settings::tilt_joint)
+        .add("rate_hz", "control rate: one /cmd_vel per period", &Settings::rate_hz)
+        .range(1, 1000)
+        .add("lost_after_s", "no pose of the constellation for this long: track lost, base stopped",
+             &Settings::lost_after_s)
+        .range(0.01, 60)
+        .add("goal_distance_m", "the goal is this far in front of the object", &Settings::drive,
+             &DriveOptions::goal_distance_m)
+        .range(0.1, 20)
+        .add("goal_tolerance_m",
+             "once arrived, the base only turns while the goal stays this close", &Settings::drive,
+             &DriveOptions::goal_tolerance_m)
+        .range(0.005, 5)
+        .add("arrival_tolerance_m",
+             "the base drives until the goal is this close (at most goal_tolerance_m)",
+             &Settings::drive, &DriveOptions::arrival_tolerance_m)
+        .range(0.005, 5)
+        .add("linear_gain", "forward speed per metre to the goal, 1/s", &Settings::drive,
+             &DriveOptions::linear_gain)
+        .range(0.01, 20)
+        .add("angular_gain", "turn rate per radian of heading error, 1/s", &Settings::drive,
+             &DriveOptions::angular_gain)
+        .range(0.01, 20)
+        .add("max_linear_mps", "top speed, m/s", &Settings::drive, &DriveOptions::max_linear_mps)
+        .range(0.01, 5)
+        .add("max_angular_rps", "top turn rate, rad/s", &Settings::drive,
+             &DriveOptions::max_angular_rps)
+        .range(0.01, 20)
+        .add("max_linear_accel_mps2", "largest change of speed, m/s^2", &Settings::acceleration,
+             &AccelerationLimits::max_linear_accel_mps2)
+        .range(0.01, 100)
+        .add("max_angular_accel_rps2", "largest change of turn rate, rad/s^2",
+             &Settings::acceleration, &AccelerationLimits::max_angular_accel_rps2)
+        .range(0.01, 100);
+
 class DriveFollowerComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Drives a two-wheeled base to stay goal_distance_m in front of a tracked constellation, "
         "pointed at it (the seed's two rules, with acceleration limits); stops at once and "
         "raises an alert when the track is lost.");
-    spec.parameter("turret", mocap::config_file("turret.yaml"),
-                   "the turret's kinematic chain: where the camera is on the base")
-        .path();
-    spec.parameter("constellation", std::string(),
-                   "the constellation to follow; empty: the first of each pose array");
-    spec.parameter("pan_joint", std::string("pan"), "the pan joint's name in the joint states");
-    spec.parameter("tilt_joint", std::string("tilt"), "the tilt joint's name in the joint states");
-    spec.parameter("rate_hz", 20.0, "control rate: one /cmd_vel per period").range(1, 1000);
-    spec.parameter("lost_after_s", 0.25,
-                   "no pose of the constellation for this long: track lost, base stopped")
-        .range(0.01, 60);
-    spec.parameter("goal_distance_m", 1.5, "the goal is this far in front of the object")
-        .range(0.1, 20);
-    spec.parameter("goal_tolerance_m", 0.25,
-                   "once arrived, the base only turns while the goal stays this close")
-        .range(0.005, 5);
-    spec.parameter("arrival_tolerance_m", 0.05,
-                   "the base drives until the goal is this close (at most goal_tolerance_m)")
-        .range(0.005, 5);
-    spec.parameter("linear_gain", 1.0, "forward speed per metre to the goal, 1/s").range(0.01, 20);
-    spec.parameter("angular_gain", 2.0, "turn rate per radian of heading error, 1/s")
-        .range(0.01, 20);
-    spec.parameter("max_linear_mps", 0.6, "top speed, m/s").range(0.01, 5);
-    spec.parameter("max_angular_rps", 1.5, "top turn rate, rad/s").range(0.01, 20);
-    spec.parameter("max_linear_accel_mps2", 1.0, "largest change of speed, m/s^2").range(0.01, 100);
-    spec.parameter("max_angular_accel_rps2", 3.0, "largest change of turn rate, rad/s^2")
-        .range(0.01, 100);
+    kParameters.declare(spec);
     spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
                                             "constellation poses in the tracking camera's frame");
     spec.subscribes<JointState>(kJointStates, Qos::sensor_data(),
@@ -92,11 +121,11 @@ class DriveFollowerComponent final : public Component {
 
   explicit DriveFollowerComponent(Context& context)
       : Component(context),
-        turret_(turret::load_turret(param<std::string>("turret"))),
+        turret_(turret::load_turret(settings_.turret)),
         follower_(follower_options()),
-        constellation_(param<std::string>("constellation")),
-        pan_joint_(param<std::string>("pan_joint")),
-        tilt_joint_(param<std::string>("tilt_joint")) {
+        constellation_(settings_.constellation),
+        pan_joint_(settings_.pan_joint),
+        tilt_joint_(settings_.tilt_joint) {
     if (pan_joint_ == tilt_joint_) {
       throw std::invalid_argument("pan_joint and tilt_joint are both '" + pan_joint_ + "'");
     }
@@ -106,7 +135,7 @@ class DriveFollowerComponent final : public Component {
                                     [this](const JointState& state) { on_joint_state(state); });
     create_subscription<ConstellationPoseArray>(
         kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
-    const double rate = param<double>("rate_hz");
+    const double rate = settings_.rate_hz;
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(1.0 / rate)),
                  [this] { control(); });
@@ -128,18 +157,8 @@ class DriveFollowerComponent final : public Component {
 
  private:
   FollowerOptions follower_options() const {
-    FollowerOptions options;
-    options.drive.goal_distance_m = param<double>("goal_distance_m");
-    options.drive.goal_tolerance_m = param<double>("goal_tolerance_m");
-    options.drive.arrival_tolerance_m = param<double>("arrival_tolerance_m");
-    options.drive.linear_gain = param<double>("linear_gain");
-    options.drive.angular_gain = param<double>("angular_gain");
-    options.drive.max_linear_mps = param<double>("max_linear_mps");
-    options.drive.max_angular_rps = param<double>("max_angular_rps");
-    options.acceleration.max_linear_accel_mps2 = param<double>("max_linear_accel_mps2");
-    options.acceleration.max_angular_accel_rps2 = param<double>("max_angular_accel_rps2");
-    options.lost_after_s = param<double>("lost_after_s");
-    options.control_period_s = 1.0 / param<double>("rate_hz");
+    FollowerOptions options = settings_;
+    options.control_period_s = 1.0 / settings_.rate_hz;
     return options;
   }
 

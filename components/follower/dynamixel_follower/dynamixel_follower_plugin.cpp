@@ -53,41 +53,73 @@ int64_t clock_ns() {
       .count();
 }
 
+// The follower's and the bus's options with what only the plugin reads.
+struct Settings : TurretFollowerOptions {
+  std::string port = "/dev/ttyUSB0";
+  dynamixel::DynamixelBusOptions bus;
+  int reply_timeout_ms = 10;  // bus.reply_timeout
+  int pan_id = 1;
+  int tilt_id = 2;
+  std::string turret = mocap::config_file("turret.yaml");
+  std::string constellation;  // empty: the first of each pose array
+  double rate_hz = 50;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("port", "serial device of the Dynamixel adaptor (or the ax12_sim's device_link)",
+             &Settings::port)
+        .path()
+        .add("baud", "bus baud rate (the servos' setting)", &Settings::bus,
+             &dynamixel::DynamixelBusOptions::baud_rate)
+        .range(9600, 3000000)
+        .add("pan_id", "servo ID of the pan joint", &Settings::pan_id)
+        .range(0, 253)
+        .add("tilt_id", "servo ID of the tilt joint", &Settings::tilt_id)
+        .range(0, 253)
+        .add("turret", "the turret's kinematic chain and servo mapping (config/turret.yaml)",
+             &Settings::turret)
+        .path()
+        .add("constellation", "the constellation to follow; empty = the first of each pose array",
+             &Settings::constellation)
+        .add("rate_hz", "control cycles per second", &Settings::rate_hz)
+        .range(1, 500)
+        .add("pan_speed_rps", "pan speed limit, rad/s (the seed's heavy turret: 0.1)",
+             &Settings::pan_speed_rps)
+        .range(0.01, 11.9)
+        .add("tilt_speed_rps", "tilt speed limit, rad/s (the seed's heavy turret: 0.05)",
+             &Settings::tilt_speed_rps)
+        .range(0.01, 11.9)
+        .add("lost_after_s", "no pose for this long: the track is lost", &Settings::lost_after_s)
+        .range(0.01, 60)
+        .add("max_lead_s",
+             "aim at where the object's velocity (in the base frame, from its recent positions) "
+             "has taken it since its image, at most this far ahead; 0 = where it was seen",
+             &Settings::max_lead_s)
+        .range(0, 2)
+        .add("hold_s", "after losing the track, hold still this long", &Settings::hold_s)
+        .range(0, 3600)
+        .add("search", "after holding, sweep the pan joint to find the object", &Settings::search)
+        .add("search_speed_rps", "pan speed while searching, rad/s", &Settings::search_speed_rps)
+        .range(0.01, 11.9)
+        .add("reply_timeout_ms", "wait for a servo's answer, per attempt",
+             &Settings::reply_timeout_ms)
+        .range(1, 1000)
+        .add("retries", "further attempts after a timeout or a corrupt answer", &Settings::bus,
+             &dynamixel::DynamixelBusOptions::retries)
+        .range(0, 10);
+
 class DynamixelFollower final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Keeps the tracked constellation centred with a pan/tilt turret of two AX-12A servos "
         "(Dynamixel Protocol 1.0 on a serial port); publishes the joints' present state. "
         "Overheating or overload: torque off and an alert.");
-    spec.parameter("port", std::string("/dev/ttyUSB0"),
-                   "serial device of the Dynamixel adaptor (or the ax12_sim's device_link)")
-        .path();
-    spec.parameter("baud", 1000000, "bus baud rate (the servos' setting)").range(9600, 3000000);
-    spec.parameter("pan_id", 1, "servo ID of the pan joint").range(0, 253);
-    spec.parameter("tilt_id", 2, "servo ID of the tilt joint").range(0, 253);
-    spec.parameter("turret", mocap::config_file("turret.yaml"),
-                   "the turret's kinematic chain and servo mapping (config/turret.yaml)")
-        .path();
-    spec.parameter("constellation", std::string(),
-                   "the constellation to follow; empty = the first of each pose array");
-    spec.parameter("rate_hz", 50.0, "control cycles per second").range(1, 500);
-    spec.parameter("pan_speed_rps", 1.5, "pan speed limit, rad/s (the seed's heavy turret: 0.1)")
-        .range(0.01, 11.9);
-    spec.parameter("tilt_speed_rps", 1.0, "tilt speed limit, rad/s (the seed's heavy turret: 0.05)")
-        .range(0.01, 11.9);
-    spec.parameter("lost_after_s", 0.3, "no pose for this long: the track is lost").range(0.01, 60);
-    spec.parameter("max_lead_s", TurretFollowerOptions{}.max_lead_s,
-                   "aim at where the object's velocity (in the base frame, from its recent "
-                   "positions) has taken it since its image, at most this far ahead; 0 = where it "
-                   "was seen")
-        .range(0, 2);
-    spec.parameter("hold_s", 2.0, "after losing the track, hold still this long").range(0, 3600);
-    spec.parameter("search", false, "after holding, sweep the pan joint to find the object");
-    spec.parameter("search_speed_rps", 0.3, "pan speed while searching, rad/s").range(0.01, 11.9);
-    spec.parameter("reply_timeout_ms", 10, "wait for a servo's answer, per attempt").range(1, 1000);
-    spec.parameter("retries", 2, "further attempts after a timeout or a corrupt answer")
-        .range(0, 10);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoseTopic, Qos::reliable(),
                                                              "tracked poses, camera frame");
     spec.publishes<JointState>(kStateTopic, Qos::reliable(),
@@ -101,17 +133,16 @@ class DynamixelFollower final : public Component {
   }
 
   explicit DynamixelFollower(Context& context)
-      : Component(context),
-        follower_(load_turret(param<std::string>("turret")), follower_options()) {
-    constellation_ = param<std::string>("constellation");
-    pan_id_ = static_cast<uint8_t>(param<int>("pan_id"));
-    tilt_id_ = static_cast<uint8_t>(param<int>("tilt_id"));
+      : Component(context), follower_(load_turret(settings_.turret), settings_) {
+    constellation_ = settings_.constellation;
+    pan_id_ = static_cast<uint8_t>(settings_.pan_id);
+    tilt_id_ = static_cast<uint8_t>(settings_.tilt_id);
     if (pan_id_ == tilt_id_) {
       throw std::invalid_argument("pan_id and tilt_id are both " + std::to_string(pan_id_) +
                                   "; each servo needs its own ID");
     }
     period_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
-        std::chrono::duration<double>(1 / param<double>("rate_hz")));
+        std::chrono::duration<double>(1 / settings_.rate_hz));
     states_ = create_publisher<JointState>(kStateTopic);
     commands_ = create_publisher<JointState>(kCommandTopic);
     alerts_ = create_publisher<mocap_msgs::msg::Alert>(kAlertTopic);
@@ -124,7 +155,7 @@ class DynamixelFollower final : public Component {
       if (!worker_.joinable()) worker_ = std::thread([this] { run(); });
     });
     log().info("servos {} (pan) and {} (tilt) on {} at {} bit/s, {} Hz; turret {}", pan_id_,
-               tilt_id_, param<std::string>("port"), param<int>("baud"), param<double>("rate_hz"),
+               tilt_id_, settings_.port, settings_.bus.baud_rate, settings_.rate_hz,
                follower_.turret().source());
   }
 
@@ -139,18 +170,6 @@ class DynamixelFollower final : public Component {
   }
 
  private:
-  TurretFollowerOptions follower_options() const {
-    TurretFollowerOptions options;
-    options.pan_speed_rps = param<double>("pan_speed_rps");
-    options.tilt_speed_rps = param<double>("tilt_speed_rps");
-    options.lost_after_s = param<double>("lost_after_s");
-    options.max_lead_s = param<double>("max_lead_s");
-    options.hold_s = param<double>("hold_s");
-    options.search = param<bool>("search");
-    options.search_speed_rps = param<double>("search_speed_rps");
-    return options;
-  }
-
   // --- executor side ----------------------------------------------------------------------
 
   void on_poses(const mocap_msgs::msg::ConstellationPoseArray& poses) {
@@ -215,11 +234,9 @@ class DynamixelFollower final : public Component {
   }
 
   void connect() {
-    dynamixel::DynamixelBusOptions options;
-    options.baud_rate = param<int>("baud");
-    options.reply_timeout = std::chrono::milliseconds(param<int>("reply_timeout_ms"));
-    options.retries = param<int>("retries");
-    bus_ = std::make_unique<dynamixel::DynamixelBus>(param<std::string>("port"), options);
+    dynamixel::DynamixelBusOptions options = settings_.bus;
+    options.reply_timeout = std::chrono::milliseconds(settings_.reply_timeout_ms);
+    bus_ = std::make_unique<dynamixel::DynamixelBus>(settings_.port, options);
     if (connections_++ > 0) ++reconnects_;
     for (uint8_t id : {pan_id_, tilt_id_}) {
       if (uint8_t errors = bus_->ping(id); errors != 0) {

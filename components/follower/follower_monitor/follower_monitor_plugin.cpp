@@ -59,20 +59,35 @@ struct RateCounter {
   }
 };
 
+// The evaluation's options with what only the plugin reads.
+struct Settings : FollowEvaluationOptions {
+  std::string constellation = "board_a";
+  double report_period_s = 2;
+  std::string summary_file;  // empty: none
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("constellation", "the followed constellation", &Settings::constellation)
+        .add("report_period_s", "seconds between summary lines", &Settings::report_period_s)
+        .range(0.1, 3600)
+        .add("settle_s", "the object standing this long: the base's distance counts as steady",
+             &Settings::settle_s)
+        .range(0, 3600)
+        .add("summary_file", "where the final figures go (YAML), optional", &Settings::summary_file)
+        .path();
+
 class FollowerMonitor final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Follower demo figures from the simulation's ground truth: the turret's pointing "
         "error, the distance the base keeps from the object once it stands still, the time "
         "from a lost track to a stopped base, and loop rates; a live line and a final table.");
-    spec.parameter("constellation", std::string("board_a"), "the followed constellation");
-    spec.parameter("report_period_s", 2.0, "seconds between summary lines").range(0.1, 3600);
-    spec.parameter("settle_s", 4.0,
-                   "the object standing this long: the base's distance counts as steady")
-        .range(0, 3600);
-    spec.parameter("summary_file", std::string(), "where the final figures go (YAML), optional")
-        .path();
+    kParameters.declare(spec);
     spec.subscribes<ConstellationPoseArray>(kTruthTopic, Qos::reliable(),
                                             "the synthetic camera's ground truth");
     spec.subscribes<PoseStamped>(kCameraPoseTopic, Qos::reliable(), "the camera in the world");
@@ -86,9 +101,9 @@ class FollowerMonitor final : public Component {
   }
 
   explicit FollowerMonitor(Context& context) : Component(context) {
-    constellation_ = param<std::string>("constellation");
-    summary_file_ = param<std::string>("summary_file");
-    evaluator_ = FollowEvaluator({.settle_s = param<double>("settle_s")});
+    constellation_ = settings_.constellation;
+    summary_file_ = settings_.summary_file;
+    evaluator_ = FollowEvaluator(settings_);
     create_subscription<PoseStamped>(kCameraPoseTopic, [this](const PoseStamped& pose) {
       const std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose());
       if (!world_from_camera) return;
@@ -132,7 +147,7 @@ class FollowerMonitor final : public Component {
         [this](const sensor_msgs::msg::JointState&) { rates_["turret"].add(steady_ns()); });
     create_subscription<mocap_msgs::msg::Alert>(
         kAlertTopic, [this](const mocap_msgs::msg::Alert&) { ++alerts_; });
-    const double period_s = param<double>("report_period_s");
+    const double period_s = settings_.report_period_s;
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(period_s)),
                  [this, period_s] { report(period_s); });

@@ -76,7 +76,49 @@ Qos tf_qos() {
   return qos;
 }
 
+struct Settings {
+  std::string parent = "camera";
+  std::string world_frame = "world";
+  std::string camera_frame = "camera_ir";
+  std::string optical_frame = "camera_ir_optical";
+  std::vector<double> camera_in_world = {0, 0, 0, 0, 0, 0};
+  std::string child_frame_prefix;
+  double pose_rate_hz = 0.0;
+  double odom_rate_hz = 0.0;
+  double tf_rate_hz = 0.0;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("parent",
+             "frame of the poses: camera (the camera's optical frame, as /mocap/poses) or "
+             "world (through camera_in_world)",
+             &Settings::parent)
+        .add("world_frame", "name of the world frame", &Settings::world_frame)
+        .add("camera_frame", "name of the camera's REP 103 body frame (x forward, y left, z up)",
+             &Settings::camera_frame)
+        .add("optical_frame",
+             "name of the camera's optical frame (z forward, x right, y down), the frame "
+             "of /mocap/poses; poses whose header names another are counted and skipped",
+             &Settings::optical_frame)
+        .add("camera_in_world", "camera_frame in world_frame: x, y, z (m), roll, pitch, yaw (rad)",
+             &Settings::camera_in_world)
+        .add("child_frame_prefix", "prefix of the boards' frame names (the board's name follows)",
+             &Settings::child_frame_prefix)
+        .add("pose_rate_hz", "most PoseStamped a second per board (0: every frame)",
+             &Settings::pose_rate_hz)
+        .min(0)
+        .add("odom_rate_hz", "most Odometry a second per board (0: every frame)",
+             &Settings::odom_rate_hz)
+        .min(0)
+        .add("tf_rate_hz", "most /tf transforms a second per board (0: every frame)",
+             &Settings::tf_rate_hz)
+        .min(0);
+
 class PoseOutputs final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
@@ -84,24 +126,7 @@ class PoseOutputs final : public Component {
         "/mocap/<board>/pose and nav_msgs/Odometry (pose and twist with covariances, twist in "
         "the board's frame) on /mocap/<board>/odom, every board on /tf, the camera's mounting "
         "on /tf_static. Frames follow REP 103/105; stamps are the images' capture times.");
-    spec.parameter("parent", std::string("camera"),
-                   "frame of the poses: camera (the camera's optical frame, as /mocap/poses) or "
-                   "world (through camera_in_world)");
-    spec.parameter("world_frame", std::string("world"), "name of the world frame");
-    spec.parameter("camera_frame", std::string("camera_ir"),
-                   "name of the camera's REP 103 body frame (x forward, y left, z up)");
-    spec.parameter("optical_frame", std::string("camera_ir_optical"),
-                   "name of the camera's optical frame (z forward, x right, y down), the frame "
-                   "of /mocap/poses; poses whose header names another are counted and skipped");
-    spec.parameter("camera_in_world", std::vector<double>{0, 0, 0, 0, 0, 0},
-                   "camera_frame in world_frame: x, y, z (m), roll, pitch, yaw (rad)");
-    spec.parameter("child_frame_prefix", std::string(),
-                   "prefix of the boards' frame names (the board's name follows)");
-    spec.parameter("pose_rate_hz", 0.0, "most PoseStamped a second per board (0: every frame)")
-        .min(0);
-    spec.parameter("odom_rate_hz", 0.0, "most Odometry a second per board (0: every frame)").min(0);
-    spec.parameter("tf_rate_hz", 0.0, "most /tf transforms a second per board (0: every frame)")
-        .min(0);
+    kParameters.declare(spec);
     spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
                                             "the tracked boards in the camera's optical frame");
     spec.publishes<PoseStamped>(kPoseFamily, Qos::sensor_data(), "each board's pose");
@@ -115,25 +140,25 @@ class PoseOutputs final : public Component {
 
   explicit PoseOutputs(Context& context)
       : Component(context),
-        in_world_(param<std::string>("parent") == "world"),
-        world_frame_(param<std::string>("world_frame")),
-        optical_frame_(param<std::string>("optical_frame")),
-        child_prefix_(param<std::string>("child_frame_prefix")),
-        pose_rate_(param<double>("pose_rate_hz")),
-        odom_rate_(param<double>("odom_rate_hz")),
-        tf_rate_(param<double>("tf_rate_hz")) {
-    const std::string parent = param<std::string>("parent");
+        in_world_(settings_.parent == "world"),
+        world_frame_(settings_.world_frame),
+        optical_frame_(settings_.optical_frame),
+        child_prefix_(settings_.child_frame_prefix),
+        pose_rate_(settings_.pose_rate_hz),
+        odom_rate_(settings_.odom_rate_hz),
+        tf_rate_(settings_.tf_rate_hz) {
+    const std::string parent = settings_.parent;
     if (parent != "camera" && parent != "world") {
       throw std::invalid_argument("parent: '" + parent + "'; expected camera or world");
     }
-    const std::string camera_frame = param<std::string>("camera_frame");
+    const std::string camera_frame = settings_.camera_frame;
     for (const auto& [name, value] : {std::pair{"world_frame", world_frame_},
                                       {"camera_frame", camera_frame},
                                       {"optical_frame", optical_frame_}}) {
       if (value.empty()) throw std::invalid_argument(std::string(name) + " is empty");
     }
     const Eigen::Isometry3d world_from_camera =
-        from_xyz_rpy(param<std::vector<double>>("camera_in_world"), "camera_in_world");
+        from_xyz_rpy(settings_.camera_in_world, "camera_in_world");
     Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
     camera_from_optical.linear() = optical_in_body().toRotationMatrix();
     world_from_optical_ = world_from_camera * camera_from_optical;

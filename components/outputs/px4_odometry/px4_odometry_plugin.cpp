@@ -49,29 +49,49 @@ std::array<float, N> to_floats(const Eigen::Matrix<double, N, 1>& v) {
 
 uint64_t microseconds(int64_t nanoseconds) { return static_cast<uint64_t>(nanoseconds / 1000); }
 
+struct Settings {
+  std::string board;
+  std::string pose_frame = "frd";
+  std::vector<double> camera_in_world = {0, 0, 0, 0, 0, 0};
+  std::vector<double> vehicle_in_board = {0, 0, 0, 0, 0, 0};
+  std::string optical_frame = "camera_ir_optical";
+  double rate_hz = 50.0;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("board", "the board the vehicle carries (required)", &Settings::board)
+        .add("pose_frame",
+             "frd: our world (z up) has any heading, PX4 gets FRD; ned: our world is ENU "
+             "(x east, y north, z up), PX4 gets NED",
+             &Settings::pose_frame)
+        .add("camera_in_world",
+             "the camera's REP 103 body frame in the world: x, y, z (m), roll, pitch, yaw "
+             "(rad)",
+             &Settings::camera_in_world)
+        .add("vehicle_in_board",
+             "the vehicle's FLU body frame (x forward, y left, z up) in the board's frame: "
+             "x, y, z (m), roll, pitch, yaw (rad)",
+             &Settings::vehicle_in_board)
+        .add("optical_frame", "the frame of /mocap/poses; poses in another are counted and skipped",
+             &Settings::optical_frame)
+        .add("rate_hz",
+             "most messages a second, by the poses' capture stamps (PX4 wants 30-50; 0: "
+             "every frame)",
+             &Settings::rate_hz)
+        .min(0);
+
 class Px4OdometryComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "One tracked board carried by a PX4 vehicle as px4_msgs/VehicleOdometry (PX4 v1.14 to "
         "v1.18) for PX4's uXRCE-DDS bridge: position, attitude, velocities and variances in "
         "PX4's frames (world NED or FRD, body FRD), at rate_hz by capture stamps.");
-    spec.parameter("board", std::string(), "the board the vehicle carries (required)");
-    spec.parameter("pose_frame", std::string("frd"),
-                   "frd: our world (z up) has any heading, PX4 gets FRD; ned: our world is ENU "
-                   "(x east, y north, z up), PX4 gets NED");
-    spec.parameter("camera_in_world", std::vector<double>{0, 0, 0, 0, 0, 0},
-                   "the camera's REP 103 body frame in the world: x, y, z (m), roll, pitch, yaw "
-                   "(rad)");
-    spec.parameter("vehicle_in_board", std::vector<double>{0, 0, 0, 0, 0, 0},
-                   "the vehicle's FLU body frame (x forward, y left, z up) in the board's frame: "
-                   "x, y, z (m), roll, pitch, yaw (rad)");
-    spec.parameter("optical_frame", std::string("camera_ir_optical"),
-                   "the frame of /mocap/poses; poses in another are counted and skipped");
-    spec.parameter("rate_hz", 50.0,
-                   "most messages a second, by the poses' capture stamps (PX4 wants 30-50; 0: "
-                   "every frame)")
-        .min(0);
+    kParameters.declare(spec);
     spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
                                             "the tracked boards in the camera's optical frame");
     spec.publishes<VehicleOdometry>(kOdometry, px4_qos(), "the vehicle's odometry");
@@ -79,20 +99,19 @@ class Px4OdometryComponent final : public Component {
 
   explicit Px4OdometryComponent(Context& context)
       : Component(context),
-        board_(param<std::string>("board")),
-        optical_frame_(param<std::string>("optical_frame")),
-        rate_(param<double>("rate_hz")) {
+        board_(settings_.board),
+        optical_frame_(settings_.optical_frame),
+        rate_(settings_.rate_hz) {
     if (board_.empty()) throw std::invalid_argument("board: name the board the vehicle carries");
-    const std::string frame = param<std::string>("pose_frame");
+    const std::string frame = settings_.pose_frame;
     if (frame != "frd" && frame != "ned") {
       throw std::invalid_argument("pose_frame: '" + frame + "'; expected frd or ned");
     }
     frame_ = frame == "ned" ? Px4Frame::Ned : Px4Frame::Frd;
-    world_from_optical_ = world_from_optical(
-        from_xyz_rpy(param<std::vector<double>>("camera_in_world"), "camera_in_world"));
-    board_from_vehicle_ =
-        from_xyz_rpy(param<std::vector<double>>("vehicle_in_board"), "vehicle_in_board");
-    const double rate = param<double>("rate_hz");
+    world_from_optical_ =
+        world_from_optical(from_xyz_rpy(settings_.camera_in_world, "camera_in_world"));
+    board_from_vehicle_ = from_xyz_rpy(settings_.vehicle_in_board, "vehicle_in_board");
+    const double rate = settings_.rate_hz;
     publisher_ = create_publisher<VehicleOdometry>(kOdometry);
     create_subscription<ConstellationPoseArray>(
         kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });

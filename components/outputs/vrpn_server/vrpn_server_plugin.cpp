@@ -23,7 +23,36 @@ using mocap_msgs::msg::ConstellationPoseArray;
 
 constexpr const char* kPoses = "/mocap/poses";
 
+// The server's options with what only the plugin reads.
+struct Settings : TrackerServerOptions {
+  std::string frame = "camera";
+  std::vector<double> camera_in_world = {0, 0, 0, 0, 0, 0};  // x y z roll pitch yaw
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("address",
+             "IPv4 address to listen on: this machine only by default; 0.0.0.0 serves the "
+             "network",
+             &Settings::address)
+        .add("port", "TCP and UDP port (0: any free port, logged)", &Settings::port)
+        .range(0, 65535)
+        .add("frame",
+             "camera: the camera's optical frame, as /mocap/poses; world: through "
+             "camera_in_world",
+             &Settings::frame)
+        .add("camera_in_world",
+             "the camera's REP 103 body frame in the world: x, y, z (m), roll, pitch, yaw "
+             "(rad)",
+             &Settings::camera_in_world)
+        .add("max_queued_bytes", "bytes a client may have waiting; beyond, it is dropped",
+             &Settings::max_queued_bytes)
+        .range(4096, 1 << 30);
+
 class VrpnServer final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
@@ -31,38 +60,21 @@ class VrpnServer final : public Component {
         "vrpn_Tracker Pos_Quat and Velocity reports, capture-time stamps) to VRPN clients: "
         "board_a@host, or board_a@tcp://host:port. Slow or dead clients are dropped, never "
         "waited for.");
-    spec.parameter("address", std::string("127.0.0.1"),
-                   "IPv4 address to listen on: this machine only by default; 0.0.0.0 serves the "
-                   "network");
-    spec.parameter("port", int64_t{kDefaultPort}, "TCP and UDP port (0: any free port, logged)")
-        .range(0, 65535);
-    spec.parameter("frame", std::string("camera"),
-                   "camera: the camera's optical frame, as /mocap/poses; world: through "
-                   "camera_in_world");
-    spec.parameter("camera_in_world", std::vector<double>{0, 0, 0, 0, 0, 0},
-                   "the camera's REP 103 body frame in the world: x, y, z (m), roll, pitch, yaw "
-                   "(rad)");
-    spec.parameter("max_queued_bytes", int64_t{1 << 20},
-                   "bytes a client may have waiting; beyond, it is dropped")
-        .range(4096, 1 << 30);
+    kParameters.declare(spec);
     spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
                                             "the tracked boards in the camera's optical frame");
   }
 
   explicit VrpnServer(Context& context) : Component(context) {
-    const std::string frame = param<std::string>("frame");
+    const std::string frame = settings_.frame;
     if (frame != "camera" && frame != "world") {
       throw std::invalid_argument("frame: '" + frame + "'; expected camera or world");
     }
     const Eigen::Isometry3d world_from_camera =
-        outputs::from_xyz_rpy(param<std::vector<double>>("camera_in_world"), "camera_in_world");
+        outputs::from_xyz_rpy(settings_.camera_in_world, "camera_in_world");
     if (frame == "world") world_from_optical_ = outputs::world_from_optical(world_from_camera);
-    TrackerServerOptions options;
-    options.address = param<std::string>("address");
-    options.port = static_cast<uint16_t>(param<int64_t>("port"));
-    options.max_queued_bytes = static_cast<size_t>(param<int64_t>("max_queued_bytes"));
     try {
-      server_ = std::make_unique<TrackerServer>(options);
+      server_ = std::make_unique<TrackerServer>(settings_);
     } catch (const std::runtime_error& e) {
       throw std::invalid_argument(e.what());  // names the parameter at fault
     }
@@ -71,7 +83,7 @@ class VrpnServer final : public Component {
     const std::string served = fmt::format(
         "VRPN trackers (one per board, in the {} frame) on {}:{} TCP and UDP; clients ask for "
         "BOARD@HOST",
-        frame, options.address, server_->port());
+        frame, settings_.address, server_->port());
     if (server_->loopback_only()) {
       log().info("{} (this machine only)", served);
     } else {

@@ -23,26 +23,50 @@ constexpr const char* kFiducialFamily = "/pixart/{camera}/fiducials";
 // Uncertainty of a PixArt coordinate: the sensor reports whole pixels (1/sqrt(12) px).
 constexpr float kQuantisationPx = 0.29f;
 
+// The decoder's and each CAN source's options with what only the plugin reads.
+struct Settings : PixartDecoderOptions {
+  std::string source = "slcan";  // slcan, socketcan or candump
+  can::SlcanSourceOptions slcan{.device = "/dev/ttyACM0"};
+  std::string interface = "can0";  // socketcan
+  can::CandumpSourceOptions candump;
+  std::vector<std::string> camera_names;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("source", "slcan, socketcan or candump", &Settings::source)
+        .add("device", "slcan: the adaptor's serial device", &Settings::slcan,
+             &can::SlcanSourceOptions::device)
+        .path()
+        .add("bitrate", "slcan: CAN bitrate, bit/s", &Settings::slcan,
+             &can::SlcanSourceOptions::bitrate)
+        .range(10000, 1000000)
+        .add("baud", "slcan: serial baud rate (USB adaptors ignore it)", &Settings::slcan,
+             &can::SlcanSourceOptions::baud)
+        .range(9600, 3000000)
+        .add("interface", "socketcan: the CAN interface", &Settings::interface)
+        .add("file", "candump: a `candump -L` log", &Settings::candump,
+             &can::CandumpSourceOptions::file)
+        .path()
+        .add("recorded_timing", "candump: replay at the recorded pace (false: as fast as possible)",
+             &Settings::candump, &can::CandumpSourceOptions::recorded_timing)
+        .add("base_id", "CAN ID of box 0, camera 0, points 0-1", &Settings::base_id)
+        .range(0, 0x7FF)
+        .add("boxes", "camera boxes on the bus (4 cameras each)", &Settings::boxes)
+        .range(1, 64)
+        .add("camera_names", "name of camera 0, 1, ...: topic and frame id; others are camera<N>",
+             &Settings::camera_names);
+
 class PixartBridge final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Reads PixArt IR sensors' points from a CAN bus (SLCAN adaptor, SocketCAN or a candump "
         "log), publishes them raw and as one fiducial array per camera sample.");
-    spec.parameter("source", std::string("slcan"), "slcan, socketcan or candump");
-    spec.parameter("device", std::string("/dev/ttyACM0"), "slcan: the adaptor's serial device")
-        .path();
-    spec.parameter("bitrate", 1000000, "slcan: CAN bitrate, bit/s").range(10000, 1000000);
-    spec.parameter("baud", 115200, "slcan: serial baud rate (USB adaptors ignore it)")
-        .range(9600, 3000000);
-    spec.parameter("interface", std::string("can0"), "socketcan: the CAN interface");
-    spec.parameter("file", std::string(), "candump: a `candump -L` log").path();
-    spec.parameter("recorded_timing", true,
-                   "candump: replay at the recorded pace (false: as fast as possible)");
-    spec.parameter("base_id", 0x100, "CAN ID of box 0, camera 0, points 0-1").range(0, 0x7FF);
-    spec.parameter("boxes", 8, "camera boxes on the bus (4 cameras each)").range(1, 64);
-    spec.parameter("camera_names", std::vector<std::string>{},
-                   "name of camera 0, 1, ...: topic and frame id; others are camera<N>");
+    kParameters.declare(spec);
     spec.publishes<mocap_msgs::msg::PixartRawPointArray>(
         kRawTopic, Qos::reliable(), "the points decoded from each batch of frames read");
     spec.publishes<mocap_msgs::msg::FiducialArray>(
@@ -50,18 +74,15 @@ class PixartBridge final : public Component {
         "one array per camera sample (up to 4 points, pixels), frame id = camera name");
   }
 
-  explicit PixartBridge(Context& context)
-      : Component(context),
-        decoder_(PixartDecoderOptions{static_cast<uint32_t>(param<int>("base_id")),
-                                      param<int>("boxes")}) {
-    source_kind_ = param<std::string>("source");
+  explicit PixartBridge(Context& context) : Component(context), decoder_(settings_) {
+    source_kind_ = settings_.source;
     if (source_kind_ != "slcan" && source_kind_ != "socketcan" && source_kind_ != "candump") {
       throw std::invalid_argument("parameter 'source' is '" + source_kind_ +
                                   "'; expected slcan, socketcan or candump");
     }
-    camera_names_ = param<std::vector<std::string>>("camera_names");
+    camera_names_ = settings_.camera_names;
     raw_ = create_publisher<mocap_msgs::msg::PixartRawPointArray>(kRawTopic);
-    for (int camera = 0; camera < 4 * param<int>("boxes"); ++camera) {
+    for (int camera = 0; camera < 4 * settings_.boxes; ++camera) {
       fiducials_.push_back(create_publisher<mocap_msgs::msg::FiducialArray>(
           "/pixart/" + camera_name(camera) + "/fiducials"));
     }
@@ -101,11 +122,10 @@ class PixartBridge final : public Component {
 
   std::unique_ptr<can::CanSource> open() {
     if (source_kind_ == "slcan") {
-      return can::open_slcan(
-          {param<std::string>("device"), param<int>("bitrate"), param<int>("baud")});
+      return can::open_slcan(settings_.slcan);
     }
-    if (source_kind_ == "socketcan") return can::open_socketcan(param<std::string>("interface"));
-    return can::open_candump({param<std::string>("file"), param<bool>("recorded_timing")});
+    if (source_kind_ == "socketcan") return can::open_socketcan(settings_.interface);
+    return can::open_candump(settings_.candump);
   }
 
   // Reads until stopped; a device that fails is reopened with back-off (0.1 s doubling to

@@ -36,7 +36,48 @@ constexpr const char* kFootprints = "/pixart/camera_footprints";
 
 double degrees(double radians) { return radians * 180.0 / M_PI; }
 
+// The localizer's options with what only the plugin reads.
+struct Settings : LocalizerOptions {
+  std::string rig = mocap::config_file("pixart/rig.yaml");
+  double publish_rate_hz = 50;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("rig", "the rig: cameras, LED plane height, robots' LED layouts", &Settings::rig)
+        .path()
+        .add("merge_distance_m", "points of two cameras closer than this are one LED",
+             &Settings::merging, &MergeOptions::merge_distance_m)
+        .range(1e-4, 1)
+        .add("merge_window_s", "... if their samples were taken within this of each other",
+             &Settings::merging, &MergeOptions::merge_window_s)
+        .range(0, 1)
+        .add("stale_after_s",
+             "a camera whose last sample is older than this (against the newest) is "
+             "left out",
+             &Settings::merging, &MergeOptions::stale_after_s)
+        .range(1e-3, 10)
+        .add("pattern_tolerance_m", "how far LED distances may be from a robot's layout",
+             &Settings::recognition, &RecognitionOptions::pattern_tolerance_m)
+        .range(1e-4, 0.1)
+        .add("tracking_gate_m",
+             "how far a robot's steady LED may be from its tracked place, for readings "
+             "of 2 LEDs and of 1",
+             &Settings::recognition, &RecognitionOptions::tracking_gate_m)
+        .range(1e-3, 10)
+        .add("publish_rate_hz",
+             "rate of /pixart/robots; 0 = after every sample used (no timer: nothing is "
+             "published while no sample arrives)",
+             &Settings::publish_rate_hz)
+        .range(0, 1000)
+        .add("lost_after_s", "a robot not seen for this long is dropped", &Settings::tracking,
+             &TrackingOptions::lost_after_s)
+        .range(0.01, 3600);
+
 class PixartLocalizer final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
@@ -44,31 +85,7 @@ class PixartLocalizer final : public Component {
         "cameras: each camera's points onto the LED plane, the same LED seen by overlapping "
         "cameras merged, robots recognised by their LED spacings, x, y, theta published for "
         "every tracked robot (also while it stands still).");
-    spec.parameter("rig", mocap::config_file("pixart/rig.yaml"),
-                   "the rig: cameras, LED plane height, robots' LED layouts")
-        .path();
-    spec.parameter("merge_distance_m", 0.02, "points of two cameras closer than this are one LED")
-        .range(1e-4, 1);
-    spec.parameter("merge_window_s", 0.005,
-                   "... if their samples were taken within this of each other")
-        .range(0, 1);
-    spec.parameter("stale_after_s", 0.02,
-                   "a camera whose last sample is older than this (against the newest) is "
-                   "left out")
-        .range(1e-3, 10);
-    spec.parameter("pattern_tolerance_m", 0.008,
-                   "how far LED distances may be from a robot's layout")
-        .range(1e-4, 0.1);
-    spec.parameter("tracking_gate_m", 0.1,
-                   "how far a robot's steady LED may be from its tracked place, for readings "
-                   "of 2 LEDs and of 1")
-        .range(1e-3, 10);
-    spec.parameter("publish_rate_hz", 50.0,
-                   "rate of /pixart/robots; 0 = after every sample used (no timer: nothing is "
-                   "published while no sample arrives)")
-        .range(0, 1000);
-    spec.parameter("lost_after_s", 1.0, "a robot not seen for this long is dropped")
-        .range(0.01, 3600);
+    kParameters.declare(spec);
     spec.subscribes<FiducialArray>(
         kFiducialFamily, Qos::reliable(),
         "one topic per rig camera: its points in pixels, frame id = the camera's rig name");
@@ -83,7 +100,7 @@ class PixartLocalizer final : public Component {
   }
 
   explicit PixartLocalizer(Context& context)
-      : Component(context), localizer_(load_rig(param<std::string>("rig")), localizer_options()) {
+      : Component(context), localizer_(load_rig(settings_.rig), settings_) {
     const Rig& rig = localizer_.rig();
     for (const std::string& problem : localizer_.recognizer().unsupported()) {
       log().warn("{}: not localized", problem);
@@ -95,7 +112,7 @@ class PixartLocalizer final : public Component {
           "/pixart/" + camera.name + "/fiducials",
           [this, name = camera.name](const FiducialArray& array) { on_sample(name, array); });
     }
-    if (const double rate = param<double>("publish_rate_hz"); rate > 0) {
+    if (const double rate = settings_.publish_rate_hz; rate > 0) {
       create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                        std::chrono::duration<double>(1.0 / rate)),
                    [this] { publish(); });
@@ -142,17 +159,6 @@ class PixartLocalizer final : public Component {
     }
     footprints_ = create_publisher<CameraFootprintArray>(kFootprints);
     footprints_.publish(std::move(footprints));
-  }
-
-  LocalizerOptions localizer_options() const {
-    LocalizerOptions options;
-    options.merging.merge_distance_m = param<double>("merge_distance_m");
-    options.merging.merge_window_s = param<double>("merge_window_s");
-    options.merging.stale_after_s = param<double>("stale_after_s");
-    options.recognition.pattern_tolerance_m = param<double>("pattern_tolerance_m");
-    options.recognition.tracking_gate_m = param<double>("tracking_gate_m");
-    options.tracking.lost_after_s = param<double>("lost_after_s");
-    return options;
   }
 
   // `topic_camera`: the rig camera whose topic carried the array. The array's frame id names

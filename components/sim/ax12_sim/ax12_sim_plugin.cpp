@@ -41,7 +41,41 @@ std::vector<uint8_t> servo_ids(const std::vector<int64_t>& values) {
   return ids;
 }
 
+struct Settings {
+  std::vector<int64_t> ids = {1, 2};
+  std::vector<int> initial_positions;
+  std::vector<std::string> faults;
+  int baud = 1000000;
+  std::string device_link;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("ids", "the servos' IDs, distinct", &Settings::ids)
+        .range(0, 253)
+        .add("initial_positions",
+             "present position of each servo (same order as ids), position units; empty = "
+             "512 (centre) for all",
+             &Settings::initial_positions)
+        .range(0, 1023)
+        .add("faults",
+             "injected faults as ID:FAULT, FAULT one of silent (no answer), corrupt (bad "
+             "checksums), overheat, overload, none; e.g. [\"2:overheat\"]",
+             &Settings::faults)
+        .add("baud",
+             "the bus's bit rate, informational: a pseudo-terminal passes bytes at any rate",
+             &Settings::baud)
+        .min(1)
+        .add("device_link",
+             "symbolic link to create to the pseudo-terminal (replacing an older link), "
+             "for the driver's `device`; empty = none (the log names the pty)",
+             &Settings::device_link)
+        .path();
+
 class Ax12Sim final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
@@ -49,27 +83,12 @@ class Ax12Sim final : public Component {
         "instructions (PING, READ, WRITE, REG_WRITE/ACTION, SYNC_WRITE, RESET) like the real "
         "servos and moves them toward their goal positions at their moving speeds, for the "
         "Dynamixel driver when no servos are attached. Publishes nothing.");
-    spec.parameter("ids", std::vector<int>{1, 2}, "the servos' IDs, distinct").range(0, 253);
-    spec.parameter("initial_positions", std::vector<int>{},
-                   "present position of each servo (same order as ids), position units; empty = "
-                   "512 (centre) for all")
-        .range(0, 1023);
-    spec.parameter("faults", std::vector<std::string>{},
-                   "injected faults as ID:FAULT, FAULT one of silent (no answer), corrupt (bad "
-                   "checksums), overheat, overload, none; e.g. [\"2:overheat\"]");
-    spec.parameter("baud", 1000000,
-                   "the bus's bit rate, informational: a pseudo-terminal passes bytes at any rate")
-        .min(1);
-    spec.parameter("device_link", std::string(),
-                   "symbolic link to create to the pseudo-terminal (replacing an older link), "
-                   "for the driver's `device`; empty = none (the log names the pty)")
-        .path();
+    kParameters.declare(spec);
   }
 
-  explicit Ax12Sim(Context& context)
-      : Component(context), chain_(servo_ids(param<std::vector<int64_t>>("ids"))) {
+  explicit Ax12Sim(Context& context) : Component(context), chain_(servo_ids(settings_.ids)) {
     const std::vector<uint8_t> ids = chain_.ids();
-    const std::vector<int> positions = param<std::vector<int>>("initial_positions");
+    const std::vector<int> positions = settings_.initial_positions;
     if (!positions.empty() && positions.size() != ids.size()) {
       throw std::invalid_argument(
           fmt::format("parameter 'initial_positions' has {} values for {} servos", positions.size(),
@@ -79,7 +98,7 @@ class Ax12Sim final : public Component {
       chain_.set_position(ids[i], static_cast<uint16_t>(positions[i]));
     }
     std::string faults;
-    for (const std::string& text : param<std::vector<std::string>>("faults")) {
+    for (const std::string& text : settings_.faults) {
       const auto [id, fault] = parse_ax12_fault_spec(text);
       if (!chain_.has_servo(id)) {
         throw std::invalid_argument(
@@ -89,12 +108,12 @@ class Ax12Sim final : public Component {
       faults += fmt::format(", servo {} {}", id, to_string(fault));
     }
     pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
-    const std::string link = param<std::string>("device_link");
+    const std::string link = settings_.device_link;
     if (!link.empty()) {
       device_link_.emplace(link, pty_->slave_path());
     }
     log().info("simulated AX-12A chain on {}{}: servos {} at {} bit/s{}", pty_->slave_path(),
-               link.empty() ? "" : " (link " + link + ")", fmt::join(ids, ", "), param<int>("baud"),
+               link.empty() ? "" : " (link " + link + ")", fmt::join(ids, ", "), settings_.baud,
                faults);
     start_ = Steady::now();
     worker_ = std::jthread([this](std::stop_token stop) { play(stop); });

@@ -12,28 +12,42 @@ namespace {
 
 constexpr const char* kTopic = "/demo/fiducials";
 
+// The pattern's options with what only the plugin reads.
+struct Settings : PatternOptions {
+  double rate_hz = 100;
+  std::string frame_id = "camera";
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("rate_hz", "arrays published per second", &Settings::rate_hz)
+        .range(0.1, 100000)
+        .add("points", "fiducials per array", &Settings::count)
+        .range(1, 100000)
+        .add("radius_px", "radius of the circle, pixels", &Settings::radius_px)
+        .range(0, 10000)
+        .add("turns_per_second", "how fast the circle turns", &Settings::turns_per_second)
+        .range(-100, 100)
+        .add("frame_id", "frame id of the arrays' headers", &Settings::frame_id);
+
 class FiducialPatternSource final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Publishes fiducials on a turning circle, a stand-in for a tracked target.");
-    spec.parameter("rate_hz", 100.0, "arrays published per second").range(0.1, 100000);
-    spec.parameter("points", 12, "fiducials per array").range(1, 100000);
-    spec.parameter("radius_px", 200.0, "radius of the circle, pixels").range(0, 10000);
-    spec.parameter("turns_per_second", 0.1, "how fast the circle turns").range(-100, 100);
-    spec.parameter("frame_id", std::string("camera"), "frame id of the arrays' headers");
+    kParameters.declare(spec);
     spec.publishes<mocap_msgs::msg::FiducialArray>(kTopic, Qos::sensor_data(),
                                                    "one array per tick, stamped when made");
   }
 
   explicit FiducialPatternSource(Context& context) : Component(context) {
-    options_.count = param<int>("points");
-    options_.radius_px = param<double>("radius_px");
-    options_.turns_per_second = param<double>("turns_per_second");
-    frame_id_ = param<std::string>("frame_id");
+    frame_id_ = settings_.frame_id;
     publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kTopic);
-    auto period = std::chrono::duration<double>(1.0 / param<double>("rate_hz"));
+    auto period = std::chrono::duration<double>(1.0 / settings_.rate_hz);
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), [this] { tick(); });
-    log().info("publishing {} fiducials at {} Hz on {}", options_.count, param<double>("rate_hz"),
+    log().info("publishing {} fiducials at {} Hz on {}", settings_.count, settings_.rate_hz,
                publisher_.topic());
   }
 
@@ -44,7 +58,7 @@ class FiducialPatternSource final : public Component {
     auto message = std::make_shared<mocap_msgs::msg::FiducialArray>();
     message->header().stamp(to_time_msg(now));
     message->header().frame_id(frame_id_);
-    for (const PatternPoint& point : fiducial_pattern(options_, t)) {
+    for (const PatternPoint& point : fiducial_pattern(settings_, t)) {
       mocap_msgs::msg::Fiducial fiducial;
       fiducial.x(static_cast<float>(point.x));
       fiducial.y(static_cast<float>(point.y));
@@ -55,7 +69,6 @@ class FiducialPatternSource final : public Component {
     publisher_.publish(std::move(message));
   }
 
-  PatternOptions options_;
   std::string frame_id_;
   Clock::time_point start_ = Clock::now();
   Publisher<mocap_msgs::msg::FiducialArray> publisher_;

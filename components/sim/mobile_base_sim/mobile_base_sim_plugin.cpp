@@ -47,29 +47,54 @@ PoseStamped stamped_pose(const Eigen::Isometry3d& pose,
   return message;
 }
 
+struct Settings {
+  double rate_hz = 100.0;
+  double cmd_vel_timeout_s = 0.5;
+  double x = 0.0;
+  double y = 0.0;
+  double yaw_deg = 0.0;
+  double max_linear_mps = 0.7;
+  double max_angular_rps = 3.14;
+  std::string turret = mocap::config_file("turret.yaml");
+  std::string pan_joint = "pan";
+  std::string tilt_joint = "tilt";
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("rate_hz", "integration and publication rate", &Settings::rate_hz)
+        .range(1, 1000)
+        .add("cmd_vel_timeout_s", "no /cmd_vel for this long: the base stops",
+             &Settings::cmd_vel_timeout_s)
+        .range(0.001, 60)
+        .add("x", "initial position in the world, m", &Settings::x)
+        .add("y", "initial position in the world, m", &Settings::y)
+        .add("yaw_deg", "initial heading, degrees counter-clockwise from world x",
+             &Settings::yaw_deg)
+        .range(-360, 360)
+        .add("max_linear_mps", "top speed (a TurtleBot 2's), m/s; 0: no limit",
+             &Settings::max_linear_mps)
+        .range(0, 100)
+        .add("max_angular_rps", "top turn rate (a TurtleBot 2's), rad/s; 0: no limit",
+             &Settings::max_angular_rps)
+        .range(0, 100)
+        .add("turret", "the turret's kinematic chain: where the camera is on the base",
+             &Settings::turret)
+        .path()
+        .add("pan_joint", "the pan joint's name in the joint states", &Settings::pan_joint)
+        .add("tilt_joint", "the tilt joint's name in the joint states", &Settings::tilt_joint);
+
 class MobileBaseSim final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Simulates a two-wheeled base driven by /cmd_vel (exact arcs, stops when commands stop) "
         "carrying the pan/tilt turret; publishes the base's pose and the turret camera's pose "
         "in the world.");
-    spec.parameter("rate_hz", 100.0, "integration and publication rate").range(1, 1000);
-    spec.parameter("cmd_vel_timeout_s", 0.5, "no /cmd_vel for this long: the base stops")
-        .range(0.001, 60);
-    spec.parameter("x", 0.0, "initial position in the world, m");
-    spec.parameter("y", 0.0, "initial position in the world, m");
-    spec.parameter("yaw_deg", 0.0, "initial heading, degrees counter-clockwise from world x")
-        .range(-360, 360);
-    spec.parameter("max_linear_mps", 0.7, "top speed (a TurtleBot 2's), m/s; 0: no limit")
-        .range(0, 100);
-    spec.parameter("max_angular_rps", 3.14, "top turn rate (a TurtleBot 2's), rad/s; 0: no limit")
-        .range(0, 100);
-    spec.parameter("turret", mocap::config_file("turret.yaml"),
-                   "the turret's kinematic chain: where the camera is on the base")
-        .path();
-    spec.parameter("pan_joint", std::string("pan"), "the pan joint's name in the joint states");
-    spec.parameter("tilt_joint", std::string("tilt"), "the tilt joint's name in the joint states");
+    kParameters.declare(spec);
     spec.subscribes<Twist>(kCommand, Qos::reliable(), "linear.x (m/s) and angular.z (rad/s)");
     spec.subscribes<JointState>(kJointStates, Qos::sensor_data(),
                                 "the turret's angles, radians (0, 0 until the first)");
@@ -80,24 +105,23 @@ class MobileBaseSim final : public Component {
 
   explicit MobileBaseSim(Context& context)
       : Component(context),
-        base_({param<double>("x"), param<double>("y"), param<double>("yaw_deg") * kDegree},
-              {param<double>("max_linear_mps"), param<double>("max_angular_rps")}),
-        turret_(turret::load_turret(param<std::string>("turret"))),
+        base_({settings_.x, settings_.y, settings_.yaw_deg * kDegree},
+              {settings_.max_linear_mps, settings_.max_angular_rps}),
+        turret_(turret::load_turret(settings_.turret)),
         timeout_(std::chrono::duration_cast<SteadyClock::duration>(
-            std::chrono::duration<double>(param<double>("cmd_vel_timeout_s")))),
-        pan_joint_(param<std::string>("pan_joint")),
-        tilt_joint_(param<std::string>("tilt_joint")) {
+            std::chrono::duration<double>(settings_.cmd_vel_timeout_s))),
+        pan_joint_(settings_.pan_joint),
+        tilt_joint_(settings_.tilt_joint) {
     base_publisher_ = create_publisher<PoseStamped>(kBasePose);
     camera_publisher_ = create_publisher<PoseStamped>(kCameraPose);
     create_subscription<Twist>(kCommand, [this](const Twist& twist) { on_command(twist); });
     create_subscription<JointState>(kJointStates,
                                     [this](const JointState& state) { on_joint_state(state); });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::duration<double>(1.0 / param<double>("rate_hz"))),
+                     std::chrono::duration<double>(1.0 / settings_.rate_hz)),
                  [this] { tick(); });
     log().info("base at x {} m, y {} m, yaw {} deg; {} Hz; turret {}", base_.pose().x,
-               base_.pose().y, base_.pose().yaw / kDegree, param<double>("rate_hz"),
-               turret_.source());
+               base_.pose().y, base_.pose().yaw / kDegree, settings_.rate_hz, turret_.source());
   }
 
   ~MobileBaseSim() override {
@@ -143,7 +167,7 @@ class MobileBaseSim final : public Component {
     const bool commanded = command_ && steady - command_at_ <= timeout_;
     if (!commanded && driving_) {
       ++timeouts_;
-      log().warn("no {} for {} s: stopped", kCommand, param<double>("cmd_vel_timeout_s"));
+      log().warn("no {} for {} s: stopped", kCommand, settings_.cmd_vel_timeout_s);
     }
     driving_ = commanded;
     if (commanded) {

@@ -66,7 +66,71 @@ int64_t wall_clock_ns() {
       .count();
 }
 
+// The simulator's options with what only the plugin reads.
+struct Settings : PixartBoxSimulatorOptions {
+  std::string rig = mocap::config_file("pixart/rig.yaml");
+  std::string scene = mocap::config_file("pixart/scenes/two_robots.yaml");
+  std::string output = "pty";
+  std::string device_link;
+  std::string file;
+  double duration_s = 10.0;
+  double start_stamp_s = 0.0;
+  double rate_hz = 270.0;
+  int bitrate = 1000000;
+  double truth_rate_hz = 50.0;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("rig", "rig file: cameras, LED plane, robots' LED layouts (config/pixart/README.md)",
+             &Settings::rig)
+        .path()
+        .add("scene",
+             "scene file: robots' trajectories, calibration boards (config/pixart/README.md)",
+             &Settings::scene)
+        .path()
+        .add("output",
+             "pty (a simulated SLCAN adaptor on a pseudo-terminal) or candump (a log file)",
+             &Settings::output)
+        .add("device_link",
+             "pty: symbolic link to create to the pseudo-terminal (replacing an older link), "
+             "for the bridge's `device`; empty = none (the log names the pty)",
+             &Settings::device_link)
+        .path()
+        .add("file", "candump: the log to write", &Settings::file)
+        .path()
+        .add("duration_s", "candump: scene time to write, seconds", &Settings::duration_s)
+        .range(0.001, 1e6)
+        .add("start_stamp_s",
+             "candump: receive time of the first sample, seconds since the Unix epoch; "
+             "0 = now",
+             &Settings::start_stamp_s)
+        .range(0, 4e9)
+        .add("rate_hz", "samples per second, all cameras at once", &Settings::rate_hz)
+        .range(1, 10000)
+        .add("bitrate",
+             "pty: the box's CAN bitrate; the adaptor passes frames only when the host "
+             "opened the channel at it",
+             &Settings::bitrate)
+        .range(10000, 1000000)
+        .add("base_id", "CAN ID of camera 0, points 0-1", &Settings::base_id)
+        .range(0, 0x7FF)
+        .add("noise_px",
+             "Gaussian noise on each coordinate before rounding, pixels (sigma); 0 = none",
+             &Settings::noise_px)
+        .range(0, 100)
+        .add("seed", "seed of the noise", &Settings::seed)
+        .range(0, 2147483647)
+        .add("truth_rate_hz",
+             "ground truth per second of scene time (pty: /pixart/ground_truth messages; "
+             "candump: rows of FILE.truth.csv); 0 = none",
+             &Settings::truth_rate_hz)
+        .range(0, 1000);
+
 class PixartBoxSim final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
@@ -74,38 +138,7 @@ class PixartBoxSim final : public Component {
         "ceiling cameras; each camera's LEDs are sent as CAN frames at the sensor's rate, as an "
         "SLCAN USB-CAN adaptor on a pseudo-terminal (for pixart_bridge source: slcan) or into a "
         "candump -L log. Publishes the robots' true poses.");
-    spec.parameter("rig", mocap::config_file("pixart/rig.yaml"),
-                   "rig file: cameras, LED plane, robots' LED layouts (config/pixart/README.md)")
-        .path();
-    spec.parameter("scene", mocap::config_file("pixart/scenes/two_robots.yaml"),
-                   "scene file: robots' trajectories, calibration boards (config/pixart/README.md)")
-        .path();
-    spec.parameter("output", std::string("pty"),
-                   "pty (a simulated SLCAN adaptor on a pseudo-terminal) or candump (a log file)");
-    spec.parameter("device_link", std::string(),
-                   "pty: symbolic link to create to the pseudo-terminal (replacing an older link), "
-                   "for the bridge's `device`; empty = none (the log names the pty)")
-        .path();
-    spec.parameter("file", std::string(), "candump: the log to write").path();
-    spec.parameter("duration_s", 10.0, "candump: scene time to write, seconds").range(0.001, 1e6);
-    spec.parameter("start_stamp_s", 0.0,
-                   "candump: receive time of the first sample, seconds since the Unix epoch; "
-                   "0 = now")
-        .range(0, 4e9);
-    spec.parameter("rate_hz", 270.0, "samples per second, all cameras at once").range(1, 10000);
-    spec.parameter("bitrate", 1000000,
-                   "pty: the box's CAN bitrate; the adaptor passes frames only when the host "
-                   "opened the channel at it")
-        .range(10000, 1000000);
-    spec.parameter("base_id", 0x100, "CAN ID of camera 0, points 0-1").range(0, 0x7FF);
-    spec.parameter("noise_px", 0.0,
-                   "Gaussian noise on each coordinate before rounding, pixels (sigma); 0 = none")
-        .range(0, 100);
-    spec.parameter("seed", 1, "seed of the noise").range(0, 2147483647);
-    spec.parameter("truth_rate_hz", 50.0,
-                   "ground truth per second of scene time (pty: /pixart/ground_truth messages; "
-                   "candump: rows of FILE.truth.csv); 0 = none")
-        .range(0, 1000);
+    kParameters.declare(spec);
     spec.publishes<mocap_msgs::msg::RobotPoseArray>(
         kTruthTopic, Qos::reliable(),
         "pty output: every robot's true floor pose (x, y, theta), frame id world, stamped with "
@@ -113,20 +146,16 @@ class PixartBoxSim final : public Component {
   }
 
   explicit PixartBoxSim(Context& context) : Component(context) {
-    output_ = param<std::string>("output");
+    output_ = settings_.output;
     if (output_ != "pty" && output_ != "candump") {
       throw std::invalid_argument("parameter 'output' is '" + output_ +
                                   "'; expected pty or candump");
     }
-    Rig rig = load_rig(param<std::string>("rig"));
-    PixartScene scene = load_pixart_scene(param<std::string>("scene"), rig);
+    Rig rig = load_rig(settings_.rig);
+    PixartScene scene = load_pixart_scene(settings_.scene, rig);
     const size_t cameras = rig.cameras.size(), objects = scene.objects.size();
-    simulator_ = std::make_unique<PixartBoxSimulator>(
-        std::move(rig), std::move(scene),
-        PixartBoxSimulatorOptions{.base_id = static_cast<uint32_t>(param<int>("base_id")),
-                                  .noise_px = param<double>("noise_px"),
-                                  .seed = static_cast<uint64_t>(param<int64_t>("seed"))});
-    rate_hz_ = param<double>("rate_hz");
+    simulator_ = std::make_unique<PixartBoxSimulator>(std::move(rig), std::move(scene), settings_);
+    rate_hz_ = settings_.rate_hz;
     scene_start_ = Steady::now();
     scene_start_wall_ns_ = wall_clock_ns();
 
@@ -134,18 +163,18 @@ class PixartBoxSim final : public Component {
       start_log(cameras, objects);
       return;
     }
-    bitrate_ = param<int>("bitrate");
+    bitrate_ = settings_.bitrate;
     can::slcan_open_commands(bitrate_);  // throws, naming the supported bitrates, for others
     truths_ = create_publisher<mocap_msgs::msg::RobotPoseArray>(kTruthTopic);
     pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
-    const std::string link = param<std::string>("device_link");
+    const std::string link = settings_.device_link;
     if (!link.empty()) {
       device_link_.emplace(link, pty_->slave_path());
     }
     log().info("simulated SLCAN adaptor on {}{}: {} cameras, {} objects, {} Hz, {} bit/s",
                pty_->slave_path(), link.empty() ? "" : " (link " + link + ")", cameras, objects,
                rate_hz_, bitrate_);
-    if (const double truth_rate = param<double>("truth_rate_hz"); truth_rate > 0) {
+    if (const double truth_rate = settings_.truth_rate_hz; truth_rate > 0) {
       create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                        std::chrono::duration<double>(1 / truth_rate)),
                    [this] { publish_truth(); });
@@ -172,18 +201,18 @@ class PixartBoxSim final : public Component {
   // --- candump output ------------------------------------------------------------------------
 
   void start_log(size_t cameras, size_t objects) {
-    const std::string file = param<std::string>("file");
+    const std::string file = settings_.file;
     if (file.empty()) {
       throw std::invalid_argument("parameter 'file' is empty; output candump needs it");
     }
     const std::string partial = file + ".partial";
     open_for_writing(log_stream_, partial);
-    const double truth_rate = param<double>("truth_rate_hz");
+    const double truth_rate = settings_.truth_rate_hz;
     const std::string truth_file = truth_rate > 0 ? file + ".truth.csv" : std::string();
     if (!truth_file.empty()) open_for_writing(truth_stream_, truth_file + ".partial");
-    const double start_s = param<double>("start_stamp_s");
+    const double start_s = settings_.start_stamp_s;
     CandumpRecordingOptions options{
-        .duration_s = param<double>("duration_s"),
+        .duration_s = settings_.duration_s,
         .rate_hz = rate_hz_,
         .start_ns =
             start_s > 0 ? static_cast<int64_t>(std::llround(start_s * 1e9)) : wall_clock_ns(),

@@ -28,6 +28,7 @@
 
 #include "camera_info_message.hpp"
 #include "constellation_database.hpp"
+#include "database_parameters.hpp"
 #include "image_message.hpp"
 #include "ir_renderer.hpp"
 #include "pose_message.hpp"
@@ -53,41 +54,59 @@ Eigen::Isometry3d world_from_scene() {
   return pose;
 }
 
+struct Settings {
+  std::string scene = mocap::config_file("scenes/demo.yaml");
+  std::string camera = mocap::config_file("cameras/synthetic_ir_1280x720.yaml");
+  constellations::DatabaseFiles boards;
+  double rate_hz = 30.0;
+  double time_step_s = 0.0;
+  std::string frame_id;
+  int max_frames = 0;
+  bool wait_for_subscriber = true;
+  bool moving_camera = false;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("scene",
+             "scene file: objects, trajectories, rendering, distractors "
+             "(config/scenes/README.md)",
+             &Settings::scene)
+        .path()
+        .add("camera", "camera file (ROS camera_info YAML): image size and lens", &Settings::camera)
+        .path()
+        .include(&Settings::boards, constellations::database_parameters())
+        .add("rate_hz", "frames per second; 0 = as fast as they render", &Settings::rate_hz)
+        .range(0, 10000)
+        .add("time_step_s",
+             "scene time between frames, seconds; 0 = 1 / rate_hz (1/30 when rate_hz is 0)",
+             &Settings::time_step_s)
+        .range(0, 3600)
+        .add("frame_id", "frame id of the headers; empty = the camera file's", &Settings::frame_id)
+        .add("max_frames", "frames to publish before stopping; 0 = no limit", &Settings::max_frames)
+        .min(0)
+        .add("wait_for_subscriber",
+             "hold the first frame until the image topic has a subscriber, so a run "
+             "across processes starts with frame 0 however long discovery takes",
+             &Settings::wait_for_subscriber)
+        .add("moving_camera",
+             "false: the camera stands still and the scene is in its frame; true: its pose "
+             "in the world comes on " +
+                 std::string(kCameraPoseTopic) +
+                 " and the scene is as seen from the world's origin looking along x",
+             &Settings::moving_camera);
+
 class SyntheticIrCamera final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Renders constellations moving through a scene, distractor lights and sensor noise "
         "into mono8 infrared images, and publishes each frame's ground truth. Frame k shows "
         "scene time k * time_step_s, whatever the wall clock does, so runs are reproducible.");
-    spec.parameter("scene", mocap::config_file("scenes/demo.yaml"),
-                   "scene file: objects, trajectories, rendering, distractors "
-                   "(config/scenes/README.md)")
-        .path();
-    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
-                   "camera file (ROS camera_info YAML): image size and lens")
-        .path();
-    spec.parameter("database", mocap::config_file("constellations.yaml"),
-                   "constellation database: YAML or the seed's constellation CSV")
-        .path();
-    spec.parameter("sub_constellations", std::string(),
-                   "the seed's sub-constellation CSV for a CSV database; empty = none")
-        .path();
-    spec.parameter("rate_hz", 30.0, "frames per second; 0 = as fast as they render")
-        .range(0, 10000);
-    spec.parameter("time_step_s", 0.0,
-                   "scene time between frames, seconds; 0 = 1 / rate_hz (1/30 when rate_hz is 0)")
-        .range(0, 3600);
-    spec.parameter("frame_id", std::string(), "frame id of the headers; empty = the camera file's");
-    spec.parameter("max_frames", 0, "frames to publish before stopping; 0 = no limit").min(0);
-    spec.parameter("wait_for_subscriber", true,
-                   "hold the first frame until the image topic has a subscriber, so a run "
-                   "across processes starts with frame 0 however long discovery takes");
-    spec.parameter("moving_camera", false,
-                   "false: the camera stands still and the scene is in its frame; true: its pose "
-                   "in the world comes on " +
-                       std::string(kCameraPoseTopic) +
-                       " and the scene is as seen from the world's origin looking along x");
+    kParameters.declare(spec);
     spec.subscribes<geometry_msgs::msg::PoseStamped>(
         kCameraPoseTopic, Qos::reliable(),
         "moving_camera: the camera's optical frame in the world (e.g. from mobile_base_sim)");
@@ -105,22 +124,21 @@ class SyntheticIrCamera final : public Component {
 
   explicit SyntheticIrCamera(Context& context) : Component(context) {
     // Load errors propagate: the runtime reports them with this component's name.
-    calibration::CameraFile camera = calibration::load_camera_file(param<std::string>("camera"));
-    constellations::ConstellationDatabase database = constellations::load_database(
-        param<std::string>("database"), param<std::string>("sub_constellations"));
-    Scene scene = load_scene(param<std::string>("scene"), database);
+    calibration::CameraFile camera = calibration::load_camera_file(settings_.camera);
+    constellations::ConstellationDatabase database = settings_.boards.load();
+    Scene scene = load_scene(settings_.scene, database);
     size_t object_count = scene.objects.size();
     renderer_ = std::make_unique<IrRenderer>(std::move(scene), camera.model);
 
-    frame_id_ = param<std::string>("frame_id");
+    frame_id_ = settings_.frame_id;
     if (frame_id_.empty()) frame_id_ = camera.frame_id;
-    max_frames_ = param<int64_t>("max_frames");
-    wait_for_subscriber_ = param<bool>("wait_for_subscriber");
-    double rate_hz = param<double>("rate_hz");
-    time_step_s_ = param<double>("time_step_s");
+    max_frames_ = settings_.max_frames;
+    wait_for_subscriber_ = settings_.wait_for_subscriber;
+    double rate_hz = settings_.rate_hz;
+    time_step_s_ = settings_.time_step_s;
     if (time_step_s_ == 0) time_step_s_ = rate_hz > 0 ? 1 / rate_hz : kDefaultTimeStep_s;
 
-    if (param<bool>("moving_camera")) {
+    if (settings_.moving_camera) {
       create_subscription<geometry_msgs::msg::PoseStamped>(
           kCameraPoseTopic, [this](const geometry_msgs::msg::PoseStamped& pose) {
             if (std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose())) {
@@ -142,9 +160,9 @@ class SyntheticIrCamera final : public Component {
                                           : std::chrono::nanoseconds(kBackToBackPeriod);
     create_timer(period, [this] { tick(); });
     log().info("{}x{} frames of {} ({} objects) at {} on {}, scene time step {:.6g} s",
-               camera.model->width(), camera.model->height(), param<std::string>("scene"),
-               object_count, rate_hz > 0 ? fmt::format("{} Hz", rate_hz) : "full speed",
-               images_.topic(), time_step_s_);
+               camera.model->width(), camera.model->height(), settings_.scene, object_count,
+               rate_hz > 0 ? fmt::format("{} Hz", rate_hz) : "full speed", images_.topic(),
+               time_step_s_);
   }
 
  private:

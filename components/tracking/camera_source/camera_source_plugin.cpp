@@ -26,38 +26,63 @@ namespace {
 
 constexpr const char* kImageTopic = "/camera/ir/image_raw";
 
+struct Settings {
+  std::string device;
+  std::string file;
+  std::string directory;
+  double rate_hz = 30.0;
+  bool loop = false;
+  bool wait_for_subscriber = true;
+  std::string frame_id = "camera_ir_optical";
+  VideoDeviceOptions device_options;  // the requested frame size
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("device",
+             "V4L2 camera: a path (/dev/video0) or an index (0); frames come at the "
+             "device's rate",
+             &Settings::device)
+        .add("file", "video file (whatever OpenCV decodes)", &Settings::file)
+        .path()
+        .add("directory", "directory of png/jpg/bmp/tif/pgm images, read in name order",
+             &Settings::directory)
+        .path()
+        .add("rate_hz", "file and directory: frames published per second; 0 = as fast as possible",
+             &Settings::rate_hz)
+        .range(0, 1e6)
+        .add("loop", "file and directory: start over at the end", &Settings::loop)
+        .add("wait_for_subscriber",
+             "file and directory: hold the first frame until a subscriber has matched",
+             &Settings::wait_for_subscriber)
+        .add("frame_id", "frame id of the images", &Settings::frame_id)
+        .add("width", "device: requested frame width; 0 = the device's", &Settings::device_options,
+             &VideoDeviceOptions::width)
+        .min(0)
+        .add("height", "device: requested frame height; 0 = the device's",
+             &Settings::device_options, &VideoDeviceOptions::height)
+        .min(0);
+
 class CameraSource final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Publishes mono8 images from a V4L2 camera, a video file or a directory of images "
         "(colour and 16-bit frames are converted). Set exactly one of device, file and "
         "directory.");
-    spec.parameter("device", std::string(),
-                   "V4L2 camera: a path (/dev/video0) or an index (0); frames come at the "
-                   "device's rate");
-    spec.parameter("file", std::string(), "video file (whatever OpenCV decodes)").path();
-    spec.parameter("directory", std::string(),
-                   "directory of png/jpg/bmp/tif/pgm images, read in name order")
-        .path();
-    spec.parameter("rate_hz", 30.0,
-                   "file and directory: frames published per second; 0 = as fast as possible")
-        .range(0, 1e6);
-    spec.parameter("loop", false, "file and directory: start over at the end");
-    spec.parameter("wait_for_subscriber", true,
-                   "file and directory: hold the first frame until a subscriber has matched");
-    spec.parameter("frame_id", std::string("camera_ir_optical"), "frame id of the images");
-    spec.parameter("width", 0, "device: requested frame width; 0 = the device's").min(0);
-    spec.parameter("height", 0, "device: requested frame height; 0 = the device's").min(0);
+    kParameters.declare(spec);
     spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
                                             "mono8 images, stamped when captured");
   }
 
   explicit CameraSource(Context& context) : Component(context) {
     source_ = open_source();
-    frame_id_ = param<std::string>("frame_id");
-    rate_hz_ = param<double>("rate_hz");
-    wait_for_subscriber_ = param<bool>("wait_for_subscriber") && !source_->is_live();
+    frame_id_ = settings_.frame_id;
+    rate_hz_ = settings_.rate_hz;
+    wait_for_subscriber_ = settings_.wait_for_subscriber && !source_->is_live();
     publisher_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
     if (source_->is_live()) {
       log().info("publishing {} on {} at the device's rate", source_->description(),
@@ -85,9 +110,9 @@ class CameraSource final : public Component {
 
  private:
   std::unique_ptr<FrameSource> open_source() {
-    const std::string device = param<std::string>("device");
-    const std::string file = param<std::string>("file");
-    const std::string directory = param<std::string>("directory");
+    const std::string device = settings_.device;
+    const std::string file = settings_.file;
+    const std::string directory = settings_.directory;
     std::vector<std::string> given;
     if (!device.empty()) given.push_back("device");
     if (!file.empty()) given.push_back("file");
@@ -98,10 +123,9 @@ class CameraSource final : public Component {
       throw std::invalid_argument("set exactly one of device, file and directory (got " + list +
                                   ")");
     }
-    const bool loop = param<bool>("loop");
+    const bool loop = settings_.loop;
     if (!device.empty()) {
-      return std::make_unique<VideoDeviceSource>(
-          device, VideoDeviceOptions{.width = param<int>("width"), .height = param<int>("height")});
+      return std::make_unique<VideoDeviceSource>(device, settings_.device_options);
     }
     if (!file.empty()) return std::make_unique<VideoFileSource>(file, loop);
     return std::make_unique<ImageDirectorySource>(

@@ -12,6 +12,7 @@
 
 #include "constellation_identifier.hpp"
 #include "constellation_message.hpp"
+#include "database_parameters.hpp"
 
 namespace mocap::constellations {
 namespace {
@@ -19,34 +20,47 @@ namespace {
 constexpr const char* kInput = "/mocap/fiducials";
 constexpr const char* kOutput = "/mocap/constellations";
 
+// The identifier's options with the files only the plugin reads.
+struct Settings : IdentifierOptions {
+  DatabaseFiles boards;
+  std::string camera;  // empty: fiducials taken as they are, distortion and all
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .include(&Settings::boards, database_parameters())
+        .add("camera", "camera file; when given, lens distortion is removed before the line search",
+             &Settings::camera)
+        .path()
+        .add("cross_ratio_tolerance",
+             "largest relative cross-ratio difference (the seed used 0.20)",
+             &Settings::cross_ratio_tolerance)
+        .range(1e-4, 0.5)
+        .add("line_tolerance_px", "largest distance of a point from its line, pixels",
+             &Settings::line_search, &LineSearchOptions::tolerance_px)
+        .range(0.01, 100)
+        .add("min_lines", "fewest lines that identify a constellation", &Settings::min_lines)
+        .range(1, 64)
+        .add("min_extra_markers",
+             "with two whole lines only, markers that must lie where their plane puts them (a "
+             "board with a hidden corner); 0 = never identify from two lines",
+             &Settings::min_extra_markers)
+        .range(0, 1000)
+        .add("max_fit_error_px",
+             "largest distance of a point from the constellation's plane fit, pixels",
+             &Settings::max_fit_error_px)
+        .range(0.01, 1000);
+
 class ConstellationIdentifierComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Finds collinear fiducials, names lines by their cross-ratio and constellations by "
         "their lines; publishes each constellation's image points in database order.");
-    spec.parameter("database", mocap::config_file("constellations.yaml"),
-                   "constellation database: YAML, or the seed's constellation CSV")
-        .path();
-    spec.parameter("sub_constellations", std::string(),
-                   "the seed's sub-constellation CSV (line types), optional")
-        .path();
-    spec.parameter("camera", std::string(),
-                   "camera file; when given, lens distortion is removed before the line search")
-        .path();
-    spec.parameter("cross_ratio_tolerance", 0.03,
-                   "largest relative cross-ratio difference (the seed used 0.20)")
-        .range(1e-4, 0.5);
-    spec.parameter("line_tolerance_px", 1.5, "largest distance of a point from its line, pixels")
-        .range(0.01, 100);
-    spec.parameter("min_lines", 3, "fewest lines that identify a constellation").range(1, 64);
-    spec.parameter("min_extra_markers", 3,
-                   "with two whole lines only, markers that must lie where their plane puts "
-                   "them (a board with a hidden corner); 0 = never identify from two lines")
-        .range(0, 1000);
-    spec.parameter("max_fit_error_px", 3.0,
-                   "largest distance of a point from the constellation's plane fit, pixels")
-        .range(0.01, 1000);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::FiducialArray>(kInput, Qos::reliable(),
                                                     "fiducials of one image, pixels");
     spec.publishes<mocap_msgs::msg::ConstellationArray>(
@@ -55,24 +69,15 @@ class ConstellationIdentifierComponent final : public Component {
         "order, NaN for a marker not seen");
   }
 
-  explicit ConstellationIdentifierComponent(Context& context) : Component(context) {
-    database_ =
-        load_database(param<std::string>("database"), param<std::string>("sub_constellations"));
-    if (!param<std::string>("camera").empty()) {
-      camera_ = calibration::load_camera_file(param<std::string>("camera")).model;
-    }
-    IdentifierOptions options;
-    options.cross_ratio_tolerance = param<double>("cross_ratio_tolerance");
-    options.line_search.tolerance_px = param<double>("line_tolerance_px");
-    options.min_lines = param<int>("min_lines");
-    options.min_extra_markers = param<int>("min_extra_markers");
-    options.max_fit_error_px = param<double>("max_fit_error_px");
-    identifier_.emplace(database_, options);
-    for (const std::string& problem : database_.ambiguities(options.cross_ratio_tolerance)) {
+  explicit ConstellationIdentifierComponent(Context& context)
+      : Component(context), database_(settings_.boards.load()) {
+    if (!settings_.camera.empty()) camera_ = calibration::load_camera_file(settings_.camera).model;
+    identifier_.emplace(database_, settings_);
+    for (const std::string& problem : database_.ambiguities(settings_.cross_ratio_tolerance)) {
       log().warn("{}", problem);
     }
     log().info("{} constellations from {}", database_.constellations().size(),
-               param<std::string>("database"));
+               settings_.boards.database);
     publisher_ = create_publisher<mocap_msgs::msg::ConstellationArray>(kOutput);
     create_subscription<mocap_msgs::msg::FiducialArray>(
         kInput, [this](const mocap_msgs::msg::FiducialArray& array) { identify(array); });

@@ -15,6 +15,7 @@
 
 #include "constellation_message.hpp"
 #include "constellation_tracker.hpp"
+#include "database_parameters.hpp"
 #include "pose_message.hpp"
 
 namespace mocap::tracking {
@@ -24,48 +25,62 @@ constexpr const char* kInput = "/mocap/fiducials";
 constexpr const char* kConstellations = "/mocap/constellations";
 constexpr const char* kPoses = "/mocap/poses";
 
+// The tracker's options with the files only the plugin reads.
+struct Settings : TrackerOptions {
+  constellations::DatabaseFiles boards;
+  std::string camera = mocap::config_file("cameras/synthetic_ir_1280x720.yaml");
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .include(&Settings::boards, constellations::database_parameters())
+        .add("camera", "camera file (ROS camera_info YAML, or one mocap_calibrate wrote)",
+             &Settings::camera)
+        .path()
+        .add("cross_ratio_tolerance",
+             "identification: largest relative cross-ratio difference (the seed used 0.20)",
+             &Settings::identification, &constellations::IdentifierOptions::cross_ratio_tolerance)
+        .range(1e-4, 0.5)
+        .add("line_tolerance_px",
+             "identification: largest distance of a point from its line, pixels",
+             &Settings::identification, &constellations::IdentifierOptions::line_search,
+             &constellations::LineSearchOptions::tolerance_px)
+        .range(0.01, 100)
+        .add("min_loose_markers",
+             "identification from one whole line: loose markers that must confirm it; 0 = never "
+             "identify from one line",
+             &Settings::identification, &constellations::IdentifierOptions::min_loose_markers)
+        .range(0, 1000)
+        .add("max_reprojection_rms_px",
+             "poses with a larger RMS reprojection error are not believed", &Settings::pose,
+             &pose::PlanarPoseOptions::max_reprojection_rms_px)
+        .range(0.01, 1000)
+        .add("min_tracked_markers", "fewest markers that keep a tracked board",
+             &Settings::min_tracked_markers)
+        .range(4, 1000)
+        .add("linear_acceleration_density",
+             "motion model: white-noise acceleration, m^2/s^3 (larger follows faster changes of "
+             "speed, with noisier velocities)",
+             &Settings::motion, &BodyMotionOptions::linear_acceleration_density)
+        .range(1e-6, 1e6)
+        .add("angular_acceleration_density",
+             "motion model: white-noise angular acceleration, rad^2/s^3", &Settings::motion,
+             &BodyMotionOptions::angular_acceleration_density)
+        .range(1e-6, 1e6);
+
 class ConstellationTrackerComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
-    const TrackerOptions defaults;
     spec.description(
         "Follows constellations from frame to frame: predicts each tracked board at the "
         "frame's capture time, associates the fiducials with its markers, estimates the pose "
         "from any four or more of them and verifies it against the whole board; identifies "
         "the boards not tracked (also from one whole line and loose markers). Publishes the "
         "seed's constellations and each board's pose with its velocity.");
-    spec.parameter("database", mocap::config_file("constellations.yaml"),
-                   "constellation database: YAML, or the seed's constellation CSV")
-        .path();
-    spec.parameter("sub_constellations", std::string(),
-                   "the seed's sub-constellation CSV (line types), optional")
-        .path();
-    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
-                   "camera file (ROS camera_info YAML, or one mocap_calibrate wrote)")
-        .path();
-    spec.parameter("cross_ratio_tolerance", defaults.identification.cross_ratio_tolerance,
-                   "identification: largest relative cross-ratio difference (the seed used 0.20)")
-        .range(1e-4, 0.5);
-    spec.parameter("line_tolerance_px", defaults.identification.line_search.tolerance_px,
-                   "identification: largest distance of a point from its line, pixels")
-        .range(0.01, 100);
-    spec.parameter("min_loose_markers", defaults.identification.min_loose_markers,
-                   "identification from one whole line: loose markers that must confirm it; 0 = "
-                   "never identify from one line")
-        .range(0, 1000);
-    spec.parameter("max_reprojection_rms_px", defaults.pose.max_reprojection_rms_px,
-                   "poses with a larger RMS reprojection error are not believed")
-        .range(0.01, 1000);
-    spec.parameter("min_tracked_markers", defaults.min_tracked_markers,
-                   "fewest markers that keep a tracked board")
-        .range(4, 1000);
-    spec.parameter("linear_acceleration_density", defaults.motion.linear_acceleration_density,
-                   "motion model: white-noise acceleration, m^2/s^3 (larger follows faster "
-                   "changes of speed, with noisier velocities)")
-        .range(1e-6, 1e6);
-    spec.parameter("angular_acceleration_density", defaults.motion.angular_acceleration_density,
-                   "motion model: white-noise angular acceleration, rad^2/s^3")
-        .range(1e-6, 1e6);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::FiducialArray>(
         kInput, Qos::reliable(), "fiducials of one image, pixels, stamped at capture");
     spec.publishes<mocap_msgs::msg::ConstellationArray>(
@@ -78,25 +93,17 @@ class ConstellationTrackerComponent final : public Component {
         "image's capture time");
   }
 
-  explicit ConstellationTrackerComponent(Context& context) : Component(context) {
-    database_ = constellations::load_database(param<std::string>("database"),
-                                              param<std::string>("sub_constellations"));
-    camera_ = calibration::load_camera_file(param<std::string>("camera"));
-    TrackerOptions options;
-    options.identification.cross_ratio_tolerance = param<double>("cross_ratio_tolerance");
-    options.identification.line_search.tolerance_px = param<double>("line_tolerance_px");
-    options.identification.min_loose_markers = param<int>("min_loose_markers");
-    options.pose.max_reprojection_rms_px = param<double>("max_reprojection_rms_px");
-    options.min_tracked_markers = param<int>("min_tracked_markers");
-    options.motion.linear_acceleration_density = param<double>("linear_acceleration_density");
-    options.motion.angular_acceleration_density = param<double>("angular_acceleration_density");
+  explicit ConstellationTrackerComponent(Context& context)
+      : Component(context),
+        database_(settings_.boards.load()),
+        camera_(calibration::load_camera_file(settings_.camera)) {
     for (const std::string& problem :
-         database_.ambiguities(options.identification.cross_ratio_tolerance)) {
+         database_.ambiguities(settings_.identification.cross_ratio_tolerance)) {
       log().warn("{}", problem);
     }
-    tracker_.emplace(database_, camera_.model, options);
+    tracker_.emplace(database_, camera_.model, settings_);
     log().info("{} constellations from {}", database_.constellations().size(),
-               param<std::string>("database"));
+               settings_.boards.database);
     constellations_ = create_publisher<mocap_msgs::msg::ConstellationArray>(kConstellations);
     poses_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kPoses);
     create_subscription<mocap_msgs::msg::FiducialArray>(

@@ -12,17 +12,29 @@ namespace {
 
 constexpr const char* kTopic = "/demo/fiducials";
 
+struct Settings {
+  double report_period_s = 2;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("report_period_s", "seconds between reports", &Settings::report_period_s)
+        .range(0.1, 3600);
+
 class FiducialMonitor final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Logs the rate, size and latency (stamp to arrival) of fiducial arrays.");
-    spec.parameter("report_period_s", 2.0, "seconds between reports").range(0.1, 3600);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::FiducialArray>(kTopic, Qos::sensor_data(),
                                                     "the stream to watch");
   }
 
   explicit FiducialMonitor(Context& context) : Component(context) {
-    period_s_ = param<double>("report_period_s");
+    period_s_ = settings_.report_period_s;
     create_subscription<mocap_msgs::msg::FiducialArray>(
         kTopic, [this](const mocap_msgs::msg::FiducialArray& array) {
           double latency =

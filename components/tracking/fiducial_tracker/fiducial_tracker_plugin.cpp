@@ -19,49 +19,82 @@ namespace {
 constexpr const char* kImageTopic = "/camera/ir/image_raw";
 constexpr const char* kFiducialTopic = "/mocap/fiducials";
 
+// The detector's options with what only the plugin reads.
+struct Settings : FiducialDetectorOptions {
+  std::vector<int> roi;  // [x, y, width, height], or empty: region_of_interest
+  double report_period_s = 5;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("threshold_ratio",
+             "pixels brighter than this fraction of the brightest pixel are fiducial",
+             &Settings::threshold_ratio)
+        .range(0, 1)
+        .add("min_threshold", "floor of the threshold, grey levels: a dark frame yields nothing",
+             &Settings::min_threshold)
+        .range(0, 255)
+        .add("min_area_px", "smaller regions are noise", &Settings::min_area_px)
+        .min(1)
+        .add("max_area_px", "larger regions are lamps or reflections", &Settings::max_area_px)
+        .min(1)
+        .add("min_circularity", "4πA/P² below which a region is rejected (1 = disc)",
+             &Settings::min_circularity)
+        .range(0, 1)
+        .add("circularity_min_area_px",
+             "circularity is judged only for regions of at least this many pixels",
+             &Settings::circularity_min_area_px)
+        .min(0)
+        .add("roi", "region of interest [x, y, width, height] in pixels; [] = whole image",
+             &Settings::roi)
+        .min(0)
+        .add("connectivity", "4 or 8 neighbours join a region", &Settings::connectivity)
+        .range(4, 8)
+        .add("centroid_margin_px",
+             "the centroid window reaches this far beyond a region; 0 = only its pixels",
+             &Settings::centroid_margin_px)
+        .min(0)
+        .add("centroid_level",
+             "centroid weights start this far from the local background to the threshold",
+             &Settings::centroid_level)
+        .range(0, 1)
+        .add("pixel_noise",
+             "1-sigma noise of a pixel, grey levels; sets each fiducial's uncertainty",
+             &Settings::pixel_noise)
+        .min(0)
+        .add("uncertainty_floor_px", "least uncertainty a fiducial reports, pixels",
+             &Settings::uncertainty_floor_px)
+        .min(0)
+        .add("reject_border_regions", "reject regions cut by the image or ROI edge (else kept)",
+             &Settings::reject_border_regions)
+        .add("report_period_s", "seconds between summary log lines", &Settings::report_period_s)
+        .range(0.1, 86400);
+
+// The launcher checked each value's range; the detector's constructor checks the combinations
+// (max_area_px below min_area_px, connectivity 5).
+FiducialDetectorOptions detector_options(Settings settings) {
+  const std::vector<int>& roi = settings.roi;
+  if (!roi.empty()) {
+    if (roi.size() != 4 || roi[2] == 0 || roi[3] == 0) {
+      throw std::invalid_argument(
+          "roi must be [] or [x, y, width, height] with a positive width and height");
+    }
+    settings.region_of_interest = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
+  }
+  return settings;
+}
+
 class FiducialTracker final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
-    const FiducialDetectorOptions defaults;
     spec.description(
         "Finds bright round fiducials in mono8 camera images: threshold at a ratio of the "
         "brightest pixel, connected regions filtered by area and circularity, "
         "background-subtracted intensity-weighted sub-pixel centroids.");
-    spec.parameter("threshold_ratio", defaults.threshold_ratio,
-                   "pixels brighter than this fraction of the brightest pixel are fiducial")
-        .range(0, 1);
-    spec.parameter("min_threshold", defaults.min_threshold,
-                   "floor of the threshold, grey levels: a dark frame yields nothing")
-        .range(0, 255);
-    spec.parameter("min_area_px", defaults.min_area_px, "smaller regions are noise").min(1);
-    spec.parameter("max_area_px", defaults.max_area_px, "larger regions are lamps or reflections")
-        .min(1);
-    spec.parameter("min_circularity", defaults.min_circularity,
-                   "4πA/P² below which a region is rejected (1 = disc)")
-        .range(0, 1);
-    spec.parameter("circularity_min_area_px", defaults.circularity_min_area_px,
-                   "circularity is judged only for regions of at least this many pixels")
-        .min(0);
-    spec.parameter("roi", std::vector<int64_t>{},
-                   "region of interest [x, y, width, height] in pixels; [] = whole image")
-        .min(0);
-    spec.parameter("connectivity", defaults.connectivity, "4 or 8 neighbours join a region")
-        .range(4, 8);
-    spec.parameter("centroid_margin_px", defaults.centroid_margin_px,
-                   "the centroid window reaches this far beyond a region; 0 = only its pixels")
-        .min(0);
-    spec.parameter("centroid_level", defaults.centroid_level,
-                   "centroid weights start this far from the local background to the threshold")
-        .range(0, 1);
-    spec.parameter("pixel_noise", defaults.pixel_noise,
-                   "1-sigma noise of a pixel, grey levels; sets each fiducial's uncertainty")
-        .min(0);
-    spec.parameter("uncertainty_floor_px", defaults.uncertainty_floor_px,
-                   "least uncertainty a fiducial reports, pixels")
-        .min(0);
-    spec.parameter("reject_border_regions", defaults.reject_border_regions,
-                   "reject regions cut by the image or ROI edge (else kept)");
-    spec.parameter("report_period_s", 5.0, "seconds between summary log lines").range(0.1, 86400);
+    kParameters.declare(spec);
     spec.subscribes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
                                              "camera images, mono8");
     spec.publishes<mocap_msgs::msg::FiducialArray>(
@@ -72,13 +105,12 @@ class FiducialTracker final : public Component {
   }
 
   explicit FiducialTracker(Context& context)
-      : Component(context), detector_(options_from_parameters()) {
+      : Component(context), detector_(detector_options(settings_)) {
     publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kFiducialTopic);
     create_subscription<sensor_msgs::msg::Image>(
         kImageTopic, [this](const sensor_msgs::msg::Image& image) { on_image(image); });
-    report_period_s_ = param<double>("report_period_s");
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::duration<double>(report_period_s_)),
+                     std::chrono::duration<double>(settings_.report_period_s)),
                  [this] { report(); });
   }
 
@@ -89,33 +121,6 @@ class FiducialTracker final : public Component {
   }
 
  private:
-  FiducialDetectorOptions options_from_parameters() const {
-    FiducialDetectorOptions options;
-    options.threshold_ratio = param<double>("threshold_ratio");
-    options.min_threshold = param<double>("min_threshold");
-    options.min_area_px = param<int>("min_area_px");
-    options.max_area_px = param<int>("max_area_px");
-    options.min_circularity = param<double>("min_circularity");
-    options.circularity_min_area_px = param<int>("circularity_min_area_px");
-    options.connectivity = param<int>("connectivity");
-    options.centroid_margin_px = param<int>("centroid_margin_px");
-    options.centroid_level = param<double>("centroid_level");
-    options.pixel_noise = param<double>("pixel_noise");
-    options.uncertainty_floor_px = param<double>("uncertainty_floor_px");
-    options.reject_border_regions = param<bool>("reject_border_regions");
-    const auto roi = param<std::vector<int>>("roi");
-    if (!roi.empty()) {
-      if (roi.size() != 4 || roi[2] == 0 || roi[3] == 0) {
-        throw std::invalid_argument(
-            "roi must be [] or [x, y, width, height] with a positive width and height");
-      }
-      options.region_of_interest = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
-    }
-    // The launcher checked each value's range; the detector's constructor checks the
-    // combinations (max_area_px below min_area_px, connectivity 5).
-    return options;
-  }
-
   void on_image(const sensor_msgs::msg::Image& image) {
     Mono8View view = view_mono8(image);
     if (!view.problem.empty()) {
@@ -156,14 +161,14 @@ class FiducialTracker final : public Component {
     if (images_since_report_ == 0 && drops_since_report_ == 0) {
       // Said once, not every period, until images come again.
       if (!reported_silence_) {
-        log().info("no images on {} in the last {} s", kImageTopic, report_period_s_);
+        log().info("no images on {} in the last {} s", kImageTopic, settings_.report_period_s);
       }
       reported_silence_ = true;
       return;
     }
     reported_silence_ = false;
     log().info("{} images in {} s, {:.1f} fiducials per image, {} dropped ({} in all)",
-               images_since_report_, report_period_s_,
+               images_since_report_, settings_.report_period_s,
                images_since_report_ > 0
                    ? static_cast<double>(fiducials_since_report_) / images_since_report_
                    : 0.0,
@@ -175,7 +180,6 @@ class FiducialTracker final : public Component {
 
   FiducialDetector detector_;
   Publisher<mocap_msgs::msg::FiducialArray> publisher_;
-  double report_period_s_ = 5;
   uint64_t images_total_ = 0, images_since_report_ = 0;
   uint64_t fiducials_total_ = 0, fiducials_since_report_ = 0;
   uint64_t drops_total_ = 0, drops_since_report_ = 0, drops_unlogged_ = 0;

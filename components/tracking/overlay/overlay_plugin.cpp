@@ -29,18 +29,32 @@ constexpr const char* kOverlay = "/mocap/overlay";
 // Frames waiting for their poses; older ones are dropped.
 constexpr size_t kPendingFrames = 30;
 
+struct Settings {
+  std::string camera = mocap::config_file("cameras/synthetic_ir_1280x720.yaml");
+  std::string snapshot_directory;  // empty: no snapshots
+  double snapshot_period_s = 1;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("camera", "camera file, to project the pose axes", &Settings::camera)
+        .path()
+        .add("snapshot_directory", "where PNG snapshots go (empty: none)",
+             &Settings::snapshot_directory)
+        .path()
+        .add("snapshot_period_s", "seconds between snapshots", &Settings::snapshot_period_s)
+        .range(0.01, 3600);
+
 class OverlayComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Debug picture: fiducials, identified lines and names, pose axes drawn on the image; "
         "published as bgr8 and saved as PNG snapshots.");
-    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
-                   "camera file, to project the pose axes")
-        .path();
-    spec.parameter("snapshot_directory", std::string(), "where PNG snapshots go (empty: none)")
-        .path();
-    spec.parameter("snapshot_period_s", 1.0, "seconds between snapshots").range(0.01, 3600);
+    kParameters.declare(spec);
     spec.subscribes<sensor_msgs::msg::Image>(kImage, Qos::sensor_data(), "camera images, mono8");
     spec.subscribes<mocap_msgs::msg::FiducialArray>(kFiducials, Qos::reliable(), "fiducials");
     spec.subscribes<mocap_msgs::msg::ConstellationArray>(kConstellations, Qos::reliable(),
@@ -51,10 +65,10 @@ class OverlayComponent final : public Component {
   }
 
   explicit OverlayComponent(Context& context) : Component(context) {
-    camera_ = calibration::load_camera_file(param<std::string>("camera"));
-    snapshot_directory_ = param<std::string>("snapshot_directory");
+    camera_ = calibration::load_camera_file(settings_.camera);
+    snapshot_directory_ = settings_.snapshot_directory;
     snapshot_period_ = std::chrono::duration_cast<Clock::duration>(
-        std::chrono::duration<double>(param<double>("snapshot_period_s")));
+        std::chrono::duration<double>(settings_.snapshot_period_s));
     if (!snapshot_directory_.empty()) std::filesystem::create_directories(snapshot_directory_);
     publisher_ = create_publisher<sensor_msgs::msg::Image>(kOverlay);
     create_subscription<sensor_msgs::msg::Image>(

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <stdexcept>
+
 #include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
@@ -137,9 +139,14 @@ UsablePoints usable_points(const calibration::CameraModel& camera,
 }
 
 bool enough_points(const PlanarPoseOptions& options, PlanarPose& result) {
-  if (result.points_used >= std::max(4, options.min_points)) return true;
-  result.rejection = fmt::format("{} usable points, {} needed", result.points_used,
-                                 std::max(4, options.min_points));
+  if (options.min_points < 4) {
+    throw std::invalid_argument(
+        fmt::format("PlanarPoseOptions::min_points is {}: four points at least fix a pose",
+                    options.min_points));
+  }
+  if (result.points_used >= options.min_points) return true;
+  result.rejection =
+      fmt::format("{} usable points, {} needed", result.points_used, options.min_points);
   return false;
 }
 

@@ -20,7 +20,8 @@ struct PlanarPoseOptions {
   // A pose whose RMS reprojection error exceeds this is a false identification (a chance
   // alignment of distractors) and is rejected.
   double max_reprojection_rms_px = 1.5;
-  // Fewest points for a pose; four fix a plane's pose, more average the noise.
+  // Fewest points for a pose, at least four (fewer throw std::invalid_argument): four fix a
+  // plane's pose, more average the noise.
   int min_points = 4;
   int max_iterations = 15;
 };

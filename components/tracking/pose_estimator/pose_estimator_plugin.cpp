@@ -10,6 +10,7 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
 #include "constellation_pose.hpp"
+#include "database_parameters.hpp"
 #include "planar_pose.hpp"
 #include "pose_message.hpp"
 
@@ -19,25 +20,37 @@ namespace {
 constexpr const char* kInput = "/mocap/constellations";
 constexpr const char* kOutput = "/mocap/poses";
 
+// The estimator's options with the files only the plugin reads. min_points is 6 here: the
+// identifier's lines come whole, four collinear points each, and one line alone leaves the
+// board free to turn about it, so a pose needs a second line's points (the tracker, whose
+// one-line identifications add loose markers off the line, keeps the estimator's 4).
+struct Settings : PlanarPoseOptions {
+  Settings() { min_points = 6; }
+  constellations::DatabaseFiles boards;
+  std::string camera = mocap::config_file("cameras/synthetic_ir_1280x720.yaml");
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .include(&Settings::boards, constellations::database_parameters())
+        .add("camera", "camera file (ROS camera_info YAML)", &Settings::camera)
+        .path()
+        .add("max_reprojection_rms_px", "poses with a larger RMS reprojection error are rejected",
+             &Settings::max_reprojection_rms_px)
+        .range(0.01, 1000)
+        .add("min_points", "fewest identified points for a pose", &Settings::min_points)
+        .range(4, 1000);
+
 class PoseEstimatorComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Estimates each identified constellation's 6-DoF pose in the camera frame (planar PnP "
         "and refinement) and rejects false identifications by their reprojection error.");
-    spec.parameter("database", mocap::config_file("constellations.yaml"),
-                   "constellation database: YAML, or the seed's constellation CSV")
-        .path();
-    spec.parameter("sub_constellations", std::string(),
-                   "the seed's sub-constellation CSV (line types), optional")
-        .path();
-    spec.parameter("camera", mocap::config_file("cameras/synthetic_ir_1280x720.yaml"),
-                   "camera file (ROS camera_info YAML)")
-        .path();
-    spec.parameter("max_reprojection_rms_px", 1.5,
-                   "poses with a larger RMS reprojection error are rejected")
-        .range(0.01, 1000);
-    spec.parameter("min_points", 6, "fewest identified points for a pose").range(4, 1000);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::ConstellationArray>(kInput, Qos::reliable(),
                                                          "identified constellations");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
@@ -45,12 +58,11 @@ class PoseEstimatorComponent final : public Component {
         "one stamped pose per accepted constellation, in the camera's frame");
   }
 
-  explicit PoseEstimatorComponent(Context& context) : Component(context) {
-    database_ = constellations::load_database(param<std::string>("database"),
-                                              param<std::string>("sub_constellations"));
-    camera_ = calibration::load_camera_file(param<std::string>("camera"));
-    options_.max_reprojection_rms_px = param<double>("max_reprojection_rms_px");
-    options_.min_points = param<int>("min_points");
+  explicit PoseEstimatorComponent(Context& context)
+      : Component(context),
+        database_(settings_.boards.load()),
+        camera_(calibration::load_camera_file(settings_.camera)),
+        options_(settings_) {
     publisher_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kOutput);
     create_subscription<mocap_msgs::msg::ConstellationArray>(
         kInput, [this](const mocap_msgs::msg::ConstellationArray& array) { estimate(array); });

@@ -42,25 +42,42 @@ std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& a
   return out;
 }
 
+// The evaluation's options with what only the plugin reads.
+struct Settings : EvaluationOptions {
+  double report_period_s = 1;
+  uint64_t stop_after_frames = 0;  // 0: never
+  std::string summary_file;        // empty: none
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("report_period_s", "seconds between summary lines", &Settings::report_period_s)
+        .range(0.1, 3600)
+        .add("min_visible_markers",
+             "a truth object with fewer visible markers is not expected to be tracked",
+             &Settings::min_visible_markers)
+        .range(0, 10000)
+        .add("stop_after_frames", "stop the process after evaluating this many frames (0: never)",
+             &Settings::stop_after_frames)
+        .range(0, 1e9)
+        .add("summary_file", "where the final figures go (YAML), optional", &Settings::summary_file)
+        .path()
+        .add("max_lag_frames",
+             "a frame whose estimate is this many truth frames late counts as lost (a test that "
+             "must not depend on the machine's speed sets it high)",
+             &Settings::max_pending_frames)
+        .range(1, 1e7);
+
 class PoseEvaluatorComponent final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
         "Compares estimated poses with the synthetic ground truth: a live summary line (input "
         "rate, latency, tracked %, errors) and a final table.");
-    spec.parameter("report_period_s", 1.0, "seconds between summary lines").range(0.1, 3600);
-    spec.parameter("min_visible_markers", 10,
-                   "a truth object with fewer visible markers is not expected to be tracked")
-        .range(0, 10000);
-    spec.parameter("stop_after_frames", 0,
-                   "stop the process after evaluating this many frames (0: never)")
-        .range(0, 1e9);
-    spec.parameter("summary_file", std::string(), "where the final figures go (YAML), optional")
-        .path();
-    spec.parameter("max_lag_frames", 200,
-                   "a frame whose estimate is this many truth frames late counts as lost (a "
-                   "test that must not depend on the machine's speed sets it high)")
-        .range(1, 1e7);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kTruth, Qos::reliable(),
                                                              "ground truth, one array per image");
     spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoses, Qos::reliable(),
@@ -68,13 +85,10 @@ class PoseEvaluatorComponent final : public Component {
   }
 
   explicit PoseEvaluatorComponent(Context& context) : Component(context) {
-    EvaluationOptions options;
-    options.min_visible_markers = param<int>("min_visible_markers");
-    options.max_pending_frames = static_cast<size_t>(param<int>("max_lag_frames"));
-    evaluator_ = PoseEvaluator(options);
-    stop_after_ = static_cast<uint64_t>(param<int>("stop_after_frames"));
-    summary_file_ = param<std::string>("summary_file");
-    period_s_ = param<double>("report_period_s");
+    evaluator_ = PoseEvaluator(settings_);
+    stop_after_ = settings_.stop_after_frames;
+    summary_file_ = settings_.summary_file;
+    period_s_ = settings_.report_period_s;
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
           // Once stopping, frames still in flight are not counted: the summary covers

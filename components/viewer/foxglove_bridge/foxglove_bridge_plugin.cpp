@@ -45,7 +45,54 @@ uint64_t nanoseconds(Clock::time_point time) {
       std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count());
 }
 
+// The server's and the client queues' options with what only the plugin reads.
+struct Settings {
+  WebSocketServerOptions server;
+  ClientQueueOptions queue;
+  std::string topics = ".*";  // a regular expression
+  double max_image_rate_hz = 10;
+  bool client_publish = false;
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("address",
+             "the address to listen on: this machine only by default; 0.0.0.0 (or one "
+             "interface's address) serves the network",
+             &Settings::server, &WebSocketServerOptions::address)
+        .add("token",
+             "when set, WebSocket clients must present it (Authorization: Bearer TOKEN, or "
+             "?token=TOKEN in the URL, as the viewer page passes on its own) or are refused "
+             "with HTTP 401",
+             &Settings::server, &WebSocketServerOptions::token)
+        .add("certificate_file",
+             "with key_file: serve TLS (wss://, https://) with this PEM certificate chain",
+             &Settings::server, &WebSocketServerOptions::certificate_file)
+        .add("key_file", "the PEM private key of certificate_file", &Settings::server,
+             &WebSocketServerOptions::key_file)
+        .add("port", "the TCP port (0: any free port, logged)", &Settings::server,
+             &WebSocketServerOptions::port)
+        .range(0, 65535)
+        .add("topics", "regular expression (ECMAScript, whole name) of the topics to offer",
+             &Settings::topics)
+        .add("max_image_rate_hz",
+             "most sensor_msgs/msg/Image messages a second per client and topic (0: all)",
+             &Settings::max_image_rate_hz)
+        .range(0.0, 1000.0)
+        .add("send_buffer_limit_bytes",
+             "bytes a client may have queued; beyond, its oldest messages are dropped, "
+             "and after 5 s of dropping it is disconnected",
+             &Settings::queue, &ClientQueueOptions::limit_bytes)
+        .range(1'000'000, 1'000'000'000)
+        .add("client_publish",
+             "let clients publish (Foxglove's clientPublish) on topics that `topics` "
+             "allows, in CDR of a type this process knows",
+             &Settings::client_publish);
+
 class FoxgloveBridge final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read(kParameters);
+
  public:
   static void declare(ComponentSpec& spec) {
     spec.description(
@@ -53,62 +100,34 @@ class FoxgloveBridge final : public Component {
         "subprotocol foxglove.websocket.v1) to Foxglove, Lichtblick or any client of the "
         "protocol: CDR payloads with ros2idl schemas. Slow clients lose their oldest messages, "
         "never slow the graph.");
-    spec.parameter("address", std::string("127.0.0.1"),
-                   "the address to listen on: this machine only by default; 0.0.0.0 (or one "
-                   "interface's address) serves the network");
-    spec.parameter("token", std::string(),
-                   "when set, WebSocket clients must present it (Authorization: Bearer TOKEN, or "
-                   "?token=TOKEN in the URL, as the viewer page passes on its own) or are refused "
-                   "with HTTP 401");
-    spec.parameter("certificate_file", std::string(),
-                   "with key_file: serve TLS (wss://, https://) with this PEM certificate chain");
-    spec.parameter("key_file", std::string(), "the PEM private key of certificate_file");
-    spec.parameter("port", int64_t{8765}, "the TCP port (0: any free port, logged)")
-        .range(0, 65535);
-    spec.parameter("topics", std::string(".*"),
-                   "regular expression (ECMAScript, whole name) of the topics to offer");
-    spec.parameter("max_image_rate_hz", 10.0,
-                   "most sensor_msgs/msg/Image messages a second per client and topic (0: all)")
-        .range(0.0, 1000.0);
-    spec.parameter("send_buffer_limit_bytes", int64_t{10'000'000},
-                   "bytes a client may have queued; beyond, its oldest messages are dropped, "
-                   "and after 5 s of dropping it is disconnected")
-        .range(1'000'000, 1'000'000'000);
-    spec.parameter("client_publish", false,
-                   "let clients publish (Foxglove's clientPublish) on topics that `topics` "
-                   "allows, in CDR of a type this process knows");
+    kParameters.declare(spec);
     spec.subscribes_any("the offered topics, with their declared or discovered types");
     spec.publishes_any("what clients publish, when client_publish is on");
   }
 
   explicit FoxgloveBridge(Context& context) : Component(context) {
-    const std::string pattern = param<std::string>("topics");
+    const std::string pattern = settings_.topics;
     try {
       allowed_ = std::regex(pattern, std::regex::ECMAScript);
     } catch (const std::regex_error& e) {
       throw std::invalid_argument("topics: '" + pattern +
                                   "' is not a regular expression: " + e.what());
     }
-    const double image_rate = param<double>("max_image_rate_hz");
+    const double image_rate = settings_.max_image_rate_hz;
     if (image_rate > 0) {
       image_period_ = std::chrono::duration_cast<Clock::duration>(
           std::chrono::duration<double>(1.0 / image_rate));
     }
-    queue_options_.limit_bytes = static_cast<size_t>(param<int64_t>("send_buffer_limit_bytes"));
+    queue_options_ = settings_.queue;
 
-    client_publish_ = param<bool>("client_publish");
+    client_publish_ = settings_.client_publish;
     const std::vector<KnownTopic> declared = context.known_topics();
     for (const KnownTopic& topic : declared) {
       if (offered(topic)) declared_.insert(topic.topic);
     }
     update_topics(declared);
 
-    WebSocketServerOptions options;
-    options.address = param<std::string>("address");
-    options.port = static_cast<uint16_t>(param<int64_t>("port"));
-    options.token = param<std::string>("token");
-    options.certificate_file = param<std::string>("certificate_file");
-    options.key_file = param<std::string>("key_file");
+    WebSocketServerOptions options = settings_.server;
     options.subprotocols = {std::string(kSubprotocol), std::string(kSdkSubprotocol)};
     WebSocketHandlers handlers;
     handlers.on_open = [this](ClientId client, const std::string&) { opened(client); };

@@ -39,15 +39,25 @@ geometry_msgs::msg::Pose to_pose(const Eigen::Isometry3d& isometry) {
   return out;
 }
 
+// The smoother's options are the component's settings: each parameter below names its member,
+// whose initial value in pose_smoother.hpp is the default.
+const mocap::ParameterList<PoseSmootherOptions> kParameters =
+    mocap::ParameterList<PoseSmootherOptions>()
+        .add("position_smoothing", "weight of a new position, 0..1 (1: none)",
+             &PoseSmootherOptions::position_smoothing)
+        .range(0.01, 1)
+        .add("orientation_smoothing", "weight of a new orientation, 0..1 (1: none)",
+             &PoseSmootherOptions::orientation_smoothing)
+        .range(0.01, 1)
+        .add("restart_after_s", "a track unseen this long starts again",
+             &PoseSmootherOptions::restart_after_s)
+        .range(0, 60);
+
 class PoseFilterComponent final : public mocap::Component {
  public:
   static void declare(mocap::ComponentSpec& spec) {
     spec.description("Smooths each constellation's pose exponentially (position and orientation).");
-    spec.parameter("position_smoothing", 0.5, "weight of a new position, 0..1 (1: none)")
-        .range(0.01, 1);
-    spec.parameter("orientation_smoothing", 0.5, "weight of a new orientation, 0..1 (1: none)")
-        .range(0.01, 1);
-    spec.parameter("restart_after_s", 0.5, "a track unseen this long starts again").range(0, 60);
+    kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kInput, mocap::Qos::reliable(),
                                                              "estimated poses");
     spec.publishes<pose_filter_msgs::msg::FilteredPoseArray>(
@@ -55,11 +65,7 @@ class PoseFilterComponent final : public mocap::Component {
   }
 
   explicit PoseFilterComponent(mocap::Context& context) : Component(context) {
-    PoseSmootherOptions options;
-    options.position_smoothing = param<double>("position_smoothing");
-    options.orientation_smoothing = param<double>("orientation_smoothing");
-    options.restart_after_s = param<double>("restart_after_s");
-    smoother_ = PoseSmoother(options);
+    smoother_ = PoseSmoother(read(kParameters));
     publisher_ = create_publisher<pose_filter_msgs::msg::FilteredPoseArray>(kOutput);
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kInput, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { filter(poses); });

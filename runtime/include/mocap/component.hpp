@@ -32,6 +32,7 @@
 #include <mocap/logger.hpp>
 #include <mocap/message_type.hpp>
 #include <mocap/parameter.hpp>
+#include <mocap/parameter_list.hpp>
 #include <mocap/qos.hpp>
 
 namespace mocap {
@@ -165,9 +166,11 @@ class Component {
     context_.add_timer(period, std::forward<Callback>(callback));
   }
 
-  template <class T>
-  T param(std::string_view name) const {
-    return context_.parameters().get<T>(name);
+  // The settings `parameters` bind, from this instance's values (the launch file's, or the
+  // defaults): what the component's declare() gave ParameterList::declare.
+  template <class Settings>
+  Settings read(const ParameterList<Settings>& parameters) const {
+    return parameters.read(context_.parameters());
   }
   const Logger& log() const { return context_.logger(); }
   Clock::time_point now() const { return context_.now(); }

@@ -25,12 +25,13 @@ struct TopicSpec {
 };
 
 // The declaration lets the launcher validate a launch file, and `mocap_launch --describe`
-// document a plugin, without constructing the component (which may open devices).
+// document a plugin, without constructing the component (which may open devices). Parameters
+// come from the component's ParameterList (parameter_list.hpp), which binds each to a member
+// of its settings struct:
 //
 //   static void declare(mocap::ComponentSpec& spec) {
 //     spec.description("Finds bright round fiducials in mono8 images.");
-//     spec.parameter("threshold_ratio", 0.75, "threshold as a fraction of the brightest pixel")
-//         .range(0.0, 1.0);
+//     kParameters.declare(spec);
 //     spec.subscribes<sensor_msgs::msg::Image>("/camera/ir/image_raw", mocap::Qos::sensor_data(),
 //                                              "camera images, mono8");
 //     spec.publishes<mocap_msgs::msg::FiducialArray>("/mocap/fiducials", mocap::Qos::reliable(),
@@ -38,32 +39,11 @@ struct TopicSpec {
 //   }
 class ComponentSpec {
  public:
-  class ParameterDeclaration {
-   public:
-    // Inclusive bounds, checked for numbers and for every element of number lists.
-    ParameterDeclaration& range(double min, double max);
-    ParameterDeclaration& min(double min);
-    ParameterDeclaration& max(double max);
-    // The string is a file or directory path (see ParameterSpec::is_path).
-    ParameterDeclaration& path();
-
-   private:
-    friend class ComponentSpec;
-    ParameterDeclaration(ComponentSpec& spec, size_t index) : spec_(spec), index_(index) {}
-    ParameterSpec& parameter();
-    ComponentSpec& spec_;
-    size_t index_;
-  };
-
   void description(std::string text) { description_ = std::move(text); }
 
-  // The type is that of the default: bool, an integer, a floating-point number, a string,
-  // or a std::vector of int64_t, int, double or std::string.
-  template <class T>
-  ParameterDeclaration parameter(std::string name, T default_value, std::string description) {
-    return add_parameter(std::move(name), detail::to_parameter_value(std::move(default_value)),
-                         std::move(description));
-  }
+  // Adds a parameter (ParameterList::declare calls it). Throws std::logic_error for a name
+  // declared twice, or a path that is not a string.
+  void parameter(ParameterSpec declared);
 
   template <class Message>
   void publishes(std::string topic, Qos qos, std::string description) {
@@ -98,8 +78,6 @@ class ComponentSpec {
   const TopicSpec* find_topic(std::string_view topic) const;
 
  private:
-  ParameterDeclaration add_parameter(std::string name, ParameterValue default_value,
-                                     std::string description);
   void add_topic(TopicSpec topic);
 
   std::string description_;

@@ -80,7 +80,7 @@ class Parameters {
   explicit Parameters(std::map<std::string, ParameterValue, std::less<>> values)
       : values_(std::move(values)) {}
 
-  // The value as T: bool, int, int64_t, double, std::string, std::vector<int64_t>,
+  // The value as T: bool, an integer type, float, double, std::string, std::vector<int64_t>,
   // std::vector<int>, std::vector<double> or std::vector<std::string>. Throws
   // std::logic_error for an undeclared name or another type: that is a bug in the
   // component, not bad input, since values were validated against the declaration.
@@ -99,10 +99,12 @@ class Parameters {
 template <class T>
 T Parameters::get(std::string_view name) const {
   const ParameterValue& value = find(name);
-  if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double> ||
-                std::is_same_v<T, std::string> || std::is_same_v<T, std::vector<int64_t>> ||
-                std::is_same_v<T, std::vector<double>> ||
-                std::is_same_v<T, std::vector<std::string>>) {
+  if constexpr (std::is_same_v<T, float>) {
+    if (const double* typed = std::get_if<double>(&value)) return static_cast<float>(*typed);
+  } else if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double> ||
+                       std::is_same_v<T, std::string> || std::is_same_v<T, std::vector<int64_t>> ||
+                       std::is_same_v<T, std::vector<double>> ||
+                       std::is_same_v<T, std::vector<std::string>>) {
     if (const T* typed = std::get_if<T>(&value)) return *typed;
   } else if constexpr (std::is_integral_v<T>) {
     if (const int64_t* typed = std::get_if<int64_t>(&value)) return static_cast<T>(*typed);
