@@ -428,7 +428,7 @@ int main(int argc, char** argv) {
   print(run_sequence("hand_and_pole.yaml", seconds, database, camera, true));
 
   fmt::print(
-      "\nTargets (DESIGN.md §8): <= 5 mm and <= 0.5 deg median over 0.5-3.5 m, >= 99.5 % "
+      "\nTargets (docs/targets.md): <= 5 mm and <= 0.5 deg median over 0.5-3.5 m, >= 99.5 % "
       "tracked within 60 deg of skew, no false identifications, 8 boards at once.\n");
   return 0;
 }

@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
   }
   fmt::print(
       "\nfound: fiducials the tracker reported; poses: boards identified and posed.\n"
-      "Targets (DESIGN.md §8): >= 2000 frames/s at 12 fiducials, >= 1000 at 38.\n");
+      "Targets (docs/targets.md): >= 2000 frames/s at 12 fiducials, >= 1000 at 38.\n");
   fmt::print(
       "\nfiducials to poses (the same frame's fiducials), one thread:\n\n"
       "| fiducials | boards | poses per frame | per frame µs | frames/s | poses from scratch | "
@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
       "\nper frame: constellation_identifier and pose_estimator as before tracking; tracker "
       "from scratch: constellation_tracker with its tracks forgotten before every frame (full "
       "identification, poses, verification); boards known: the same frame again 33 ms later.\n"
-      "Targets (DESIGN.md §8): 100 markers / 8 boards >= 2000 frames/s from scratch, >= 5000 "
+      "Targets (docs/targets.md): 100 markers / 8 boards >= 2000 frames/s from scratch, >= 5000 "
       "tracked.\n");
   return 0;
 }

@@ -1,4 +1,4 @@
-// PixArt frame decoding (DESIGN.md §5) and the grouping of frames into camera samples.
+// PixArt frame decoding (docs/pixart_can.md) and the grouping of frames into camera samples.
 #include <gtest/gtest.h>
 
 #include "camera_samples.hpp"

@@ -1,4 +1,4 @@
-// PixArt points from the CAN frames of the camera boxes (DESIGN.md §5, seed 002 §11.1).
+// PixArt points from the CAN frames of the camera boxes (docs/pixart_can.md).
 //
 // A box carries four PixArt sensors and sends each sensor's up to four points in two
 // standard 8-byte frames: ID base + 2·camera_id for points 0–1, base + 2·camera_id + 1 for

@@ -1,4 +1,4 @@
-// The seed's PixArt camera box, simulated (DESIGN.md §5, §7): the LEDs of a scene seen by
+// The seed's PixArt camera box, simulated (docs/pixart_can.md): the LEDs of a scene seen by
 // each camera of a rig, as the CAN frames the box sends for one sample of all its cameras.
 //
 // A sample of a camera holds the LEDs that are on, projected through the camera's model from

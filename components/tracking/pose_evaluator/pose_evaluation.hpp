@@ -1,5 +1,5 @@
 // Compares estimated poses with the synthetic camera's ground truth, frame by frame: the
-// accuracy figures of the tracking pipeline (DESIGN.md §8).
+// accuracy figures of the tracking pipeline (docs/targets.md).
 #pragma once
 
 #include <cstdint>
