@@ -25,10 +25,11 @@ case "$mode" in
   address) build=build-asan ;;
   thread)
     build=build-tsan
-    # The runtime's unit tests (executor, timers, component host, intra-process and shared memory
-    # transports; not ShutdownSignal's: they fork a child that starts a thread, which
-    # ThreadSanitizer does not support after a fork, and there the child twice missed its stop
-    # requests; ASan runs them, and the graph tests below signal whole processes), the graph and DDS
+    # The runtime's unit tests (executor, timers, component host and its workers, intra-process
+    # and shared memory transports; not ShutdownSignal's: they fork a child that starts a
+    # thread, which ThreadSanitizer does not support after a fork, and there the child twice
+    # missed its stop requests; ASan runs them, and the graph tests below signal whole
+    # processes), the graph and DDS
     # tests on both implementations (each process a multi-threaded executor), Discovery Servers and
     # mixed Fast DDS / Cyclone DDS graphs (not the DDS security tests: Fast DDS 2.9.1 races with
     # itself in the secure handshake, two receive threads writing one ReaderProxyData under
@@ -38,7 +39,7 @@ case "$mode" in
     # the reports of the pose outputs; the viewer's WebSocket server thread and its client queues,
     # pixart_bridge's serial reader and the simulated PixArt box, the Dynamixel follower's worker
     # and the simulated AX-12 chain, and camera_source's capture thread.
-    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds(\.|/MixedTracking\.)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|Lifecycle|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds(\.|/MixedTracking\.)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)
     echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -65,7 +66,7 @@ class Source final : public Component {
   }
   explicit Source(Context& context) : Component(context) {
     publisher_ = create_publisher<Array>("/numbers");
-    create_timer(std::chrono::milliseconds(1), [this, count = read(kCount).count] {
+    create_timer(std::chrono::milliseconds(1), [this, count = read_settings(kCount).count] {
       if (publisher_.matched_subscribers() == 0 || sent_ == count) return;
       auto message = std::make_shared<Array>();
       message->header().stamp().sec(sent_++);
@@ -89,12 +90,12 @@ class Sink final : public Component {
     spec.subscribes<Array>("/numbers", Qos::reliable(), "");
   }
   explicit Sink(Context& context) : Component(context) {
-    create_subscription<Array>(
-        "/numbers", [this, expect = read(kExpect).expect](const std::shared_ptr<const Array>& m) {
-          std::lock_guard lock(record.mutex);
-          record.received.push_back(m.get());
-          if (static_cast<int>(record.received.size()) == expect) request_shutdown(0);
-        });
+    create_subscription<Array>("/numbers", [this, expect = read_settings(kExpect).expect](
+                                               const std::shared_ptr<const Array>& m) {
+      std::lock_guard lock(record.mutex);
+      record.received.push_back(m.get());
+      if (static_cast<int>(record.received.size()) == expect) request_shutdown(0);
+    });
   }
 };
 
@@ -138,7 +139,7 @@ class FamilySource final : public Component {
     spec.publishes<Array>("/cameras/{camera}/numbers", Qos::reliable(), "");
   }
   explicit FamilySource(Context& context) : Component(context) {
-    publisher_ = create_publisher<Array>("/cameras/" + read(kCamera).camera + "/numbers");
+    publisher_ = create_publisher<Array>("/cameras/" + read_settings(kCamera).camera + "/numbers");
     create_timer(std::chrono::milliseconds(1), [this] {
       if (publisher_.matched_subscribers() == 0 || sent_ == 50) return;
       auto message = std::make_shared<Array>();
@@ -370,7 +371,7 @@ class Ticker final : public Component {
  public:
   static void declare(ComponentSpec& spec) { kFail.declare(spec); }
   explicit Ticker(Context& context) : Component(context) {
-    bool fail = read(kFail).fail;
+    bool fail = read_settings(kFail).fail;
     for (int timer = 0; timer < 3; ++timer) {
       create_timer(std::chrono::microseconds(200), [this, fail] {
         // Callbacks of one component never overlap, however many threads there are.
@@ -446,7 +447,7 @@ class Burst final : public Component {
 
  private:
   Publisher<Array> publisher_;
-  const int count_ = read(kBurstCount).count;
+  const int count_ = read_settings(kBurstCount).count;
   bool sent_ = false;
 };
 
@@ -457,14 +458,13 @@ class SlowSink final : public Component {
     spec.subscribes<Array>("/burst", Qos::reliable(), "");
   }
   explicit SlowSink(Context& context) : Component(context) {
-    create_subscription<Array>("/burst",
-                               [this, expect = read(kBurstExpect).expect](const Array& message) {
-                                 std::this_thread::sleep_for(std::chrono::milliseconds(1));
-                                 std::lock_guard lock(burst.mutex);
-                                 burst.received.push_back(message.header().stamp().sec());
-                                 if (static_cast<int>(burst.received.size()) == expect)
-                                   request_shutdown(0);
-                               });
+    create_subscription<Array>(
+        "/burst", [this, expect = read_settings(kBurstExpect).expect](const Array& message) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+          std::lock_guard lock(burst.mutex);
+          burst.received.push_back(message.header().stamp().sec());
+          if (static_cast<int>(burst.received.size()) == expect) request_shutdown(0);
+        });
   }
 };
 
@@ -527,6 +527,108 @@ TEST_F(ComponentHostTest, StoppingReleasesAPublisherWaitingForASubscriber) {
   EXPECT_TRUE(std::is_sorted(burst.received.begin(), burst.received.end()));
   EXPECT_EQ(std::adjacent_find(burst.received.begin(), burst.received.end()),
             burst.received.end());  // none twice
+}
+
+// The lifecycle as components see it: what happened, in order.
+struct Lifecycle {
+  std::mutex mutex;
+  std::vector<std::string> events;
+  void add(std::string event) {
+    std::lock_guard lock(mutex);
+    events.push_back(std::move(event));
+  }
+  std::vector<std::string> list() {
+    std::lock_guard lock(mutex);
+    return events;
+  }
+  void clear() {
+    std::lock_guard lock(mutex);
+    events.clear();
+  }
+} lifecycle;
+
+// A worker that blocks in a read (a pipe nobody writes) with a 20 ms timeout, as a serial or
+// CAN reader does; it ends when asked to stop.
+class Reader final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit Reader(Context& context) : Component(context) {
+    if (pipe(fds_) != 0) throw std::runtime_error("pipe");
+    lifecycle.add(name() + " constructed");
+    create_worker("read", [this](std::stop_token stop) {
+      lifecycle.add(name() + " worker started");
+      char byte;
+      while (!stop.stop_requested()) {
+        pollfd fd{fds_[0], POLLIN, 0};
+        if (poll(&fd, 1, 20) > 0 && read(fds_[0], &byte, 1) == 1) lifecycle.add("read");
+      }
+      lifecycle.add(name() + " worker stopped");
+    });
+  }
+  ~Reader() override {
+    lifecycle.add(name() + " destroyed");
+    close(fds_[0]);
+    close(fds_[1]);
+  }
+
+ private:
+  int fds_[2] = {-1, -1};
+};
+
+// A one-shot timer beside a periodic one, which ends the run at its fifth tick.
+class OneShot final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit OneShot(Context& context) : Component(context) {
+    create_one_shot_timer(std::chrono::milliseconds(1), [] { lifecycle.add("one shot"); });
+    create_timer(std::chrono::milliseconds(20), [this] {
+      if (++ticks_ == 5) request_shutdown(0);
+    });
+  }
+
+ private:
+  int ticks_ = 0;
+};
+
+// A worker that fails at once.
+class Failing final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit Failing(Context& context) : Component(context) {
+    create_worker("fail", [](std::stop_token) { throw std::runtime_error("no device"); });
+  }
+};
+
+TEST(Lifecycle, WorkersRunBetweenTheConstructorsAndTheDestructorsAndStopWhenAsked) {
+  lifecycle.clear();
+  {
+    ComponentHost host(in_process());
+    host.add(make_component_factory<Reader>("reader"), {.name = "first"});
+    host.add(make_component_factory<Reader>("reader"), {.name = "second"});
+    host.add(make_component_factory<Failing>("failing"), {.name = "failing"});
+    host.add(make_component_factory<OneShot>("one_shot"), {.name = "one_shot"});
+    // Nothing runs before the host starts, however long construction takes.
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    EXPECT_EQ(lifecycle.list(),
+              (std::vector<std::string>{"first constructed", "second constructed"}));
+    EXPECT_EQ(host.run(), 0);               // until the fifth tick
+    EXPECT_EQ(host.callback_errors(), 1u);  // the failing worker, counted; the others ran on
+  }
+  const std::vector<std::string> events = lifecycle.list();
+  auto at = [&](const std::string& event) {
+    auto found = std::find(events.begin(), events.end(), event);
+    EXPECT_NE(found, events.end()) << event;
+    return found - events.begin();
+  };
+  for (const char* component : {"first", "second"}) {
+    const std::string name(component);
+    EXPECT_GT(at(name + " worker started"), at("second constructed")) << name;
+    // Blocked in a read, the worker saw the stop within its timeout, before any destructor.
+    EXPECT_LT(at(name + " worker stopped"), at("first destroyed")) << name;
+    EXPECT_LT(at(name + " worker stopped"), at("second destroyed")) << name;
+  }
+  EXPECT_EQ(std::count(events.begin(), events.end(), "one shot"), 1);  // not again in 100 ms
+  EXPECT_EQ(std::count(events.begin(), events.end(), "read"), 0);
 }
 
 }  // namespace

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -16,6 +19,15 @@
 #include "timer_service.hpp"
 
 namespace mocap {
+
+bool wait_for_stop(const std::stop_token& stop, std::chrono::nanoseconds duration) {
+  std::mutex mutex;
+  std::condition_variable_any woken;
+  std::unique_lock lock(mutex);
+  woken.wait_for(lock, stop, duration, [] { return false; });
+  return !stop.stop_requested();
+}
+
 namespace {
 
 std::string format_period(std::chrono::nanoseconds period) {
@@ -215,6 +227,8 @@ class ComponentHost::Impl::ComponentContext final : public Context {
         strand_(host.executor, logger_) {}
 
   ~ComponentContext() override {
+    request_workers_stop();
+    join_workers();
     for (const auto& timer : timers_) host_.timers.remove(timer.get());
     // Transport endpoints go first, so that nothing notifies the strand once it is gone.
     strand_.clear();
@@ -303,19 +317,56 @@ class ComponentHost::Impl::ComponentContext final : public Context {
       throw std::invalid_argument(
           fmt::format("timer period must be positive, got {} ns", period.count()));
     }
-    auto timer = std::make_shared<Timer>("timer every " + format_period(period), period,
-                                         std::move(callback), strand_);
-    timers_.push_back(timer);
-    waitables_.push_back(timer);
-    strand_.add(timer);
-    host_.timers.add(timer);
+    add_timer(std::make_shared<Timer>("timer every " + format_period(period), period,
+                                      std::move(callback), strand_));
+  }
+
+  void add_one_shot_timer(std::chrono::nanoseconds delay, std::function<void()> callback) override {
+    add_timer(std::make_shared<Timer>("timer after " + format_period(delay),
+                                      std::max(delay, std::chrono::nanoseconds(1)),
+                                      std::move(callback), strand_, Timer::Repeat::Once));
+  }
+
+  void add_worker(std::string name, std::function<void(std::stop_token)> body) override {
+    // Started by the host once the component exists (ComponentHost::start, or add()).
+    workers_.push_back(std::make_unique<Worker>(Worker{std::move(name), std::move(body), {}}));
   }
 
   void request_shutdown(int exit_code) override { host_.request_shutdown(exit_code); }
 
   Strand& strand() { return strand_; }
 
+  void start_workers() {
+    for (auto& worker : workers_) {
+      if (worker->thread.joinable()) continue;
+      worker->thread = std::jthread([this, worker = worker.get()](std::stop_token stop) {
+        try {
+          worker->body(stop);
+        } catch (const std::exception& e) {
+          worker_errors_.fetch_add(1);
+          logger_.error("worker '{}' ended: {}", worker->name, e.what());
+        }
+      });
+    }
+  }
+  void request_workers_stop() {
+    for (auto& worker : workers_) worker->thread.request_stop();
+  }
+  void join_workers() {
+    for (auto& worker : workers_) {
+      if (worker->thread.joinable()) worker->thread.join();
+    }
+  }
+  uint64_t worker_errors() const { return worker_errors_.load(); }
+
  private:
+  void add_timer(std::shared_ptr<Timer> timer) {
+    timers_.push_back(timer);
+    waitables_.push_back(timer);
+    strand_.add(timer);
+    host_.timers.add(timer);
+  }
+
   Endpoint resolve(std::string_view topic, const MessageType& type, TopicDirection direction) {
     const TopicSpec* declared = spec_.find_topic(topic);
     // A topic of a declared family: its placeholders' values carry over to a remap.
@@ -379,6 +430,13 @@ class ComponentHost::Impl::ComponentContext final : public Context {
   std::vector<std::shared_ptr<HostPublisher>> publishers_;
   std::vector<std::shared_ptr<Waitable>> waitables_;
   std::vector<std::shared_ptr<Timer>> timers_;
+  struct Worker {
+    std::string name;
+    std::function<void(std::stop_token)> body;
+    std::jthread thread;
+  };
+  std::vector<std::unique_ptr<Worker>> workers_;
+  std::atomic<uint64_t> worker_errors_{0};
 };
 
 // ---------------------------------------------------------------------------------------
@@ -467,6 +525,7 @@ Component& ComponentHost::add(const ComponentFactory& factory, ComponentConfig c
     throw ComponentError(fmt::format("{} failed to start: {}", label, e.what()));
   }
   context->strand().enable();
+  if (impl_->started) context->start_workers();
   impl_->contexts.push_back(std::move(context));
   impl_->components.push_back(std::move(component));
   return *impl_->components.back();
@@ -518,6 +577,7 @@ void ComponentHost::start() {
   }
   impl_->executor.start();
   impl_->timers.start();
+  for (const auto& context : impl_->contexts) context->start_workers();
 }
 
 int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
@@ -554,15 +614,20 @@ int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
 
 void ComponentHost::stop() {
   impl_->timers.stop();
-  // Callbacks waiting for a subscriber's room would hold the executor's stop up forever: the
+  for (const auto& context : impl_->contexts) context->request_workers_stop();
+  // Callbacks and workers waiting for a subscriber's room would hold the stop up forever: the
   // subscribers in this process no longer run, those in others may not catch up.
   for (auto& transport : impl_->transports) transport->stop_waiting();
+  // Workers first: they may still publish, and components are destroyed only after this.
+  for (const auto& context : impl_->contexts) context->join_workers();
   impl_->executor.stop();
 }
 
 uint64_t ComponentHost::callback_errors() const {
   uint64_t errors = 0;
-  for (const auto& context : impl_->contexts) errors += context->strand().callback_errors();
+  for (const auto& context : impl_->contexts) {
+    errors += context->strand().callback_errors() + context->worker_errors();
+  }
   return errors;
 }
 

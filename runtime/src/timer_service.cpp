@@ -56,6 +56,10 @@ void TimerService::run() {
     for (auto& timer : timers_) {
       if (timer->next_ <= now) {
         timer->fire();
+        if (timer->repeat_ == Timer::Repeat::Once) {
+          timer->next_ = std::chrono::steady_clock::time_point::max();
+          continue;
+        }
         // Keep the schedule on the period grid; ticks missed while asleep are skipped.
         timer->next_ += timer->period_;
         if (timer->next_ <= now) {

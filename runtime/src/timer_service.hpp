@@ -1,4 +1,5 @@
-// Periodic timers: one thread marks timers due; their callbacks run on the component strands.
+// Timers, periodic or one-shot: one thread marks them due; their callbacks run on the component
+// strands.
 #pragma once
 
 #include <atomic>
@@ -18,10 +19,14 @@ class TimerService;
 
 class Timer final : public Waitable {
  public:
+  enum class Repeat { Periodic, Once };
+
+  // Due every `period`; Once: a single time, `period` after it starts.
   Timer(std::string label, std::chrono::nanoseconds period, std::function<void()> callback,
-        Strand& strand)
+        Strand& strand, Repeat repeat = Repeat::Periodic)
       : Waitable(std::move(label)),
         period_(period),
+        repeat_(repeat),
         callback_(std::move(callback)),
         strand_(strand) {}
 
@@ -35,6 +40,7 @@ class Timer final : public Waitable {
   void fire();
 
   std::chrono::nanoseconds period_;
+  Repeat repeat_;
   std::function<void()> callback_;
   Strand& strand_;
   std::atomic<bool> due_{false};

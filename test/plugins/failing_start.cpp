@@ -15,7 +15,7 @@ const mocap::ParameterList<Settings> kParameters = mocap::ParameterList<Settings
 
 class FailingStart final : public mocap::Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(mocap::ComponentSpec& spec) { kParameters.declare(spec); }

@@ -54,7 +54,7 @@ const ParameterList<Settings> kParameters =
 
 class SequenceSink final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {

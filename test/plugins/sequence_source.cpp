@@ -37,7 +37,7 @@ const ParameterList<Settings> kParameters =
 
 class SequenceSource final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {

@@ -7,7 +7,6 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <mocap/bag/bag_reader.hpp>
@@ -46,7 +45,7 @@ const ParameterList<Settings> kParameters =
 
 class BagPlayer final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -90,20 +89,17 @@ class BagPlayer final : public Component {
       qos.depth = 1000;
       topics_[topic.name] = {type, context.advertise_any(topic.name, *type, qos)};
     }
-    // Timers tick only once the process runs, when every component of it subscribes: the
-    // first tick starts the playback thread.
-    const double delay = std::max(settings_.start_delay_s, 1e-3);
-    const double exit_after = settings_.exit_after_s;
-    create_timer(
-        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(delay)),
-        [this, exit_after] {
-          if (!thread_.joinable()) thread_ = std::thread([this, exit_after] { run(exit_after); });
-        });
-  }
-
-  ~BagPlayer() override {
-    stop_.store(true);
-    if (thread_.joinable()) thread_.join();
+    // Workers start once the process runs, when every component of it subscribes; playback
+    // waits start_delay_s more for the subscribers of other processes.
+    create_worker("playback", [this](std::stop_token stop) {
+      const auto delay = std::chrono::duration_cast<std::chrono::nanoseconds>(
+          std::chrono::duration<double>(settings_.start_delay_s));
+      if (!wait_for_stop(stop, delay)) return;
+      std::atomic<bool> stopped{false};  // what the bag library's play() watches
+      const std::stop_callback on_stop(stop, [&stopped] { stopped.store(true); });
+      run(stopped);
+      if (!stopped.load()) exit_later(stop);
+    });
   }
 
  private:
@@ -112,7 +108,7 @@ class BagPlayer final : public Component {
     std::shared_ptr<PublisherPort> publisher;
   };
 
-  void run(double exit_after) {
+  void run(const std::atomic<bool>& stop) {
     uint64_t dropped = 0;
     const PlaybackStats stats = play(
         *reader_, settings_,
@@ -130,24 +126,22 @@ class BagPlayer final : public Component {
           }
           topic->second.publisher->publish(std::move(typed));
         },
-        stop_);
+        stop);
     log().info("played {} message(s){}", stats.published,
                dropped ? fmt::format(", {} dropped (not deserializable)", dropped) : "");
-    if (exit_after < 0 || settings_.loop) return;
-    const auto end = std::chrono::steady_clock::now() +
-                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                         std::chrono::duration<double>(exit_after));
-    while (!stop_.load() && std::chrono::steady_clock::now() < end) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    if (!stop_.load()) request_shutdown(0);
+  }
+
+  // exit_after_s after the last message, the process ends (an offline run).
+  void exit_later(const std::stop_token& stop) {
+    if (settings_.exit_after_s < 0 || settings_.loop) return;
+    const auto after = std::chrono::duration_cast<std::chrono::nanoseconds>(
+        std::chrono::duration<double>(settings_.exit_after_s));
+    if (wait_for_stop(stop, after)) request_shutdown(0);
   }
 
   std::unique_ptr<BagReader> reader_;
   std::vector<std::unique_ptr<RawMessageType>> raw_types_;
   std::map<std::string, Topic> topics_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
 };
 
 }  // namespace

@@ -49,7 +49,7 @@ const ParameterList<Settings> kParameters =
 
 class BagRecorder final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {

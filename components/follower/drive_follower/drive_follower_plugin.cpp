@@ -23,6 +23,7 @@
 #include <sensor_msgs/msg/joint_state.hpp>
 
 #include "drive_follower.hpp"
+#include "graph_topics.hpp"
 #include "joint_history.hpp"
 #include "object_in_base.hpp"
 #include "pose_message.hpp"
@@ -37,10 +38,6 @@ using mocap_msgs::msg::ConstellationPose;
 using mocap_msgs::msg::ConstellationPoseArray;
 using sensor_msgs::msg::JointState;
 
-constexpr const char* kPoses = "/mocap/poses";
-constexpr const char* kJointStates = "/turret/joint_states";
-constexpr const char* kCommand = "/cmd_vel";
-constexpr const char* kAlerts = "/alerts";
 constexpr uint8_t kWarning = 1;
 
 double steady_seconds() {
@@ -101,7 +98,7 @@ const ParameterList<Settings> kParameters =
 
 class DriveFollowerComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -110,13 +107,14 @@ class DriveFollowerComponent final : public Component {
         "pointed at it (the seed's two rules, with acceleration limits); stops at once and "
         "raises an alert when the track is lost.");
     kParameters.declare(spec);
-    spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
+    spec.subscribes<ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                             "constellation poses in the tracking camera's frame");
-    spec.subscribes<JointState>(kJointStates, Qos::sensor_data(),
+    spec.subscribes<JointState>(topics::kTurretJointStates, Qos::sensor_data(),
                                 "the turret's pan and tilt angles, radians");
-    spec.publishes<Twist>(kCommand, Qos::reliable(),
+    spec.publishes<Twist>(topics::kCmdVel, Qos::reliable(),
                           "linear.x (m/s) and angular.z (rad/s) every control period");
-    spec.publishes<Alert>(kAlerts, Qos::reliable(), "one alert each time the track is lost");
+    spec.publishes<Alert>(topics::kAlerts, Qos::reliable(),
+                          "one alert each time the track is lost");
   }
 
   explicit DriveFollowerComponent(Context& context)
@@ -129,12 +127,12 @@ class DriveFollowerComponent final : public Component {
     if (pan_joint_ == tilt_joint_) {
       throw std::invalid_argument("pan_joint and tilt_joint are both '" + pan_joint_ + "'");
     }
-    command_publisher_ = create_publisher<Twist>(kCommand);
-    alert_publisher_ = create_publisher<Alert>(kAlerts);
-    create_subscription<JointState>(kJointStates,
+    command_publisher_ = create_publisher<Twist>(topics::kCmdVel);
+    alert_publisher_ = create_publisher<Alert>(topics::kAlerts);
+    create_subscription<JointState>(topics::kTurretJointStates,
                                     [this](const JointState& state) { on_joint_state(state); });
     create_subscription<ConstellationPoseArray>(
-        kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
+        topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
     const double rate = settings_.rate_hz;
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(1.0 / rate)),
@@ -195,8 +193,8 @@ class DriveFollowerComponent final : public Component {
         joints_.at(to_nanoseconds(followed->pose().header().stamp()));
     if (!joints) {
       if (poses_before_joints_++ == 0) {
-        log().warn("poses are not used until {} carries the angles of '{}' and '{}'", kJointStates,
-                   pan_joint_, tilt_joint_);
+        log().warn("poses are not used until {} carries the angles of '{}' and '{}'",
+                   topics::kTurretJointStates, pan_joint_, tilt_joint_);
       }
       return;
     }

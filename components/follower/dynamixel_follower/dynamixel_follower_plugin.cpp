@@ -10,14 +10,12 @@
 // time. A servo reporting overheating or overload gets its torque switched off, for both, and
 // an alert on /alerts; the follower then only reports, until restarted. A bus that goes away
 // (adaptor unplugged) is reopened with back-off.
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 
 #include <mocap/component.hpp>
 #include <mocap/config_files.hpp>
@@ -28,6 +26,7 @@
 
 #include "ax12_control_table.hpp"
 #include "dynamixel_bus.hpp"
+#include "graph_topics.hpp"
 #include "joint_history.hpp"
 #include "servo_mapping.hpp"
 #include "turret_follower.hpp"
@@ -41,10 +40,6 @@ using dynamixel::BusError;
 using dynamixel::BusErrorKind;
 using JointState = sensor_msgs::msg::JointState;
 
-constexpr const char* kPoseTopic = "/mocap/poses";
-constexpr const char* kStateTopic = "/turret/joint_states";
-constexpr const char* kCommandTopic = "/turret/command";
-constexpr const char* kAlertTopic = "/alerts";
 constexpr uint8_t kShutdownErrors =
     dynamixel::error_bit::kOverheating | dynamixel::error_bit::kOverload;
 
@@ -111,7 +106,7 @@ const ParameterList<Settings> kParameters =
 
 class DynamixelFollower final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -120,15 +115,15 @@ class DynamixelFollower final : public Component {
         "(Dynamixel Protocol 1.0 on a serial port); publishes the joints' present state. "
         "Overheating or overload: torque off and an alert.");
     kParameters.declare(spec);
-    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoseTopic, Qos::reliable(),
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                                              "tracked poses, camera frame");
-    spec.publishes<JointState>(kStateTopic, Qos::reliable(),
+    spec.publishes<JointState>(topics::kTurretJointStates, Qos::reliable(),
                                "joints pan and tilt: present position (rad), speed (rad/s), "
                                "load (fraction of the maximum torque) as effort");
-    spec.publishes<JointState>(kCommandTopic, Qos::reliable(),
+    spec.publishes<JointState>(topics::kTurretCommand, Qos::reliable(),
                                "joints pan and tilt: goal position (rad) and speed limit "
                                "(rad/s) sent each cycle");
-    spec.publishes<mocap_msgs::msg::Alert>(kAlertTopic, Qos::reliable(),
+    spec.publishes<mocap_msgs::msg::Alert>(topics::kAlerts, Qos::reliable(),
                                            "servo faults: torque switched off");
   }
 
@@ -143,25 +138,21 @@ class DynamixelFollower final : public Component {
     }
     period_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
         std::chrono::duration<double>(1 / settings_.rate_hz));
-    states_ = create_publisher<JointState>(kStateTopic);
-    commands_ = create_publisher<JointState>(kCommandTopic);
-    alerts_ = create_publisher<mocap_msgs::msg::Alert>(kAlertTopic);
+    states_ = create_publisher<JointState>(topics::kTurretJointStates);
+    commands_ = create_publisher<JointState>(topics::kTurretCommand);
+    alerts_ = create_publisher<mocap_msgs::msg::Alert>(topics::kAlerts);
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
-        kPoseTopic,
+        topics::kPoses,
         [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { on_poses(poses); });
-    // The bus is driven from its own thread, started with the graph (timers run once every
-    // component exists), so that blocking serial I/O never holds up the executor.
-    create_timer(std::chrono::milliseconds(1), [this] {
-      if (!worker_.joinable()) worker_ = std::thread([this] { run(); });
-    });
+    // The bus is driven from a worker of its own, started with the graph, so that blocking
+    // serial I/O never holds up the executor.
+    create_worker("bus", [this](std::stop_token stop) { run(stop); });
     log().info("servos {} (pan) and {} (tilt) on {} at {} bit/s, {} Hz; turret {}", pan_id_,
                tilt_id_, settings_.port, settings_.bus.baud_rate, settings_.rate_hz,
                follower_.turret().source());
   }
 
   ~DynamixelFollower() override {
-    stop_ = true;
-    if (worker_.joinable()) worker_.join();
     log().info(
         "{} cycles, {} poses used, {} without a joint reading; bus: {} packets, {} replies, {} "
         "timeouts, {} corrupt, {} retries; {} reconnects",
@@ -192,10 +183,10 @@ class DynamixelFollower final : public Component {
 
   // --- bus thread --------------------------------------------------------------------------
 
-  void run() {
+  void run(const std::stop_token& stop) {
     std::chrono::milliseconds backoff(100);
     auto next = std::chrono::steady_clock::now();
-    while (!stop_) {
+    while (!stop.stop_requested()) {
       try {
         if (!bus_) {
           connect();
@@ -210,7 +201,7 @@ class DynamixelFollower final : public Component {
           bus_stats_ = add(bus_stats_, bus_->stats());
           bus_.reset();
           log().warn("{}; reopening in {} ms", e.what(), backoff.count());
-          sleep_for(backoff);
+          wait_for_stop(stop, backoff);
           backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
           continue;
         }
@@ -221,14 +212,14 @@ class DynamixelFollower final : public Component {
         }
       } catch (const std::exception& e) {  // cannot open the device
         log().warn("{}; retrying in {} ms", e.what(), backoff.count());
-        sleep_for(backoff);
+        wait_for_stop(stop, backoff);
         backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
         continue;
       }
       next += period_;
       const auto now = std::chrono::steady_clock::now();
       if (next < now) next = now;  // fell behind: no burst of cycles to catch up
-      std::this_thread::sleep_until(next);
+      wait_for_stop(stop, next - now);
     }
     if (bus_) bus_stats_ = add(bus_stats_, bus_->stats());
   }
@@ -348,13 +339,6 @@ class DynamixelFollower final : public Component {
     alerts_.publish(std::move(alert));
   }
 
-  void sleep_for(std::chrono::milliseconds duration) const {
-    for (auto waited = std::chrono::milliseconds(0); waited < duration && !stop_;
-         waited += std::chrono::milliseconds(20)) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-
   static dynamixel::DynamixelBusStats add(dynamixel::DynamixelBusStats a,
                                           const dynamixel::DynamixelBusStats& b) {
     a.packets_sent += b.packets_sent;
@@ -384,8 +368,6 @@ class DynamixelFollower final : public Component {
   Publisher<JointState> states_;
   Publisher<JointState> commands_;
   Publisher<mocap_msgs::msg::Alert> alerts_;
-  std::atomic<bool> stop_{false};
-  std::thread worker_;
 };
 
 }  // namespace

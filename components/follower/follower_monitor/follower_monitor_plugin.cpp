@@ -17,6 +17,7 @@
 #include <sensor_msgs/msg/joint_state.hpp>
 
 #include "follow_evaluation.hpp"
+#include "graph_topics.hpp"
 #include "pose_message.hpp"
 
 namespace mocap::evaluation {
@@ -25,13 +26,6 @@ namespace {
 using geometry_msgs::msg::PoseStamped;
 using mocap_msgs::msg::ConstellationPoseArray;
 
-constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
-constexpr const char* kCameraPoseTopic = "/sim/camera_pose";
-constexpr const char* kBasePoseTopic = "/base/pose";
-constexpr const char* kPoseTopic = "/mocap/poses";
-constexpr const char* kVelocityTopic = "/cmd_vel";
-constexpr const char* kJointTopic = "/turret/joint_states";
-constexpr const char* kAlertTopic = "/alerts";
 // The camera's poses come at the simulated base's 100 Hz: a second of them.
 constexpr size_t kKeptCameraPoses = 100;
 // A board showing this many of its markers can be tracked (three sides of twelve).
@@ -79,7 +73,7 @@ const ParameterList<Settings> kParameters =
 
 class FollowerMonitor final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -88,33 +82,34 @@ class FollowerMonitor final : public Component {
         "error, the distance the base keeps from the object once it stands still, the time "
         "from a lost track to a stopped base, and loop rates; a live line and a final table.");
     kParameters.declare(spec);
-    spec.subscribes<ConstellationPoseArray>(kTruthTopic, Qos::reliable(),
+    spec.subscribes<ConstellationPoseArray>(topics::kGroundTruth, Qos::reliable(),
                                             "the synthetic camera's ground truth");
-    spec.subscribes<PoseStamped>(kCameraPoseTopic, Qos::reliable(), "the camera in the world");
-    spec.subscribes<PoseStamped>(kBasePoseTopic, Qos::reliable(), "the base in the world");
-    spec.subscribes<ConstellationPoseArray>(kPoseTopic, Qos::reliable(), "tracked poses");
-    spec.subscribes<geometry_msgs::msg::Twist>(kVelocityTopic, Qos::reliable(),
+    spec.subscribes<PoseStamped>(topics::kSimCameraPose, Qos::reliable(),
+                                 "the camera in the world");
+    spec.subscribes<PoseStamped>(topics::kBasePose, Qos::reliable(), "the base in the world");
+    spec.subscribes<ConstellationPoseArray>(topics::kPoses, Qos::reliable(), "tracked poses");
+    spec.subscribes<geometry_msgs::msg::Twist>(topics::kCmdVel, Qos::reliable(),
                                                "the drive follower's commands");
-    spec.subscribes<sensor_msgs::msg::JointState>(kJointTopic, Qos::reliable(),
+    spec.subscribes<sensor_msgs::msg::JointState>(topics::kTurretJointStates, Qos::reliable(),
                                                   "the turret's joint states (its cycle rate)");
-    spec.subscribes<mocap_msgs::msg::Alert>(kAlertTopic, Qos::reliable(), "alerts, counted");
+    spec.subscribes<mocap_msgs::msg::Alert>(topics::kAlerts, Qos::reliable(), "alerts, counted");
   }
 
   explicit FollowerMonitor(Context& context) : Component(context) {
     constellation_ = settings_.constellation;
     summary_file_ = settings_.summary_file;
     evaluator_ = FollowEvaluator(settings_);
-    create_subscription<PoseStamped>(kCameraPoseTopic, [this](const PoseStamped& pose) {
+    create_subscription<PoseStamped>(topics::kSimCameraPose, [this](const PoseStamped& pose) {
       const std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose());
       if (!world_from_camera) return;
       camera_poses_.emplace_back(to_nanoseconds(pose.header().stamp()), *world_from_camera);
       while (camera_poses_.size() > kKeptCameraPoses) camera_poses_.pop_front();
     });
-    create_subscription<PoseStamped>(kBasePoseTopic, [this](const PoseStamped& pose) {
+    create_subscription<PoseStamped>(topics::kBasePose, [this](const PoseStamped& pose) {
       evaluator_.add_base({pose.pose().position().x(), pose.pose().position().y()});
     });
     create_subscription<ConstellationPoseArray>(
-        kTruthTopic, [this](const ConstellationPoseArray& truth) {
+        topics::kGroundTruth, [this](const ConstellationPoseArray& truth) {
           rates_["camera"].add(steady_ns());
           const std::optional<Eigen::Isometry3d> world_from_camera =
               camera_pose_at(to_nanoseconds(truth.header().stamp()));
@@ -127,7 +122,7 @@ class FollowerMonitor final : public Component {
                                  pose.points_used() >= kTrackableMarkers);
           }
         });
-    create_subscription<ConstellationPoseArray>(kPoseTopic,
+    create_subscription<ConstellationPoseArray>(topics::kPoses,
                                                 [this](const ConstellationPoseArray& poses) {
                                                   for (const auto& pose : poses.poses()) {
                                                     if (pose.name() != constellation_) continue;
@@ -137,16 +132,16 @@ class FollowerMonitor final : public Component {
                                                   }
                                                 });
     create_subscription<geometry_msgs::msg::Twist>(
-        kVelocityTopic, [this](const geometry_msgs::msg::Twist& twist) {
+        topics::kCmdVel, [this](const geometry_msgs::msg::Twist& twist) {
           const int64_t now = steady_ns();
           rates_["drive"].add(now);
           evaluator_.add_velocity_command(now, twist.linear().x(), twist.angular().z());
         });
     create_subscription<sensor_msgs::msg::JointState>(
-        kJointTopic,
+        topics::kTurretJointStates,
         [this](const sensor_msgs::msg::JointState&) { rates_["turret"].add(steady_ns()); });
     create_subscription<mocap_msgs::msg::Alert>(
-        kAlertTopic, [this](const mocap_msgs::msg::Alert&) { ++alerts_; });
+        topics::kAlerts, [this](const mocap_msgs::msg::Alert&) { ++alerts_; });
     const double period_s = settings_.report_period_s;
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(period_s)),

@@ -19,6 +19,7 @@
 #include <tf2_msgs/msg/tf_message.hpp>
 
 #include "body_state_message.hpp"
+#include "graph_topics.hpp"
 #include "pose_message.hpp"
 #include "stamp_rate.hpp"
 
@@ -31,12 +32,6 @@ using mocap_msgs::msg::ConstellationPose;
 using mocap_msgs::msg::ConstellationPoseArray;
 using nav_msgs::msg::Odometry;
 using tf2_msgs::msg::TFMessage;
-
-constexpr const char* kPoses = "/mocap/poses";
-constexpr const char* kPoseFamily = "/mocap/{board}/pose";
-constexpr const char* kOdomFamily = "/mocap/{board}/odom";
-constexpr const char* kTf = "/tf";
-constexpr const char* kTfStatic = "/tf_static";
 
 std::array<double, 36> to_row_major(const Matrix6d& matrix) {
   std::array<double, 36> values{};
@@ -117,7 +112,7 @@ const ParameterList<Settings> kParameters =
 
 class PoseOutputs final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -127,14 +122,14 @@ class PoseOutputs final : public Component {
         "the board's frame) on /mocap/<board>/odom, every board on /tf, the camera's mounting "
         "on /tf_static. Frames follow REP 103/105; stamps are the images' capture times.");
     kParameters.declare(spec);
-    spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
+    spec.subscribes<ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                             "the tracked boards in the camera's optical frame");
-    spec.publishes<PoseStamped>(kPoseFamily, Qos::sensor_data(), "each board's pose");
-    spec.publishes<Odometry>(kOdomFamily, Qos::sensor_data(),
+    spec.publishes<PoseStamped>(topics::kBoardPose, Qos::sensor_data(), "each board's pose");
+    spec.publishes<Odometry>(topics::kBoardOdometry, Qos::sensor_data(),
                              "each board's pose and velocity with their covariances");
     // tf2's own QoS: its listeners are reliable readers, which a best-effort writer never meets.
-    spec.publishes<TFMessage>(kTf, tf_qos(), "the boards in the parent frame");
-    spec.publishes<TFMessage>(kTfStatic, Qos::latched(),
+    spec.publishes<TFMessage>(topics::kTf, tf_qos(), "the boards in the parent frame");
+    spec.publishes<TFMessage>(topics::kTfStatic, Qos::latched(),
                               "world -> camera_frame -> optical_frame, once");
   }
 
@@ -163,9 +158,9 @@ class PoseOutputs final : public Component {
     camera_from_optical.linear() = optical_in_body().toRotationMatrix();
     world_from_optical_ = world_from_camera * camera_from_optical;
 
-    tf_ = create_publisher<TFMessage>(kTf);
+    tf_ = create_publisher<TFMessage>(topics::kTf);
     create_subscription<ConstellationPoseArray>(
-        kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
+        topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
 
     // Latched: a tf2 listener that starts later still gets the camera's place.
     TFMessage mounted;
@@ -175,12 +170,12 @@ class PoseOutputs final : public Component {
     mounted.transforms().push_back(to_transform(header, camera_frame, world_from_camera));
     header.frame_id(camera_frame);
     mounted.transforms().push_back(to_transform(header, optical_frame_, camera_from_optical));
-    create_publisher<TFMessage>(kTfStatic).publish(mounted);
+    create_publisher<TFMessage>(topics::kTfStatic).publish(mounted);
 
     log().info(
         "boards of {} in frame {} on /mocap/<board>/pose, /mocap/<board>/odom and /tf; "
         "{} -> {} -> {} on /tf_static",
-        kPoses, in_world_ ? world_frame_ : optical_frame_, world_frame_, camera_frame,
+        topics::kPoses, in_world_ ? world_frame_ : optical_frame_, world_frame_, camera_frame,
         optical_frame_);
   }
 
@@ -257,8 +252,9 @@ class PoseOutputs final : public Component {
     if (auto found = outputs_.find(board); found != outputs_.end()) return &found->second;
     if (unpublishable_.count(board) > 0) return nullptr;
     try {
-      BoardOutputs outputs{create_publisher<PoseStamped>("/mocap/" + board + "/pose"),
-                           create_publisher<Odometry>("/mocap/" + board + "/odom")};
+      BoardOutputs outputs{
+          create_publisher<PoseStamped>(topics::member_of(topics::kBoardPose, board)),
+          create_publisher<Odometry>(topics::member_of(topics::kBoardOdometry, board))};
       return &outputs_.emplace(board, std::move(outputs)).first->second;
     } catch (const std::exception& e) {
       unpublishable_.insert(board);

@@ -18,6 +18,7 @@
 #include <px4_msgs/msg/vehicle_odometry.hpp>
 
 #include "body_state_message.hpp"
+#include "graph_topics.hpp"
 #include "px4_frames.hpp"
 #include "stamp_rate.hpp"
 
@@ -27,9 +28,6 @@ namespace {
 using mocap_msgs::msg::ConstellationPose;
 using mocap_msgs::msg::ConstellationPoseArray;
 using px4_msgs::msg::VehicleOdometry;
-
-constexpr const char* kPoses = "/mocap/poses";
-constexpr const char* kOdometry = "/fmu/in/vehicle_visual_odometry";
 
 // What PX4's ROS 2 examples publish with: reliable, the last 10 kept. A reliable writer meets
 // the agent's reader whichever reliability it asks for; keep-last never holds the graph up.
@@ -83,7 +81,7 @@ const ParameterList<Settings> kParameters =
 
 class Px4OdometryComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -92,9 +90,10 @@ class Px4OdometryComponent final : public Component {
         "v1.18) for PX4's uXRCE-DDS bridge: position, attitude, velocities and variances in "
         "PX4's frames (world NED or FRD, body FRD), at rate_hz by capture stamps.");
     kParameters.declare(spec);
-    spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
+    spec.subscribes<ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                             "the tracked boards in the camera's optical frame");
-    spec.publishes<VehicleOdometry>(kOdometry, px4_qos(), "the vehicle's odometry");
+    spec.publishes<VehicleOdometry>(topics::kPx4VisualOdometry, px4_qos(),
+                                    "the vehicle's odometry");
   }
 
   explicit Px4OdometryComponent(Context& context)
@@ -112,13 +111,13 @@ class Px4OdometryComponent final : public Component {
         world_from_optical(from_xyz_rpy(settings_.camera_in_world, "camera_in_world"));
     board_from_vehicle_ = from_xyz_rpy(settings_.vehicle_in_board, "vehicle_in_board");
     const double rate = settings_.rate_hz;
-    publisher_ = create_publisher<VehicleOdometry>(kOdometry);
+    publisher_ = create_publisher<VehicleOdometry>(topics::kPx4VisualOdometry);
     create_subscription<ConstellationPoseArray>(
-        kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
+        topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
     log().info("{} as PX4 odometry ({} world, FRD body) at {} on {}", board_,
                frame == "ned" ? "NED" : "FRD",
                rate > 0 ? fmt::format("{} Hz at most", rate) : std::string("every frame"),
-               kOdometry);
+               topics::kPx4VisualOdometry);
   }
 
   ~Px4OdometryComponent() override {

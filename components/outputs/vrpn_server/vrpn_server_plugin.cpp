@@ -13,6 +13,7 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
 #include "body_state_message.hpp"
+#include "graph_topics.hpp"
 #include "tracker_server.hpp"
 
 namespace mocap::vrpn {
@@ -20,8 +21,6 @@ namespace {
 
 using mocap_msgs::msg::ConstellationPose;
 using mocap_msgs::msg::ConstellationPoseArray;
-
-constexpr const char* kPoses = "/mocap/poses";
 
 // The server's options with what only the plugin reads.
 struct Settings : TrackerServerOptions {
@@ -51,7 +50,7 @@ const ParameterList<Settings> kParameters =
 
 class VrpnServer final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -61,7 +60,7 @@ class VrpnServer final : public Component {
         "board_a@host, or board_a@tcp://host:port. Slow or dead clients are dropped, never "
         "waited for.");
     kParameters.declare(spec);
-    spec.subscribes<ConstellationPoseArray>(kPoses, Qos::reliable(),
+    spec.subscribes<ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                             "the tracked boards in the camera's optical frame");
   }
 
@@ -79,7 +78,7 @@ class VrpnServer final : public Component {
       throw std::invalid_argument(e.what());  // names the parameter at fault
     }
     create_subscription<ConstellationPoseArray>(
-        kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
+        topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
     const std::string served = fmt::format(
         "VRPN trackers (one per board, in the {} frame) on {}:{} TCP and UDP; clients ask for "
         "BOARD@HOST",

@@ -1,10 +1,8 @@
 // pixart_bridge: PixArt points from a CAN bus (can_source.hpp, pixart_decoder.hpp), published
 // raw and as one FiducialArray per camera sample, so that downstream components treat each
 // PixArt sensor like any camera.
-#include <atomic>
 #include <chrono>
 #include <memory>
-#include <thread>
 
 #include <mocap/component.hpp>
 #include <mocap/message_time.hpp>
@@ -13,13 +11,12 @@
 
 #include "camera_samples.hpp"
 #include "can_source.hpp"
+#include "graph_topics.hpp"
 #include "pixart_decoder.hpp"
 
 namespace mocap::pixart {
 namespace {
 
-constexpr const char* kRawTopic = "/pixart/raw";
-constexpr const char* kFiducialFamily = "/pixart/{camera}/fiducials";
 // Uncertainty of a PixArt coordinate: the sensor reports whole pixels (1/sqrt(12) px).
 constexpr float kQuantisationPx = 0.29f;
 
@@ -59,7 +56,7 @@ const ParameterList<Settings> kParameters =
 
 class PixartBridge final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -68,9 +65,9 @@ class PixartBridge final : public Component {
         "log), publishes them raw and as one fiducial array per camera sample.");
     kParameters.declare(spec);
     spec.publishes<mocap_msgs::msg::PixartRawPointArray>(
-        kRawTopic, Qos::reliable(), "the points decoded from each batch of frames read");
+        topics::kPixartRaw, Qos::reliable(), "the points decoded from each batch of frames read");
     spec.publishes<mocap_msgs::msg::FiducialArray>(
-        kFiducialFamily, Qos::reliable(),
+        topics::kPixartFiducials, Qos::reliable(),
         "one array per camera sample (up to 4 points, pixels), frame id = camera name");
   }
 
@@ -81,23 +78,19 @@ class PixartBridge final : public Component {
                                   "'; expected slcan, socketcan or candump");
     }
     camera_names_ = settings_.camera_names;
-    raw_ = create_publisher<mocap_msgs::msg::PixartRawPointArray>(kRawTopic);
+    raw_ = create_publisher<mocap_msgs::msg::PixartRawPointArray>(topics::kPixartRaw);
     for (int camera = 0; camera < 4 * settings_.boxes; ++camera) {
       fiducials_.push_back(create_publisher<mocap_msgs::msg::FiducialArray>(
-          "/pixart/" + camera_name(camera) + "/fiducials"));
+          topics::member_of(topics::kPixartFiducials, camera_name(camera))));
     }
     // A log must exist now: a typo is an error at start, not a retry loop.
     if (source_kind_ == "candump") source_ = open();
-    // Reading starts with the graph (timers run once the host has started every component),
-    // so no frame is published before the subscribers exist.
-    create_timer(std::chrono::milliseconds(1), [this] {
-      if (!reader_.joinable()) reader_ = std::thread([this] { read_loop(); });
-    });
+    // Reading starts with the graph (once the host has started every component), so no frame
+    // is published before the subscribers exist.
+    create_worker("reader", [this](std::stop_token stop) { read_loop(stop); });
   }
 
   ~PixartBridge() override {
-    stop_ = true;
-    if (reader_.joinable()) reader_.join();
     const PixartDecodeStats& s = decoder_.stats();
     log().info(
         "{} frames, {} points; {} frames of the wrong length, {} of unknown IDs, {} invalid "
@@ -130,15 +123,15 @@ class PixartBridge final : public Component {
 
   // Reads until stopped; a device that fails is reopened with back-off (0.1 s doubling to
   // 2 s), so unplugging the adaptor costs the frames of the gap and nothing else.
-  void read_loop() {
+  void read_loop(const std::stop_token& stop) {
     // A log replayed as fast as possible would be over before subscribers in other processes
     // are discovered: it waits for one.
-    while (source_kind_ == "candump" && !stop_ && !subscribed()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    while (source_kind_ == "candump" && !subscribed()) {
+      if (!wait_for_stop(stop, std::chrono::milliseconds(10))) return;
     }
     std::chrono::milliseconds backoff(100);
     bool reported_end = false;
-    while (!stop_) {
+    while (!stop.stop_requested()) {
       try {
         if (!source_) {
           source_ = open();
@@ -155,10 +148,7 @@ class PixartBridge final : public Component {
         if (source_) read_errors_ += source_->read_errors();
         source_.reset();
         log().warn("{}; retrying in {} ms", e.what(), backoff.count());
-        for (auto waited = std::chrono::milliseconds(0); waited < backoff && !stop_;
-             waited += std::chrono::milliseconds(20)) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        }
+        wait_for_stop(stop, backoff);
         backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
       }
     }
@@ -214,8 +204,6 @@ class PixartBridge final : public Component {
   Publisher<mocap_msgs::msg::PixartRawPointArray> raw_;
   std::vector<Publisher<mocap_msgs::msg::FiducialArray>> fiducials_;
   uint64_t read_errors_ = 0;
-  std::atomic<bool> stop_{false};
-  std::thread reader_;
 };
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
+#include "graph_topics.hpp"
 #include "led_plane_points.hpp"
 #include "pixart_rig.hpp"
 #include "robot_localizer.hpp"
@@ -29,10 +30,6 @@ namespace {
 using mocap_msgs::msg::CameraFootprintArray;
 using mocap_msgs::msg::FiducialArray;
 using mocap_msgs::msg::RobotPoseArray;
-
-constexpr const char* kFiducialFamily = "/pixart/{camera}/fiducials";
-constexpr const char* kOutput = "/pixart/robots";
-constexpr const char* kFootprints = "/pixart/camera_footprints";
 
 double degrees(double radians) { return radians * 180.0 / M_PI; }
 
@@ -76,7 +73,7 @@ const ParameterList<Settings> kParameters =
 
 class PixartLocalizer final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -87,14 +84,14 @@ class PixartLocalizer final : public Component {
         "every tracked robot (also while it stands still).");
     kParameters.declare(spec);
     spec.subscribes<FiducialArray>(
-        kFiducialFamily, Qos::reliable(),
+        topics::kPixartFiducials, Qos::reliable(),
         "one topic per rig camera: its points in pixels, frame id = the camera's rig name");
     spec.publishes<RobotPoseArray>(
-        kOutput, Qos::reliable(),
+        topics::kPixartRobots, Qos::reliable(),
         "every tracked robot's x, y (m) and theta (rad) in frame 'world', stamped with the "
         "newest sample used");
     spec.publishes<CameraFootprintArray>(
-        kFootprints, Qos::latched(),
+        topics::kPixartFootprints, Qos::latched(),
         "once: what each rig camera sees of the LED plane (its image corners there), frame "
         "'world', for viewers");
   }
@@ -105,11 +102,11 @@ class PixartLocalizer final : public Component {
     for (const std::string& problem : localizer_.recognizer().unsupported()) {
       log().warn("{}: not localized", problem);
     }
-    publisher_ = create_publisher<RobotPoseArray>(kOutput);
+    publisher_ = create_publisher<RobotPoseArray>(topics::kPixartRobots);
     publish_footprints(rig);
     for (const RigCamera& camera : rig.cameras) {
       create_subscription<FiducialArray>(
-          "/pixart/" + camera.name + "/fiducials",
+          topics::member_of(topics::kPixartFiducials, camera.name),
           [this, name = camera.name](const FiducialArray& array) { on_sample(name, array); });
     }
     if (const double rate = settings_.publish_rate_hz; rate > 0) {
@@ -157,7 +154,7 @@ class PixartLocalizer final : public Component {
       }
       footprints->cameras().push_back(std::move(footprint));
     }
-    footprints_ = create_publisher<CameraFootprintArray>(kFootprints);
+    footprints_ = create_publisher<CameraFootprintArray>(topics::kPixartFootprints);
     footprints_.publish(std::move(footprints));
   }
 

@@ -11,7 +11,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -74,7 +73,7 @@ const ParameterList<Settings> kParameters =
 
 class Ax12Sim final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -116,12 +115,10 @@ class Ax12Sim final : public Component {
                link.empty() ? "" : " (link " + link + ")", fmt::join(ids, ", "), settings_.baud,
                faults);
     start_ = Steady::now();
-    worker_ = std::jthread([this](std::stop_token stop) { play(stop); });
+    create_worker("servo chain", [this](std::stop_token stop) { play(stop); });
   }
 
   ~Ax12Sim() override {
-    worker_.request_stop();
-    if (worker_.joinable()) worker_.join();
     device_link_.reset();
     pty_->close_master();
     const SimulatedAx12ChainStats& s = chain_.stats();
@@ -163,13 +160,13 @@ class Ax12Sim final : public Component {
     }
   }
 
-  // The chain and the counter belong to the worker thread until it ends.
+  // The chain and the counter belong to the worker until it ends (the host joins it before
+  // destroying the component).
   SimulatedAx12Chain chain_;
   uint64_t failed_writes_ = 0;
   std::optional<serial::PseudoTerminal> pty_;
   std::optional<serial::DeviceLink> device_link_;
   Steady::time_point start_;
-  std::jthread worker_;  // last: starts once everything it uses exists
 };
 
 }  // namespace

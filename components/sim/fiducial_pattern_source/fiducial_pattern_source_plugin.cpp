@@ -6,11 +6,10 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 #include "fiducial_pattern.hpp"
+#include "graph_topics.hpp"
 
 namespace mocap::demo {
 namespace {
-
-constexpr const char* kTopic = "/demo/fiducials";
 
 // The pattern's options with what only the plugin reads.
 struct Settings : PatternOptions {
@@ -32,19 +31,19 @@ const ParameterList<Settings> kParameters =
 
 class FiducialPatternSource final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Publishes fiducials on a turning circle, a stand-in for a tracked target.");
     kParameters.declare(spec);
-    spec.publishes<mocap_msgs::msg::FiducialArray>(kTopic, Qos::sensor_data(),
+    spec.publishes<mocap_msgs::msg::FiducialArray>(topics::kDemoFiducials, Qos::sensor_data(),
                                                    "one array per tick, stamped when made");
   }
 
   explicit FiducialPatternSource(Context& context) : Component(context) {
     frame_id_ = settings_.frame_id;
-    publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kTopic);
+    publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(topics::kDemoFiducials);
     auto period = std::chrono::duration<double>(1.0 / settings_.rate_hz);
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), [this] { tick(); });
     log().info("publishing {} fiducials at {} Hz on {}", settings_.count, settings_.rate_hz,

@@ -20,6 +20,7 @@
 #include <mocap/message_time.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
+#include "graph_topics.hpp"
 #include "pose_message.hpp"
 #include "turret_model.hpp"
 #include "unicycle_base.hpp"
@@ -32,10 +33,6 @@ using geometry_msgs::msg::Twist;
 using sensor_msgs::msg::JointState;
 using SteadyClock = std::chrono::steady_clock;
 
-constexpr const char* kCommand = "/cmd_vel";
-constexpr const char* kJointStates = "/turret/joint_states";
-constexpr const char* kBasePose = "/base/pose";
-constexpr const char* kCameraPose = "/sim/camera_pose";
 constexpr double kDegree = M_PI / 180;
 
 PoseStamped stamped_pose(const Eigen::Isometry3d& pose,
@@ -86,7 +83,7 @@ const ParameterList<Settings> kParameters =
 
 class MobileBaseSim final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -95,11 +92,12 @@ class MobileBaseSim final : public Component {
         "carrying the pan/tilt turret; publishes the base's pose and the turret camera's pose "
         "in the world.");
     kParameters.declare(spec);
-    spec.subscribes<Twist>(kCommand, Qos::reliable(), "linear.x (m/s) and angular.z (rad/s)");
-    spec.subscribes<JointState>(kJointStates, Qos::sensor_data(),
+    spec.subscribes<Twist>(topics::kCmdVel, Qos::reliable(),
+                           "linear.x (m/s) and angular.z (rad/s)");
+    spec.subscribes<JointState>(topics::kTurretJointStates, Qos::sensor_data(),
                                 "the turret's angles, radians (0, 0 until the first)");
-    spec.publishes<PoseStamped>(kBasePose, Qos::reliable(), "the base in frame 'world'");
-    spec.publishes<PoseStamped>(kCameraPose, Qos::reliable(),
+    spec.publishes<PoseStamped>(topics::kBasePose, Qos::reliable(), "the base in frame 'world'");
+    spec.publishes<PoseStamped>(topics::kSimCameraPose, Qos::reliable(),
                                 "the turret's camera (optical frame) in frame 'world'");
   }
 
@@ -112,10 +110,10 @@ class MobileBaseSim final : public Component {
             std::chrono::duration<double>(settings_.cmd_vel_timeout_s))),
         pan_joint_(settings_.pan_joint),
         tilt_joint_(settings_.tilt_joint) {
-    base_publisher_ = create_publisher<PoseStamped>(kBasePose);
-    camera_publisher_ = create_publisher<PoseStamped>(kCameraPose);
-    create_subscription<Twist>(kCommand, [this](const Twist& twist) { on_command(twist); });
-    create_subscription<JointState>(kJointStates,
+    base_publisher_ = create_publisher<PoseStamped>(topics::kBasePose);
+    camera_publisher_ = create_publisher<PoseStamped>(topics::kSimCameraPose);
+    create_subscription<Twist>(topics::kCmdVel, [this](const Twist& twist) { on_command(twist); });
+    create_subscription<JointState>(topics::kTurretJointStates,
                                     [this](const JointState& state) { on_joint_state(state); });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(1.0 / settings_.rate_hz)),
@@ -167,7 +165,7 @@ class MobileBaseSim final : public Component {
     const bool commanded = command_ && steady - command_at_ <= timeout_;
     if (!commanded && driving_) {
       ++timeouts_;
-      log().warn("no {} for {} s: stopped", kCommand, settings_.cmd_vel_timeout_s);
+      log().warn("no {} for {} s: stopped", topics::kCmdVel, settings_.cmd_vel_timeout_s);
     }
     driving_ = commanded;
     if (commanded) {

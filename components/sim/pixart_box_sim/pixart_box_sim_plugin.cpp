@@ -26,7 +26,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include <mocap/component.hpp>
 #include <mocap/config_files.hpp>
@@ -35,6 +34,7 @@
 
 #include "candump_recording.hpp"
 #include "device_link.hpp"
+#include "graph_topics.hpp"
 #include "pixart_box_simulator.hpp"
 #include "pixart_rig.hpp"
 #include "pixart_scene.hpp"
@@ -49,7 +49,6 @@ namespace {
 namespace fs = std::filesystem;
 using Steady = std::chrono::steady_clock;
 
-constexpr const char* kTruthTopic = "/pixart/ground_truth";
 constexpr const char* kTruthFrame = "world";
 // The adaptor thread checks for shutdown at least this often while nothing else wakes it.
 constexpr std::chrono::milliseconds kLongestWait{50};
@@ -129,7 +128,7 @@ const ParameterList<Settings> kParameters =
 
 class PixartBoxSim final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -140,7 +139,7 @@ class PixartBoxSim final : public Component {
         "candump -L log. Publishes the robots' true poses.");
     kParameters.declare(spec);
     spec.publishes<mocap_msgs::msg::RobotPoseArray>(
-        kTruthTopic, Qos::reliable(),
+        topics::kPixartGroundTruth, Qos::reliable(),
         "pty output: every robot's true floor pose (x, y, theta), frame id world, stamped with "
         "the wall-clock time it describes");
   }
@@ -165,7 +164,7 @@ class PixartBoxSim final : public Component {
     }
     bitrate_ = settings_.bitrate;
     can::slcan_open_commands(bitrate_);  // throws, naming the supported bitrates, for others
-    truths_ = create_publisher<mocap_msgs::msg::RobotPoseArray>(kTruthTopic);
+    truths_ = create_publisher<mocap_msgs::msg::RobotPoseArray>(topics::kPixartGroundTruth);
     pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
     const std::string link = settings_.device_link;
     if (!link.empty()) {
@@ -179,12 +178,10 @@ class PixartBoxSim final : public Component {
                        std::chrono::duration<double>(1 / truth_rate)),
                    [this] { publish_truth(); });
     }
-    worker_ = std::jthread([this](std::stop_token stop) { play_adaptor(stop); });
+    create_worker("adaptor", [this](std::stop_token stop) { play_adaptor(stop); });
   }
 
   ~PixartBoxSim() override {
-    worker_.request_stop();
-    if (worker_.joinable()) worker_.join();
     device_link_.reset();
     if (pty_) {
       pty_->close_master();
@@ -221,7 +218,7 @@ class PixartBoxSim final : public Component {
     log().info("writing {} s of {} cameras, {} objects at {} Hz to {}{}", options.duration_s,
                cameras, objects, rate_hz_, file,
                truth_file.empty() ? "" : ", ground truth to " + truth_file);
-    worker_ = std::jthread([this, options, file, partial, truth_file](std::stop_token stop) {
+    create_worker("candump log", [this, options, file, partial, truth_file](std::stop_token stop) {
       try {
         const uint64_t frames = write_candump_recording(*simulator_, log_stream_, options, stop);
         log_stream_.close();
@@ -369,7 +366,6 @@ class PixartBoxSim final : public Component {
   // candump output
   std::ofstream log_stream_;
   std::ofstream truth_stream_;
-  std::jthread worker_;  // last: starts once everything it uses exists
 };
 
 }  // namespace

@@ -29,6 +29,7 @@
 #include "camera_info_message.hpp"
 #include "constellation_database.hpp"
 #include "database_parameters.hpp"
+#include "graph_topics.hpp"
 #include "image_message.hpp"
 #include "ir_renderer.hpp"
 #include "pose_message.hpp"
@@ -37,10 +38,6 @@
 namespace mocap::synthetic {
 namespace {
 
-constexpr const char* kImageTopic = "/camera/ir/image_raw";
-constexpr const char* kCameraInfoTopic = "/camera/ir/camera_info";
-constexpr const char* kTruthTopic = "/camera/ir/ground_truth";
-constexpr const char* kCameraPoseTopic = "/sim/camera_pose";
 // With rate_hz 0 frames follow each other as fast as they render: the timer only has to fire
 // again before a frame is done, and a faster timer would only wake its thread for nothing.
 constexpr std::chrono::microseconds kBackToBackPeriod{200};
@@ -92,13 +89,13 @@ const ParameterList<Settings> kParameters =
         .add("moving_camera",
              "false: the camera stands still and the scene is in its frame; true: its pose "
              "in the world comes on " +
-                 std::string(kCameraPoseTopic) +
+                 std::string(topics::kSimCameraPose) +
                  " and the scene is as seen from the world's origin looking along x",
              &Settings::moving_camera);
 
 class SyntheticIrCamera final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -108,15 +105,15 @@ class SyntheticIrCamera final : public Component {
         "scene time k * time_step_s, whatever the wall clock does, so runs are reproducible.");
     kParameters.declare(spec);
     spec.subscribes<geometry_msgs::msg::PoseStamped>(
-        kCameraPoseTopic, Qos::reliable(),
+        topics::kSimCameraPose, Qos::reliable(),
         "moving_camera: the camera's optical frame in the world (e.g. from mobile_base_sim)");
-    spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
+    spec.publishes<sensor_msgs::msg::Image>(topics::kCameraImage, Qos::sensor_data(),
                                             "rendered frames, mono8");
     spec.publishes<sensor_msgs::msg::CameraInfo>(
-        kCameraInfoTopic, Qos::sensor_data(),
+        topics::kCameraInfo, Qos::sensor_data(),
         "the camera file's lens with each frame, same header (pinhole cameras only)");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
-        kTruthTopic, Qos::reliable(),
+        topics::kGroundTruth, Qos::reliable(),
         "per frame, the true pose and velocity of every constellation in front of the camera "
         "(camera frame, mid-exposure; the velocity of a fixed camera's view); points_used = its "
         "visible markers; same header as the image");
@@ -140,7 +137,7 @@ class SyntheticIrCamera final : public Component {
 
     if (settings_.moving_camera) {
       create_subscription<geometry_msgs::msg::PoseStamped>(
-          kCameraPoseTopic, [this](const geometry_msgs::msg::PoseStamped& pose) {
+          topics::kSimCameraPose, [this](const geometry_msgs::msg::PoseStamped& pose) {
             if (std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose())) {
               camera_from_world_ = world_from_camera->inverse() * world_from_scene();
             }
@@ -148,12 +145,12 @@ class SyntheticIrCamera final : public Component {
     } else {
       camera_from_world_ = Eigen::Isometry3d::Identity();
     }
-    images_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
+    images_ = create_publisher<sensor_msgs::msg::Image>(topics::kCameraImage);
     if (auto info = camera_info_message(*camera.model)) {
       camera_info_ = std::move(*info);
-      infos_ = create_publisher<sensor_msgs::msg::CameraInfo>(kCameraInfoTopic);
+      infos_ = create_publisher<sensor_msgs::msg::CameraInfo>(topics::kCameraInfo);
     }
-    truths_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kTruthTopic);
+    truths_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(topics::kGroundTruth);
     std::chrono::nanoseconds period = rate_hz > 0
                                           ? std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                 std::chrono::duration<double>(1 / rate_hz))
@@ -183,7 +180,8 @@ class SyntheticIrCamera final : public Component {
       return;
     }
     if (!camera_from_world_) {
-      if (!reported_no_pose_) log().info("waiting for the camera's pose on {}", kCameraPoseTopic);
+      if (!reported_no_pose_)
+        log().info("waiting for the camera's pose on {}", topics::kSimCameraPose);
       reported_no_pose_ = true;
       return;
     }

@@ -6,12 +6,9 @@
 // subscriber, so that a short recording is not played to nobody while the graph starts.
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <mocap/component.hpp>
@@ -19,12 +16,11 @@
 #include <sensor_msgs/msg/image.hpp>
 
 #include "frame_source.hpp"
+#include "graph_topics.hpp"
 #include "image_message.hpp"
 
 namespace mocap::capture {
 namespace {
-
-constexpr const char* kImageTopic = "/camera/ir/image_raw";
 
 struct Settings {
   std::string device;
@@ -65,7 +61,7 @@ const ParameterList<Settings> kParameters =
 
 class CameraSource final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -74,7 +70,7 @@ class CameraSource final : public Component {
         "(colour and 16-bit frames are converted). Set exactly one of device, file and "
         "directory.");
     kParameters.declare(spec);
-    spec.publishes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
+    spec.publishes<sensor_msgs::msg::Image>(topics::kCameraImage, Qos::sensor_data(),
                                             "mono8 images, stamped when captured");
   }
 
@@ -83,7 +79,7 @@ class CameraSource final : public Component {
     frame_id_ = settings_.frame_id;
     rate_hz_ = settings_.rate_hz;
     wait_for_subscriber_ = settings_.wait_for_subscriber && !source_->is_live();
-    publisher_ = create_publisher<sensor_msgs::msg::Image>(kImageTopic);
+    publisher_ = create_publisher<sensor_msgs::msg::Image>(topics::kCameraImage);
     if (source_->is_live()) {
       log().info("publishing {} on {} at the device's rate", source_->description(),
                  publisher_.topic());
@@ -94,19 +90,11 @@ class CameraSource final : public Component {
       log().info("publishing {} on {} as fast as possible", source_->description(),
                  publisher_.topic());
     }
-    capture_thread_ = std::thread([this] { capture(); });
+    // A device's grab returns within a frame period: the stop is seen that soon.
+    create_worker("capture", [this](std::stop_token stop) { capture(stop); });
   }
 
-  ~CameraSource() override {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    // A device's grab returns within a frame period.
-    capture_thread_.join();
-    log().info("published {} frames", published_.load());
-  }
+  ~CameraSource() override { log().info("published {} frames", published_.load()); }
 
  private:
   std::unique_ptr<FrameSource> open_source() {
@@ -132,28 +120,18 @@ class CameraSource final : public Component {
         directory, loop, [this](const std::string& warning) { log().warn("{}", warning); });
   }
 
-  // Waits until `deadline` or until the component stops; true when it stops.
-  bool wait_until(std::chrono::steady_clock::time_point deadline) {
-    std::unique_lock lock(mutex_);
-    return wake_.wait_until(lock, deadline, [this] { return stopping_; });
-  }
-  bool stopping() {
-    std::lock_guard lock(mutex_);
-    return stopping_;
-  }
-
-  void capture() {
+  void capture(const std::stop_token& stop) {
     using Steady = std::chrono::steady_clock;
     try {
       while (wait_for_subscriber_ && publisher_.matched_subscribers() == 0) {
-        if (wait_until(Steady::now() + std::chrono::milliseconds(10))) return;
+        if (!wait_for_stop(stop, std::chrono::milliseconds(10))) return;
       }
       const auto period = rate_hz_ > 0 ? std::chrono::duration_cast<Steady::duration>(
                                              std::chrono::duration<double>(1.0 / rate_hz_))
                                        : Steady::duration::zero();
       Steady::time_point next = Steady::now();
       cv::Mat frame;
-      while (!stopping()) {
+      while (!stop.stop_requested()) {
         if (!source_->read(frame)) {
           log().info("end of input after {} frames", source_->frames_read());
           return;
@@ -169,7 +147,7 @@ class CameraSource final : public Component {
         // a burst.
         next += period;
         if (next < Steady::now()) next = Steady::now();
-        if (wait_until(next)) return;
+        if (!wait_for_stop(stop, next - Steady::now())) return;
       }
     } catch (const std::exception& e) {
       log().error("{}: {}; no more frames", source_->description(), e.what());
@@ -182,10 +160,6 @@ class CameraSource final : public Component {
   bool wait_for_subscriber_ = true;
   Publisher<sensor_msgs::msg::Image> publisher_;
   std::atomic<uint64_t> published_{0};
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stopping_ = false;
-  std::thread capture_thread_;  // last: starts once everything it uses exists
 };
 
 }  // namespace

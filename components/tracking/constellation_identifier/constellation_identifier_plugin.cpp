@@ -13,12 +13,10 @@
 #include "constellation_identifier.hpp"
 #include "constellation_message.hpp"
 #include "database_parameters.hpp"
+#include "graph_topics.hpp"
 
 namespace mocap::constellations {
 namespace {
-
-constexpr const char* kInput = "/mocap/fiducials";
-constexpr const char* kOutput = "/mocap/constellations";
 
 // The identifier's options with the files only the plugin reads.
 struct Settings : IdentifierOptions {
@@ -53,7 +51,7 @@ const ParameterList<Settings> kParameters =
 
 class ConstellationIdentifierComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -61,10 +59,10 @@ class ConstellationIdentifierComponent final : public Component {
         "Finds collinear fiducials, names lines by their cross-ratio and constellations by "
         "their lines; publishes each constellation's image points in database order.");
     kParameters.declare(spec);
-    spec.subscribes<mocap_msgs::msg::FiducialArray>(kInput, Qos::reliable(),
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(topics::kFiducials, Qos::reliable(),
                                                     "fiducials of one image, pixels");
     spec.publishes<mocap_msgs::msg::ConstellationArray>(
-        kOutput, Qos::reliable(),
+        topics::kConstellations, Qos::reliable(),
         "constellations identified in each fiducial array: each line's fiducials in database "
         "order, NaN for a marker not seen");
   }
@@ -78,9 +76,10 @@ class ConstellationIdentifierComponent final : public Component {
     }
     log().info("{} constellations from {}", database_.constellations().size(),
                settings_.boards.database);
-    publisher_ = create_publisher<mocap_msgs::msg::ConstellationArray>(kOutput);
+    publisher_ = create_publisher<mocap_msgs::msg::ConstellationArray>(topics::kConstellations);
     create_subscription<mocap_msgs::msg::FiducialArray>(
-        kInput, [this](const mocap_msgs::msg::FiducialArray& array) { identify(array); });
+        topics::kFiducials,
+        [this](const mocap_msgs::msg::FiducialArray& array) { identify(array); });
   }
 
   ~ConstellationIdentifierComponent() override {

@@ -16,14 +16,11 @@
 #include "constellation_message.hpp"
 #include "constellation_tracker.hpp"
 #include "database_parameters.hpp"
+#include "graph_topics.hpp"
 #include "pose_message.hpp"
 
 namespace mocap::tracking {
 namespace {
-
-constexpr const char* kInput = "/mocap/fiducials";
-constexpr const char* kConstellations = "/mocap/constellations";
-constexpr const char* kPoses = "/mocap/poses";
 
 // The tracker's options with the files only the plugin reads.
 struct Settings : TrackerOptions {
@@ -70,7 +67,7 @@ const ParameterList<Settings> kParameters =
 
 class ConstellationTrackerComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -82,13 +79,13 @@ class ConstellationTrackerComponent final : public Component {
         "seed's constellations and each board's pose with its velocity.");
     kParameters.declare(spec);
     spec.subscribes<mocap_msgs::msg::FiducialArray>(
-        kInput, Qos::reliable(), "fiducials of one image, pixels, stamped at capture");
+        topics::kFiducials, Qos::reliable(), "fiducials of one image, pixels, stamped at capture");
     spec.publishes<mocap_msgs::msg::ConstellationArray>(
-        kConstellations, Qos::reliable(),
+        topics::kConstellations, Qos::reliable(),
         "the boards found in each fiducial array: each line's fiducials in database order, NaN "
         "for a marker not seen");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
-        kPoses, Qos::reliable(),
+        topics::kPoses, Qos::reliable(),
         "one pose per board found, in the camera's frame, with its velocity; stamped with the "
         "image's capture time");
   }
@@ -104,10 +101,11 @@ class ConstellationTrackerComponent final : public Component {
     tracker_.emplace(database_, camera_.model, settings_);
     log().info("{} constellations from {}", database_.constellations().size(),
                settings_.boards.database);
-    constellations_ = create_publisher<mocap_msgs::msg::ConstellationArray>(kConstellations);
-    poses_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kPoses);
+    constellations_ =
+        create_publisher<mocap_msgs::msg::ConstellationArray>(topics::kConstellations);
+    poses_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(topics::kPoses);
     create_subscription<mocap_msgs::msg::FiducialArray>(
-        kInput, [this](const mocap_msgs::msg::FiducialArray& array) { track(array); });
+        topics::kFiducials, [this](const mocap_msgs::msg::FiducialArray& array) { track(array); });
   }
 
   ~ConstellationTrackerComponent() override {

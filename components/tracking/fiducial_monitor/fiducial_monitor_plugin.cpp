@@ -5,12 +5,11 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
+#include "graph_topics.hpp"
 #include "stream_statistics.hpp"
 
 namespace mocap::demo {
 namespace {
-
-constexpr const char* kTopic = "/demo/fiducials";
 
 struct Settings {
   double report_period_s = 2;
@@ -23,20 +22,20 @@ const ParameterList<Settings> kParameters =
 
 class FiducialMonitor final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
     spec.description("Logs the rate, size and latency (stamp to arrival) of fiducial arrays.");
     kParameters.declare(spec);
-    spec.subscribes<mocap_msgs::msg::FiducialArray>(kTopic, Qos::sensor_data(),
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(topics::kDemoFiducials, Qos::sensor_data(),
                                                     "the stream to watch");
   }
 
   explicit FiducialMonitor(Context& context) : Component(context) {
     period_s_ = settings_.report_period_s;
     create_subscription<mocap_msgs::msg::FiducialArray>(
-        kTopic, [this](const mocap_msgs::msg::FiducialArray& array) {
+        topics::kDemoFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
           double latency =
               std::chrono::duration<double>(now() - from_time_msg(array.header().stamp())).count();
           statistics_.add(latency, array.fiducials().size());

@@ -11,13 +11,11 @@
 #include <sensor_msgs/msg/image.hpp>
 
 #include "fiducial_detector.hpp"
+#include "graph_topics.hpp"
 #include "image_message.hpp"
 
 namespace mocap::tracking {
 namespace {
-
-constexpr const char* kImageTopic = "/camera/ir/image_raw";
-constexpr const char* kFiducialTopic = "/mocap/fiducials";
 
 // The detector's options with what only the plugin reads.
 struct Settings : FiducialDetectorOptions {
@@ -86,7 +84,7 @@ FiducialDetectorOptions detector_options(Settings settings) {
 
 class FiducialTracker final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -95,10 +93,10 @@ class FiducialTracker final : public Component {
         "brightest pixel, connected regions filtered by area and circularity, "
         "background-subtracted intensity-weighted sub-pixel centroids.");
     kParameters.declare(spec);
-    spec.subscribes<sensor_msgs::msg::Image>(kImageTopic, Qos::sensor_data(),
+    spec.subscribes<sensor_msgs::msg::Image>(topics::kCameraImage, Qos::sensor_data(),
                                              "camera images, mono8");
     spec.publishes<mocap_msgs::msg::FiducialArray>(
-        kFiducialTopic, Qos::reliable(),
+        topics::kFiducials, Qos::reliable(),
         "one array per image, with the image's header; x, y = centroid (pixels, centre of "
         "the top-left pixel at 0, 0), z = 0 (unused for image points), size = area in pixels, "
         "uncertainty = 1-sigma position error in pixels");
@@ -106,9 +104,9 @@ class FiducialTracker final : public Component {
 
   explicit FiducialTracker(Context& context)
       : Component(context), detector_(detector_options(settings_)) {
-    publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(kFiducialTopic);
+    publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(topics::kFiducials);
     create_subscription<sensor_msgs::msg::Image>(
-        kImageTopic, [this](const sensor_msgs::msg::Image& image) { on_image(image); });
+        topics::kCameraImage, [this](const sensor_msgs::msg::Image& image) { on_image(image); });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                      std::chrono::duration<double>(settings_.report_period_s)),
                  [this] { report(); });
@@ -131,7 +129,7 @@ class FiducialTracker final : public Component {
       // The first drop at once, then at most one line per second with the count.
       if (drops_total_ == 1 || now - last_drop_log_ >= std::chrono::seconds(1)) {
         log().warn("dropped {} unreadable image(s) on {} ({} in all): {}", drops_unlogged_,
-                   kImageTopic, drops_total_, view.problem);
+                   topics::kCameraImage, drops_total_, view.problem);
         drops_unlogged_ = 0;
         last_drop_log_ = now;
       }
@@ -161,7 +159,8 @@ class FiducialTracker final : public Component {
     if (images_since_report_ == 0 && drops_since_report_ == 0) {
       // Said once, not every period, until images come again.
       if (!reported_silence_) {
-        log().info("no images on {} in the last {} s", kImageTopic, settings_.report_period_s);
+        log().info("no images on {} in the last {} s", topics::kCameraImage,
+                   settings_.report_period_s);
       }
       reported_silence_ = true;
       return;

@@ -13,6 +13,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
+#include "graph_topics.hpp"
 #include "image_message.hpp"
 #include "overlay_drawing.hpp"
 #include "png_file.hpp"
@@ -21,11 +22,6 @@
 namespace mocap::overlay {
 namespace {
 
-constexpr const char* kImage = "/camera/ir/image_raw";
-constexpr const char* kFiducials = "/mocap/fiducials";
-constexpr const char* kConstellations = "/mocap/constellations";
-constexpr const char* kPoses = "/mocap/poses";
-constexpr const char* kOverlay = "/mocap/overlay";
 // Frames waiting for their poses; older ones are dropped.
 constexpr size_t kPendingFrames = 30;
 
@@ -47,7 +43,7 @@ const ParameterList<Settings> kParameters =
 
 class OverlayComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -55,13 +51,16 @@ class OverlayComponent final : public Component {
         "Debug picture: fiducials, identified lines and names, pose axes drawn on the image; "
         "published as bgr8 and saved as PNG snapshots.");
     kParameters.declare(spec);
-    spec.subscribes<sensor_msgs::msg::Image>(kImage, Qos::sensor_data(), "camera images, mono8");
-    spec.subscribes<mocap_msgs::msg::FiducialArray>(kFiducials, Qos::reliable(), "fiducials");
-    spec.subscribes<mocap_msgs::msg::ConstellationArray>(kConstellations, Qos::reliable(),
+    spec.subscribes<sensor_msgs::msg::Image>(topics::kCameraImage, Qos::sensor_data(),
+                                             "camera images, mono8");
+    spec.subscribes<mocap_msgs::msg::FiducialArray>(topics::kFiducials, Qos::reliable(),
+                                                    "fiducials");
+    spec.subscribes<mocap_msgs::msg::ConstellationArray>(topics::kConstellations, Qos::reliable(),
                                                          "identified constellations");
-    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoses, Qos::reliable(),
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                                              "estimated poses; draws the frame");
-    spec.publishes<sensor_msgs::msg::Image>(kOverlay, Qos::sensor_data(), "the picture, bgr8");
+    spec.publishes<sensor_msgs::msg::Image>(topics::kOverlay, Qos::sensor_data(),
+                                            "the picture, bgr8");
   }
 
   explicit OverlayComponent(Context& context) : Component(context) {
@@ -70,15 +69,15 @@ class OverlayComponent final : public Component {
     snapshot_period_ = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(settings_.snapshot_period_s));
     if (!snapshot_directory_.empty()) std::filesystem::create_directories(snapshot_directory_);
-    publisher_ = create_publisher<sensor_msgs::msg::Image>(kOverlay);
+    publisher_ = create_publisher<sensor_msgs::msg::Image>(topics::kOverlay);
     create_subscription<sensor_msgs::msg::Image>(
-        kImage, [this](const std::shared_ptr<const sensor_msgs::msg::Image>& image) {
+        topics::kCameraImage, [this](const std::shared_ptr<const sensor_msgs::msg::Image>& image) {
           if (Pending* pending = frame(to_nanoseconds(image->header().stamp()))) {
             pending->image = image;
           }
         });
     create_subscription<mocap_msgs::msg::FiducialArray>(
-        kFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
+        topics::kFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
           Pending* pending = frame(to_nanoseconds(array.header().stamp()));
           if (pending == nullptr) return;
           for (const auto& f : array.fiducials()) {
@@ -86,7 +85,7 @@ class OverlayComponent final : public Component {
           }
         });
     create_subscription<mocap_msgs::msg::ConstellationArray>(
-        kConstellations, [this](const mocap_msgs::msg::ConstellationArray& array) {
+        topics::kConstellations, [this](const mocap_msgs::msg::ConstellationArray& array) {
           Pending* pending = frame(to_nanoseconds(array.header().stamp()));
           if (pending == nullptr) return;
           for (const auto& c : array.constellations()) {
@@ -102,7 +101,8 @@ class OverlayComponent final : public Component {
           }
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
-        kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { draw(poses); });
+        topics::kPoses,
+        [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { draw(poses); });
   }
 
  private:

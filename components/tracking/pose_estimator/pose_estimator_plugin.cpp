@@ -11,14 +11,12 @@
 
 #include "constellation_pose.hpp"
 #include "database_parameters.hpp"
+#include "graph_topics.hpp"
 #include "planar_pose.hpp"
 #include "pose_message.hpp"
 
 namespace mocap::pose {
 namespace {
-
-constexpr const char* kInput = "/mocap/constellations";
-constexpr const char* kOutput = "/mocap/poses";
 
 // The estimator's options with the files only the plugin reads. min_points is 6 here: the
 // identifier's lines come whole, four collinear points each, and one line alone leaves the
@@ -43,7 +41,7 @@ const ParameterList<Settings> kParameters =
 
 class PoseEstimatorComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -51,10 +49,10 @@ class PoseEstimatorComponent final : public Component {
         "Estimates each identified constellation's 6-DoF pose in the camera frame (planar PnP "
         "and refinement) and rejects false identifications by their reprojection error.");
     kParameters.declare(spec);
-    spec.subscribes<mocap_msgs::msg::ConstellationArray>(kInput, Qos::reliable(),
+    spec.subscribes<mocap_msgs::msg::ConstellationArray>(topics::kConstellations, Qos::reliable(),
                                                          "identified constellations");
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
-        kOutput, Qos::reliable(),
+        topics::kPoses, Qos::reliable(),
         "one stamped pose per accepted constellation, in the camera's frame");
   }
 
@@ -63,9 +61,10 @@ class PoseEstimatorComponent final : public Component {
         database_(settings_.boards.load()),
         camera_(calibration::load_camera_file(settings_.camera)),
         options_(settings_) {
-    publisher_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(kOutput);
+    publisher_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(topics::kPoses);
     create_subscription<mocap_msgs::msg::ConstellationArray>(
-        kInput, [this](const mocap_msgs::msg::ConstellationArray& array) { estimate(array); });
+        topics::kConstellations,
+        [this](const mocap_msgs::msg::ConstellationArray& array) { estimate(array); });
   }
 
   ~PoseEstimatorComponent() override {

@@ -7,14 +7,12 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
+#include "graph_topics.hpp"
 #include "pose_evaluation.hpp"
 #include "pose_message.hpp"
 
 namespace mocap::evaluation {
 namespace {
-
-constexpr const char* kTruth = "/camera/ir/ground_truth";
-constexpr const char* kPoses = "/mocap/poses";
 
 // `truth`: the synthetic camera's, whose velocities are exact (and have no covariance).
 std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array, bool truth) {
@@ -70,7 +68,7 @@ const ParameterList<Settings> kParameters =
 
 class PoseEvaluatorComponent final : public Component {
   // Before the other members, which may start from it.
-  const Settings settings_ = read(kParameters);
+  const Settings settings_ = read_settings(kParameters);
 
  public:
   static void declare(ComponentSpec& spec) {
@@ -78,9 +76,9 @@ class PoseEvaluatorComponent final : public Component {
         "Compares estimated poses with the synthetic ground truth: a live summary line (input "
         "rate, latency, tracked %, errors) and a final table.");
     kParameters.declare(spec);
-    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kTruth, Qos::reliable(),
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(topics::kGroundTruth, Qos::reliable(),
                                                              "ground truth, one array per image");
-    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(kPoses, Qos::reliable(),
+    spec.subscribes<mocap_msgs::msg::ConstellationPoseArray>(topics::kPoses, Qos::reliable(),
                                                              "estimated poses");
   }
 
@@ -90,7 +88,7 @@ class PoseEvaluatorComponent final : public Component {
     summary_file_ = settings_.summary_file;
     period_s_ = settings_.report_period_s;
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
-        kTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
+        topics::kGroundTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
           // Once stopping, frames still in flight are not counted: the summary covers
           // stop_after_frames frames however long the stop takes.
           if (stopping_) return;
@@ -99,7 +97,7 @@ class PoseEvaluatorComponent final : public Component {
           check_done();
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
-        kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
+        topics::kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
           if (stopping_) return;
           latencies_s_.push_back(
               std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());

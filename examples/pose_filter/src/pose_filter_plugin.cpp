@@ -65,7 +65,7 @@ class PoseFilterComponent final : public mocap::Component {
   }
 
   explicit PoseFilterComponent(mocap::Context& context) : Component(context) {
-    smoother_ = PoseSmoother(read(kParameters));
+    smoother_ = PoseSmoother(read_settings(kParameters));
     publisher_ = create_publisher<pose_filter_msgs::msg::FilteredPoseArray>(kOutput);
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         kInput, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) { filter(poses); });

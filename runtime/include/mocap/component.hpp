@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stop_token>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -123,6 +124,9 @@ class Context {
   // processes' topics disappear once their publishers leave. Empty without DDS.
   virtual std::vector<KnownTopic> discovered_topics() const = 0;
   virtual void add_timer(std::chrono::nanoseconds period, std::function<void()> callback) = 0;
+  virtual void add_one_shot_timer(std::chrono::nanoseconds delay,
+                                  std::function<void()> callback) = 0;
+  virtual void add_worker(std::string name, std::function<void(std::stop_token)> body) = 0;
   // Ends the process's run once the current callbacks return; the process exits with
   // `exit_code` (the largest requested, if several components ask).
   virtual void request_shutdown(int exit_code) = 0;
@@ -165,11 +169,28 @@ class Component {
   void create_timer(std::chrono::nanoseconds period, Callback&& callback) {
     context_.add_timer(period, std::forward<Callback>(callback));
   }
+  // Runs `callback` once, `delay` after the process starts (after this call, if it runs).
+  template <class Callback>
+  void create_one_shot_timer(std::chrono::nanoseconds delay, Callback&& callback) {
+    context_.add_one_shot_timer(delay, std::forward<Callback>(callback));
+  }
+
+  // Runs `body` on a thread of its own, for work that blocks (a serial port, a capture device,
+  // a file played at its pace). The host starts it with the timers, once every component of
+  // the process exists, and when the process stops it requests the stop (`body`'s token) and
+  // joins the thread before any component is destroyed: a body checks the token at least as
+  // often as the host should wait for it (a read with a timeout; wait_for_stop to sleep). An
+  // exception ends the worker; it is logged with the component's name and counted as a
+  // callback error. Unlike callbacks, a worker runs beside the component's callbacks: what
+  // both touch needs a lock.
+  void create_worker(std::string name, std::function<void(std::stop_token)> body) {
+    context_.add_worker(std::move(name), std::move(body));
+  }
 
   // The settings `parameters` bind, from this instance's values (the launch file's, or the
   // defaults): what the component's declare() gave ParameterList::declare.
   template <class Settings>
-  Settings read(const ParameterList<Settings>& parameters) const {
+  Settings read_settings(const ParameterList<Settings>& parameters) const {
     return parameters.read(context_.parameters());
   }
   const Logger& log() const { return context_.logger(); }
@@ -181,10 +202,13 @@ class Component {
   Context& context_;
 };
 
+// Sleeps for `duration` or until `stop` is requested; false if it was (a worker's pause).
+bool wait_for_stop(const std::stop_token& stop, std::chrono::nanoseconds duration);
+
 // What a plugin library exports, through MOCAP_REGISTER_COMPONENT.
 struct ComponentFactory {
   // Raised whenever Component, Context or this struct change layout.
-  static constexpr uint32_t kAbiVersion = 4;
+  static constexpr uint32_t kAbiVersion = 5;
   static constexpr const char* kSymbol = "mocap_component_factory";
 
   uint32_t abi_version;

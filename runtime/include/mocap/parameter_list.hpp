@@ -11,9 +11,11 @@
 //       .add("report_period_s", "seconds between summary lines", &Settings::report_period_s)
 //           .range(0.1, 86400);
 //
-//   static void declare(ComponentSpec& spec) { kParameters.declare(spec); ... }
-//   explicit FiducialTracker(Context& context)
-//       : Component(context), settings_(kParameters.read(context.parameters())) {}
+//   class FiducialTracker final : public Component {
+//     const Settings settings_ = read_settings(kParameters);  // before the members using it
+//    public:
+//     static void declare(ComponentSpec& spec) { kParameters.declare(spec); ... }
+//     ...
 //
 // The launcher validates a launch file's values against the declaration and `mocap_launch
 // --describe` prints it, so the default a user reads is the one the code starts from.
