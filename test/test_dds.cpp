@@ -222,7 +222,13 @@ TEST_P(ReliableUnderLoad, ARestartedSubscriberProcessReceivesAgain) {
   EXPECT_EQ(summary.at("corrupt"), 0);
   source.signal(SIGTERM);
   EXPECT_EQ(source.wait(std::chrono::seconds(30)), 0) << source.output();
-  EXPECT_EQ(source.output().find("dropped"), std::string::npos) << source.output();
+  // Nothing dropped while it ran. Stopping, it may drop the sample it was writing for a
+  // subscriber that has left but not yet been seen to leave (its DDS goodbye still on the way):
+  // no process could have received that one.
+  const std::string output = source.output();
+  EXPECT_EQ(output.substr(0, output.find("shutting down on signal")).find("dropped"),
+            std::string::npos)
+      << output;
 }
 
 TEST_P(ReliableUnderLoad, ALatchedSampleReachesAProcessStartedLater) {
