@@ -33,9 +33,9 @@
 #include <mocap/component_host.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "fastdds_qos.hpp"
-#include "fastdds_transport.hpp"
-#include "names.hpp"
+#include "core/names.hpp"
+#include "dds/fastdds/fastdds_qos.hpp"
+#include "dds/fastdds/fastdds_transport.hpp"
 
 namespace {
 

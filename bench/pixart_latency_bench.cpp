@@ -26,11 +26,11 @@
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
 #include "camera_samples.hpp"
+#include "core/plugin_loader.hpp"
 #include "pixart_box_simulator.hpp"
 #include "pixart_decoder.hpp"
 #include "pixart_rig.hpp"
 #include "pixart_scene.hpp"
-#include "plugin_loader.hpp"
 #include "robot_localizer.hpp"
 #include "serial_port.hpp"
 #include "simulated_slcan_adaptor.hpp"

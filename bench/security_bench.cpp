@@ -38,7 +38,7 @@ using namespace mocap::one_hop;
 mocap::DdsOptions dds_options(const std::string& security, bool shared_memory,
                               const std::string& identity) {
   mocap::DdsOptions options;
-  options.shared_memory = shared_memory;
+  options.fastdds.shared_memory = shared_memory;
   if (!security.empty()) {
     options.security_directory = security;
     options.security_identity = identity;

@@ -45,10 +45,10 @@
 
 #include "one_hop.hpp"
 
-#include "cyclonedds_transport.hpp"
-#include "cyclonedds_type_support.hpp"
-#include "dds_transport.hpp"
-#include "fastdds_qos.hpp"
+#include "dds/cyclonedds/cyclonedds_transport.hpp"
+#include "dds/cyclonedds/cyclonedds_type_support.hpp"
+#include "dds/dds_transport.hpp"
+#include "dds/fastdds/fastdds_qos.hpp"
 
 namespace {
 

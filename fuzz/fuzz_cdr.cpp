@@ -11,8 +11,8 @@
 
 #include <mocap/generated_message_types.hpp>
 #include <mocap/message_type.hpp>
-#include "cdr_format.hpp"
-#include "idl_schema.hpp"
+#include "messages/cdr_format.hpp"
+#include "messages/idl_schema.hpp"
 
 namespace {
 

@@ -5,8 +5,8 @@
 #include <string_view>
 
 #include <mocap/message_type.hpp>
-#include "cdr_format.hpp"
-#include "idl_schema.hpp"
+#include "messages/cdr_format.hpp"
+#include "messages/idl_schema.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Text up to the first NUL is IDL; what follows is CDR to format with the last struct.

@@ -8,8 +8,8 @@
 #include <string>
 #include <string_view>
 
-#include "launch_file.hpp"
-#include "plugin_loader.hpp"
+#include "core/plugin_loader.hpp"
+#include "launch/launch_file.hpp"
 #include "scratch_files.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "idl_schema.hpp"
+#include "messages/idl_schema.hpp"
 
 namespace mocap::test {
 

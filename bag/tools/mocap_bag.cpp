@@ -17,9 +17,9 @@
 #include <mocap/generated_message_types.hpp>
 #include <mocap/raw_message_type.hpp>
 
-#include "dds_transport.hpp"
-#include "plugin_loader.hpp"
-#include "shutdown_signal.hpp"
+#include "core/plugin_loader.hpp"
+#include "core/shutdown_signal.hpp"
+#include "dds/dds_transport.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <mocap/bag/recorder.hpp>
 #include <mocap/generated_message_types.hpp>
 
-#include "idl_schema.hpp"
+#include "messages/idl_schema.hpp"
 #include "random_cdr.hpp"
 #include "test_support.hpp"
 

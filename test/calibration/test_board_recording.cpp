@@ -24,10 +24,10 @@
 #include <mocap/component_host.hpp>
 
 #include "candump_recording.hpp"
+#include "core/plugin_loader.hpp"
 #include "pixart_box_simulator.hpp"
 #include "pixart_rig.hpp"
 #include "pixart_scene.hpp"
-#include "plugin_loader.hpp"
 #include "test_support.hpp"
 
 namespace mocap::calibration {

@@ -22,7 +22,7 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "plugin_loader.hpp"
+#include "core/plugin_loader.hpp"
 #include "test_support.hpp"
 #include "turret_model.hpp"
 

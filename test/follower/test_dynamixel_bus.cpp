@@ -16,8 +16,8 @@
 #include <mocap/component_host.hpp>
 
 #include "ax12_control_table.hpp"
+#include "core/plugin_loader.hpp"
 #include "dynamixel_bus.hpp"
-#include "plugin_loader.hpp"
 #include "protocol.hpp"
 #include "test_support.hpp"
 

@@ -19,8 +19,8 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
+#include "core/plugin_loader.hpp"
 #include "joint_history.hpp"
-#include "plugin_loader.hpp"
 #include "servo_mapping.hpp"
 #include "test_support.hpp"
 #include "turret_follower.hpp"

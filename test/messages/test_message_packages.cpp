@@ -9,10 +9,10 @@
 #include <mocap_test_msgs/msg/empty.hpp>
 #include <mocap_test_msgs/msg/thing.hpp>
 
-#include "cdr_format.hpp"
-#include "idl_schema.hpp"
-#include "msg_to_idl.hpp"
+#include "messages/cdr_format.hpp"
+#include "messages/idl_schema.hpp"
 #include "test_support.hpp"
+#include "tools/msg_to_idl.hpp"
 
 namespace mocap {
 namespace {

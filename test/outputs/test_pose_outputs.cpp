@@ -19,8 +19,8 @@
 #include <tf2_msgs/msg/tf_message.hpp>
 
 #include "body_frames.hpp"
+#include "core/plugin_loader.hpp"
 #include "outputs/pose_feeder.hpp"
-#include "plugin_loader.hpp"
 #include "pose_message.hpp"
 #include "test_support.hpp"
 

@@ -18,8 +18,8 @@
 #include <px4_msgs/msg/vehicle_odometry.hpp>
 
 #include "body_frames.hpp"
+#include "core/plugin_loader.hpp"
 #include "outputs/pose_feeder.hpp"
-#include "plugin_loader.hpp"
 #include "pose_message.hpp"
 #include "px4_frames.hpp"
 #include "test_support.hpp"

@@ -12,8 +12,8 @@
 #include <mocap_msgs/msg/pixart_raw_point_array.hpp>
 
 #include "candump_log.hpp"
+#include "core/plugin_loader.hpp"
 #include "pixart_decoder.hpp"
-#include "plugin_loader.hpp"
 #include "serial_port.hpp"
 #include "slcan.hpp"
 #include "test_support.hpp"

@@ -22,10 +22,10 @@
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
 #include "camera_views.hpp"
+#include "core/plugin_loader.hpp"
 #include "led_plane_points.hpp"
 #include "pixart_rig.hpp"
 #include "planar_fit.hpp"
-#include "plugin_loader.hpp"
 #include "point_merging.hpp"
 #include "robot_localizer.hpp"
 #include "test_support.hpp"

@@ -21,9 +21,9 @@
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
 #include "candump_recording.hpp"
+#include "core/plugin_loader.hpp"
 #include "pixart_box_simulator.hpp"
 #include "pixart_scene.hpp"
-#include "plugin_loader.hpp"
 #include "test_support.hpp"
 
 namespace mocap::pixart {

@@ -1,6 +1,7 @@
 // dynamixel_follower: the pan/tilt turret of seed 000 §5.11 on two AX-12A servos. It keeps the
 // tracked constellation on the camera's optical axis (turret_follower.hpp) and drives the
-// servos over a Dynamixel Protocol 1.0 bus (dynamixel_bus.hpp) on its own thread, each cycle:
+// servos over a Dynamixel Protocol 1.0 bus (dynamixel_bus.hpp) on a worker the host runs, each
+// cycle:
 //
 //   1. READ present position, speed and load of both servos -> /turret/joint_states;
 //   2. the command for now -> one SYNC_WRITE of goal position and moving speed to both

@@ -22,6 +22,19 @@
 
 namespace mocap {
 
+// What only Fast DDS does; other implementations talk UDP and discover by multicast.
+struct FastDdsOptions {
+  // Off: UDP only. Needed between containers that do not share /dev/shm, and to force the
+  // network path between network namespaces.
+  bool shared_memory = true;
+  // Discovery through Fast DDS Discovery Servers instead of multicast: "host:port" each (host
+  // an IPv4 address or a name), the i-th being the server started with id i
+  // (`fast-discovery-server -i i -l host -p port`, as ROS_DISCOVERY_SERVER). Empty: multicast
+  // (SIMPLE) discovery. The MOCAP_DISCOVERY_SERVER environment variable ("host:port;..")
+  // overrides it.
+  std::vector<std::string> discovery_servers = {};
+};
+
 struct DdsOptions {
   // Off: the process talks to nobody outside itself (no participant is created).
   bool enabled = true;
@@ -31,21 +44,13 @@ struct DdsOptions {
   std::string implementation = {};
   // 0..232; the MOCAP_DOMAIN_ID environment variable overrides it.
   int domain_id = 0;
-  // Off: UDP only (Cyclone DDS always is). Needed between containers that do not share /dev/shm,
-  // and to force the network path between network namespaces.
-  bool shared_memory = true;
-  // Discovery through Fast DDS Discovery Servers (Fast DDS only) instead of multicast: "host:port"
-  // each (host an IPv4 address or a name), the i-th being the server started with id i
-  // (`fast-discovery-server -i i -l host -p port`, as ROS_DISCOVERY_SERVER). Empty: multicast
-  // (SIMPLE) discovery. The MOCAP_DISCOVERY_SERVER environment variable ("host:port;..")
-  // overrides it.
-  std::vector<std::string> discovery_servers = {};
   // DDS Security (authentication, access control, encryption): a folder made by
   // scripts/make_security.sh and the identity to take from it (NAME.cert.pem and the like).
   // Empty: no security. The MOCAP_SECURITY_DIRECTORY and MOCAP_SECURITY_IDENTITY environment
   // variables override them.
   std::string security_directory = {};
   std::string security_identity = {};
+  FastDdsOptions fastdds = {};
 };
 
 struct HostOptions {

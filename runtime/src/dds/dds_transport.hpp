@@ -1,0 +1,69 @@
+// Delivery between processes and hosts over DDS, whichever implementation carries it: the
+// interface the host, tools and benchmarks use, and the choice of implementation.
+//
+// Every implementation puts the same wire on the network: topics "rt/a/b", types
+// "pkg::msg::dds_::Type_", XCDR1 data, the runtime's QoS. So processes on different
+// implementations in one graph exchange every message both ways.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <mocap/component_host.hpp>
+
+#include "transport/transport.hpp"
+
+namespace mocap {
+
+// A reader or writer of another participant, as discovery reports it.
+struct DiscoveredEndpoint {
+  std::string topic;  // ROS name when the DDS name is a ROS one ("rt/a" -> "/a")
+  std::string type;   // DDS type name
+  bool is_publisher = false;
+  Qos qos;  // reliability and durability as announced; history is not announced
+  std::string participant;
+};
+
+class DdsTransport : public Transport {
+ public:
+  // "fastdds" or "cyclonedds".
+  virtual std::string_view implementation() const = 0;
+  virtual int domain_id() const = 0;
+  // Endpoints of other participants seen so far (alive ones only).
+  virtual std::vector<DiscoveredEndpoint> discovered_endpoints() const = 0;
+};
+
+// A DDS implementation this runtime carries, and what it can do. Adding one: a folder under
+// dds/ with its DdsTransport, and its line in the table of dds_transport.cpp (runtime/README.md).
+struct DdsImplementation {
+  std::string_view name;  // as DdsOptions::implementation and MOCAP_DDS_IMPLEMENTATION say it
+  // Whether it takes DdsOptions::fastdds (shared memory, Discovery Servers); otherwise it
+  // talks UDP only and discovers by multicast.
+  bool takes_fastdds_options;
+  // Why it cannot take the signed governance document `governance`, or nullopt.
+  std::optional<std::string> (*governance_problem)(const std::filesystem::path& governance);
+  std::unique_ptr<DdsTransport> (*make)(const DdsOptions& options,
+                                        const std::string& participant_name);
+};
+
+// The names DdsOptions::implementation takes, for messages: "fastdds, cyclonedds".
+std::string dds_implementation_names();
+
+// `configured` when set, else MOCAP_DDS_IMPLEMENTATION when set, else the first of the table
+// (Fast DDS). Throws std::runtime_error naming the source of an unknown name and listing the
+// known ones.
+const DdsImplementation& resolve_dds_implementation(std::string_view configured);
+
+// MOCAP_DOMAIN_ID if set (validated), otherwise `configured`.
+int resolve_domain_id(int configured);
+
+// A participant named `participant_name` on the implementation `options` (and the environment)
+// choose. Throws std::runtime_error when it cannot be created.
+std::unique_ptr<DdsTransport> make_dds_transport(const DdsOptions& options,
+                                                 const std::string& participant_name);
+
+}  // namespace mocap

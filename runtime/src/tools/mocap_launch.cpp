@@ -1,0 +1,221 @@
+// mocap_launch: validates and runs launch files; documents plugins.
+#include <unistd.h>
+
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include <mocap/component_host.hpp>
+
+#include "core/plugin_loader.hpp"
+#include "launch/group_supervisor.hpp"
+#include "launch/launch_file.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage:
+  mocap_launch FILE [--group NAME] [--set COMPONENT.PARAM=VALUE]... [--duration SECONDS]
+               [--health-file PATH] [--check]
+  mocap_launch --describe PLUGIN
+  mocap_launch --plugins
+
+Runs the components of a launch file (launch_yaml/README.md describes the format).
+  FILE             every group runs as its own child process, output prefixed with [group];
+                   a single-group file runs in this process
+  --group NAME     run only this group, in this process (one host's share of a deployment)
+  --set C.P=V      set parameter P of component C to V (YAML: 3, 0.5, true, [1, 2], text)
+  --duration S     stop after S seconds (default, or 0: run until Ctrl-C)
+  --health-file P  rewrite P every second while callbacks run (several groups: P.GROUP each);
+                   a container's HEALTHCHECK reads its age (default: $MOCAP_HEALTH_FILE)
+  --check          validate the file and exit: 0 when valid
+  --describe NAME  print a plugin's description, parameters and topics
+  --plugins        list the plugins on the search path (MOCAP_PLUGIN_PATH, then
+                   lib/mocap_graph/plugins beside bin/)
+Environment: MOCAP_DOMAIN_ID overrides the DDS domain, MOCAP_LOG_LEVEL=debug|info|warn|error.
+)";
+
+[[noreturn]] void usage_error(std::string_view message) {
+  fmt::print(stderr, "mocap_launch: {}\n\n{}", message, kUsage);
+  std::exit(2);
+}
+
+std::string describe(const mocap::LoadedPlugin& plugin) {
+  const mocap::ComponentSpec& spec = plugin.spec;
+  std::string out =
+      fmt::format("{}: {}\nlibrary: {}\n", plugin.name,
+                  spec.description().empty() ? "(no description)" : spec.description(),
+                  plugin.library.string());
+  out += "\nparameters:\n";
+  if (spec.parameters().empty()) out += "  (none)\n";
+  for (const mocap::ParameterSpec& p : spec.parameters()) {
+    out += fmt::format("  {}: {} = {}\n      {}\n", p.name, p.type_description(),
+                       mocap::to_string(p.default_value), p.description);
+  }
+  out += "\ntopics:\n";
+  if (spec.topics().empty()) out += "  (none)\n";
+  for (const mocap::TopicSpec& t : spec.topics()) {
+    out += fmt::format("  {} {} [{}] {}\n      {}\n",
+                       t.direction == mocap::TopicDirection::Publish ? "publishes " : "subscribes",
+                       t.topic, t.type ? t.type->name() : "any type",
+                       t.type ? t.qos.to_string() : "QoS chosen at run time", t.description);
+  }
+  return out;
+}
+
+int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
+              std::optional<double> duration, const std::string& health_file) {
+  try {
+    mocap::ComponentHost host(
+        {group.name, group.threads, file.dds_of(group), mocap::known_topics(file), health_file});
+    for (const mocap::LaunchComponent& component : group.components) {
+      try {
+        host.add(*component.plugin->factory, component.config);
+      } catch (const mocap::ComponentError& e) {
+        fmt::print(stderr, "{}:{}: {}\n", file.path, component.line, e.what());
+        return 1;
+      }
+    }
+    std::optional<std::chrono::duration<double>> run_for;
+    if (duration) run_for = std::chrono::duration<double>(*duration);
+    return host.run(run_for);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "{}: group '{}': {}\n", file.path, group.name, e.what());
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::optional<std::string> file, group, describe_plugin;
+  std::vector<std::string> set_texts;
+  std::optional<double> duration;
+  const char* health_file_variable = std::getenv("MOCAP_HEALTH_FILE");
+  std::string health_file = health_file_variable ? health_file_variable : "";
+  bool check = false, list_plugins = false;
+
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&](std::string_view option) -> const std::string& {
+      if (i + 1 >= args.size()) usage_error(fmt::format("{} needs a value", option));
+      return args[++i];
+    };
+    if (arg == "--help" || arg == "-h") {
+      fmt::print("{}", kUsage);
+      return 0;
+    } else if (arg == "--group") {
+      group = value(arg);
+    } else if (arg == "--set") {
+      set_texts.push_back(value(arg));
+    } else if (arg == "--duration") {
+      const std::string& text = value(arg);
+      double seconds = 0;
+      auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), seconds);
+      if (error != std::errc() || end != text.data() + text.size() || !(seconds >= 0)) {
+        usage_error(fmt::format("--duration {}: expected a number of seconds >= 0", text));
+      }
+      // The last one given counts, so a wrapper's default can be overridden; 0 means none.
+      duration = seconds > 0 ? std::optional<double>(seconds) : std::nullopt;
+    } else if (arg == "--health-file") {
+      health_file = value(arg);
+    } else if (arg == "--check") {
+      check = true;
+    } else if (arg == "--describe") {
+      describe_plugin = value(arg);
+    } else if (arg == "--plugins") {
+      list_plugins = true;
+    } else if (arg.starts_with("-")) {
+      usage_error(fmt::format("unknown option {}", arg));
+    } else if (file) {
+      usage_error(fmt::format("one launch file at a time ({} and {})", *file, arg));
+    } else {
+      file = arg;
+    }
+  }
+
+  mocap::PluginLoader plugins;
+  if (list_plugins) {
+    for (const std::string& name : plugins.available()) {
+      try {
+        const mocap::LoadedPlugin& plugin = plugins.load(name);
+        fmt::print("{:28} {}\n", name, plugin.spec.description());
+      } catch (const mocap::PluginError& e) {
+        fmt::print("{:28} (cannot load: {})\n", name, e.what());
+      }
+    }
+    return 0;
+  }
+  if (describe_plugin) {
+    try {
+      fmt::print("{}", describe(plugins.load(*describe_plugin)));
+      return 0;
+    } catch (const mocap::PluginError& e) {
+      fmt::print(stderr, "mocap_launch: {}\n", e.what());
+      return 1;
+    }
+  }
+  if (!file) usage_error("no launch file given");
+
+  mocap::LaunchFile launch;
+  try {
+    std::vector<mocap::ParameterOverride> overrides;
+    for (const std::string& text : set_texts) {
+      overrides.push_back(mocap::parse_parameter_override(text));
+    }
+    launch = mocap::load_launch_file(*file, plugins, overrides);
+  } catch (const mocap::LaunchError& e) {
+    for (const std::string& problem : e.problems()) fmt::print(stderr, "{}\n", problem);
+    fmt::print(stderr, "{}: {} problem(s); nothing was started\n", *file, e.problems().size());
+    return 1;
+  }
+  if (group && launch.find_group(*group) == nullptr) {
+    std::vector<std::string> names;
+    for (const auto& g : launch.groups) names.push_back(g.name);
+    fmt::print(stderr, "{}: no group named '{}' (groups: {})\n", launch.path, *group,
+               fmt::join(names, ", "));
+    return 1;
+  }
+  if (check) {
+    fmt::print("{}: valid ({} group(s), {} component(s))\n", launch.path, launch.groups.size(),
+               launch.component_count());
+    return 0;
+  }
+  if (group) return run_group(launch, *launch.find_group(*group), duration, health_file);
+  if (launch.groups.size() == 1) {
+    return run_group(launch, launch.groups.front(), duration, health_file);
+  }
+
+  // One child process per group, each running this program with --group.
+  std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::vector<mocap::ChildProcess> children;
+  for (const mocap::LaunchGroup& g : launch.groups) {
+    mocap::ChildProcess child{g.name, {self, *file, "--group", g.name}};
+    for (const std::string& text : set_texts) {
+      child.argv.push_back("--set");
+      child.argv.push_back(text);
+    }
+    if (duration) {
+      child.argv.push_back("--duration");
+      child.argv.push_back(fmt::format("{}", *duration));
+    }
+    if (!health_file.empty()) {
+      child.argv.push_back("--health-file");
+      child.argv.push_back(health_file + "." + g.name);
+    }
+    children.push_back(std::move(child));
+  }
+  std::optional<std::chrono::steady_clock::duration> timeout;
+  if (duration) {
+    // The groups stop themselves; this is for a group that does not.
+    timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(*duration + 15.0));
+  }
+  return mocap::supervise(children, timeout);
+}
