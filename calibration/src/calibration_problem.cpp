@@ -131,6 +131,112 @@ bool spans_an_area(const std::vector<Eigen::Vector2d>& points) {
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues().minCoeff() > 0.25;
 }
 
+// "images" entries get their shots and image size from the images (find_board_shots in
+// mocap_calibrate): without them nothing would say what went wrong.
+void check_image_sizes(const CalibrationConfig& config) {
+  for (size_t d = 0; d < config.data.size(); ++d) {
+    const DataSpec& data = config.data[d];
+    if (data.image_width <= 0 || data.image_height <= 0) {
+      throw CalibrationError(fmt::format(
+          "{}: data[{}] ({}): no image size{}", config.source, d, data.camera,
+          data.type == "images" ? ": the board has not been looked for in its images" : ""));
+    }
+  }
+}
+
+// Enough data for each camera: each shot of n points adds 2n measurements and 6 unknowns.
+void check_enough_shots(const CalibrationConfig& config) {
+  for (const CameraSpec& camera : config.cameras) {
+    int shots = 0, net = 0, points = 4;
+    for (const DataSpec& data : config.data) {
+      if (data.camera != camera.name) continue;
+      for (const Shot& shot : data.shots) {
+        ++shots;
+        points = static_cast<int>(shot.points.size());
+        net += 2 * points - 6;
+      }
+    }
+    const int unknowns = free_intrinsics(camera);
+    if (unknowns > 0 && net <= unknowns) {
+      const int needed = unknowns / std::max(1, 2 * points - 6) + 1;
+      throw CalibrationError(fmt::format(
+          "{}: camera {}: {} shots are too few for its {} intrinsics: each shot of {} points "
+          "adds {} measurements and 6 unknowns (its board pose), so {} shots are needed at least "
+          "(seed 002 §2.3); more, from different angles, make the result reliable",
+          config.source, camera.name, shots, unknowns, points, 2 * points, needed));
+    }
+  }
+}
+
+// The board's pose in the camera for one shot, from a planar PnP through the initial lens
+// model `model`. `where` names the shot in errors.
+Eigen::Isometry3d initial_board_pose(const CameraModel& model,
+                                     const std::vector<cv::Point3d>& object, const Shot& shot,
+                                     const std::string& where) {
+  std::vector<cv::Point2d> normalised;
+  for (const Eigen::Vector2d& pixel : shot.points) {
+    auto ray = model.unproject(pixel);
+    if (!ray) throw CalibrationError(where + ": a point is outside the initial lens model");
+    normalised.emplace_back(ray->x(), ray->y());
+  }
+  const bool planar = std::all_of(object.begin(), object.end(),
+                                  [&](const cv::Point3d& p) { return p.z == object[0].z; });
+  // A planar target has two poses that fit about equally (IPPE gives both); of those
+  // with the whole board in front of the camera, the one that fits best.
+  std::vector<cv::Mat> rvecs, tvecs;
+  std::vector<double> errors;
+  cv::solvePnPGeneric(object, normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvecs, tvecs,
+                      false, planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE, cv::noArray(),
+                      cv::noArray(), errors);
+  std::optional<Eigen::Isometry3d> best;
+  double best_error = 0;
+  for (size_t k = 0; k < rvecs.size(); ++k) {
+    const Pose6 pose = {tvecs[k].at<double>(0), tvecs[k].at<double>(1), tvecs[k].at<double>(2),
+                        rvecs[k].at<double>(0), rvecs[k].at<double>(1), rvecs[k].at<double>(2)};
+    const Eigen::Isometry3d candidate = to_isometry(pose);
+    const bool in_front = std::all_of(object.begin(), object.end(), [&](const cv::Point3d& p) {
+      return (candidate * Eigen::Vector3d(p.x, p.y, p.z)).z() > 0;
+    });
+    const double error = k < errors.size() ? errors[k] : 0.0;
+    if (in_front && (!best || error < best_error)) {
+      best = candidate;
+      best_error = error;
+    }
+  }
+  if (!best) {
+    throw CalibrationError(where +
+                           ": no board pose in front of the camera fits the points (are "
+                           "they the board's points, in the order of its corners?)");
+  }
+  return *best;
+}
+
+// Bounds that keep each lens model's parameters physical.
+void bound_intrinsics(ceres::Problem& problem, double* block, const CameraSpec& spec) {
+  if (spec.type == "eucm") {
+    problem.SetParameterLowerBound(block, 0, 0.0);  // alpha in [0, 1]
+    problem.SetParameterUpperBound(block, 0, 1.0);
+    // beta > 0, and not beyond 100: in a narrow view only alpha and beta's combined bending
+    // shows, and without a ceiling the fit creeps along that valley for hundreds of
+    // iterations towards alpha = 0, beta -> infinity, changing nothing that can be seen.
+    problem.SetParameterLowerBound(block, 1, 1e-6);
+    problem.SetParameterUpperBound(block, 1, 100.0);
+    problem.SetParameterLowerBound(block, 2, 1.0);  // focal lengths
+    problem.SetParameterLowerBound(block, 3, 1.0);
+  } else if (spec.type == "ucm" || spec.type == "mei") {
+    problem.SetParameterLowerBound(block, 0, 0.0);  // xi
+    const int fu = static_cast<int>(spec.value.size()) - 4;
+    problem.SetParameterLowerBound(block, fu, 1.0);
+    problem.SetParameterLowerBound(block, fu + 1, 1.0);
+  } else {
+    problem.SetParameterLowerBound(block, 0, 1.0);
+    problem.SetParameterLowerBound(block, 1, 1.0);
+    if (spec.value.size() == 4) {
+      problem.SetManifold(block, new ceres::SubsetManifold(kPinholeParameters, {4, 5, 6, 7, 8}));
+    }
+  }
+}
+
 }  // namespace
 
 struct CalibrationProblem::State {
@@ -197,10 +303,170 @@ struct CalibrationProblem::State {
     }
     return count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
   }
+
+  // Starting values of the per-shot transforms of data entry `d`: a planar PnP of the first
+  // view of each frame through the initial camera, moved through the chain's other (global)
+  // links.
+  void initialize_shot_poses(size_t d) {
+    const DataSpec& data = config.data[d];
+    const size_t c = camera_index.at(data.camera);
+    const CameraSpec& spec = config.cameras[c];
+    std::shared_ptr<const CameraModel> model;
+    try {
+      model = make_camera_model(spec.type, data.image_width, data.image_height, cameras[c]);
+    } catch (const std::invalid_argument& e) {
+      throw CalibrationError(fmt::format("{}: camera {}: {}", config.source, spec.name, e.what()));
+    }
+    const size_t link = shot_link(data);
+    const size_t t = transform_index.at(data.transform_chain[link].name);
+    Eigen::Isometry3d prefix = Eigen::Isometry3d::Identity(), suffix = prefix;
+    for (size_t i = 0; i < link; ++i) prefix = prefix * link_value(data.transform_chain[i]);
+    for (size_t i = link + 1; i < data.transform_chain.size(); ++i) {
+      suffix = suffix * link_value(data.transform_chain[i]);
+    }
+    std::vector<cv::Point3d> object;
+    for (int corner : data.corners) {
+      const Eigen::Vector3d& p = data.object_points[static_cast<size_t>(corner)];
+      object.emplace_back(p.x(), p.y(), p.z());
+    }
+    for (const Shot& shot : data.shots) {
+      const auto key = std::make_tuple(t, data.data_path, shot.frame);
+      if (shot_poses.count(key)) continue;
+      const std::string where = fmt::format("{}: data[{}] ({}), frame {} of {}", config.source, d,
+                                            data.camera, shot.frame, data.data_file);
+      if (!spans_an_area(shot.points)) {
+        throw CalibrationError(where + ": the points are (nearly) on one line or in one spot");
+      }
+      const Eigen::Isometry3d camera_from_board =
+          data.init ? *data.init : initial_board_pose(*model, object, shot, where);
+      Eigen::Isometry3d shot_pose = prefix.inverse() * camera_from_board * suffix.inverse();
+      if (!data.transform_chain[link].direct) shot_pose = shot_pose.inverse();
+      shot_poses[key] = to_pose6(shot_pose);
+    }
+  }
+
+  // One residual block per observed point: its pixel error through the entry's chain.
+  void add_point_residuals() {
+    ceres::LossFunction* loss = nullptr;  // the problem owns it (one instance, shared)
+    if (options.robust_scale_px > 0) loss = new ceres::HuberLoss(options.robust_scale_px);
+    for (size_t d = 0; d < config.data.size(); ++d) {
+      const DataSpec& data = config.data[d];
+      const size_t c = camera_index.at(data.camera);
+      std::vector<bool> direct;
+      for (const ChainLink& link : data.transform_chain) direct.push_back(link.direct);
+      for (size_t k = 0; k < data.shots.size(); ++k) {
+        const Shot& shot = data.shots[k];
+        ShotResiduals residuals{d, k, {}};
+        std::vector<double*> blocks = {cameras[c].data()};
+        for (size_t i = 0; i < data.transform_chain.size(); ++i) {
+          blocks.push_back(pose_block(data, i, shot.frame));
+        }
+        for (size_t p = 0; p < shot.points.size(); ++p) {
+          auto* cost = new ceres::DynamicAutoDiffCostFunction<PointResidual, 4>(new PointResidual{
+              lens_of(config.cameras[c].type),
+              data.object_points[static_cast<size_t>(data.corners[p])], shot.points[p], direct});
+          cost->AddParameterBlock(static_cast<int>(cameras[c].size()));
+          for (size_t i = 0; i < data.transform_chain.size(); ++i) cost->AddParameterBlock(6);
+          cost->SetNumResiduals(2);
+          residuals.points.push_back(problem.AddResidualBlock(cost, loss, blocks));
+        }
+        shot_residuals.push_back(std::move(residuals));
+      }
+    }
+  }
+
+  // Priors, constants, bounds.
+  void add_priors_and_bounds() {
+    for (size_t t = 0; t < config.transformations.size(); ++t) {
+      const TransformSpec& spec = config.transformations[t];
+      if (!spec.global || !problem.HasParameterBlock(transforms[t].data())) continue;
+      if (spec.constant) problem.SetParameterBlockConstant(transforms[t].data());
+      if (spec.prior && !spec.constant) {
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<PriorResidual, 6, 6>(new PriorResidual{
+                spec.value.value_or(Eigen::Isometry3d::Identity()), spec.prior_stiffness}),
+            nullptr, transforms[t].data());
+      }
+    }
+    for (size_t c = 0; c < config.cameras.size(); ++c) {
+      double* block = cameras[c].data();
+      if (!problem.HasParameterBlock(block)) continue;
+      if (config.cameras[c].constant) {
+        problem.SetParameterBlockConstant(block);
+      } else {
+        bound_intrinsics(problem, block, config.cameras[c]);
+      }
+    }
+  }
+
+  // Standard deviations of the free cameras' and global transforms' values, scaled by the
+  // residuals' own spread (the pixel noise is not given); or why there are none.
+  struct Deviations {
+    std::vector<std::vector<double>> cameras;     // per CameraSpec; empty: none
+    std::vector<std::vector<double>> transforms;  // per TransformSpec; empty: none
+    std::string problem;
+  };
+  Deviations standard_deviations(double final_cost) {
+    Deviations result{std::vector<std::vector<double>>(cameras.size()),
+                      std::vector<std::vector<double>>(transforms.size()),
+                      {}};
+    std::vector<const double*> blocks;
+    for (auto& camera : cameras) {
+      if (problem.HasParameterBlock(camera.data()) &&
+          !problem.IsParameterBlockConstant(camera.data())) {
+        blocks.push_back(camera.data());
+      }
+    }
+    for (size_t t = 0; t < transforms.size(); ++t) {
+      if (config.transformations[t].global && problem.HasParameterBlock(transforms[t].data()) &&
+          !problem.IsParameterBlockConstant(transforms[t].data())) {
+        blocks.push_back(transforms[t].data());
+      }
+    }
+    if (blocks.empty()) return result;  // nothing free: nothing to report
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (const double* block : blocks) pairs.emplace_back(block, block);
+    ceres::Covariance::Options covariance_options;
+    // Sparse: a rig has thousands of per-shot pose values (a dense SVD of them took a minute).
+    // A rank-deficient Jacobian makes Compute fail, reported below, rather than guess.
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
+    ceres::Covariance covariance(covariance_options);
+    if (!covariance.Compute(pairs, &problem)) {
+      result.problem =
+          "the parameters are not all determined by the data (rank-deficient): more shots, "
+          "from more different angles, are needed";
+      return result;
+    }
+    const double dof = degrees_of_freedom();
+    const double variance = dof > 0 ? 2 * final_cost / dof : 1.0;
+    auto sigmas = [&](const double* block, int size) {
+      std::vector<double> values(static_cast<size_t>(size));
+      std::vector<double> matrix(static_cast<size_t>(size * size));
+      covariance.GetCovarianceBlock(block, block, matrix.data());
+      for (int i = 0; i < size; ++i) {
+        values[static_cast<size_t>(i)] =
+            std::sqrt(std::max(0.0, matrix[static_cast<size_t>(i * size + i)] * variance));
+      }
+      return values;
+    };
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      if (std::find(blocks.begin(), blocks.end(), cameras[c].data()) != blocks.end()) {
+        result.cameras[c] = sigmas(cameras[c].data(), static_cast<int>(cameras[c].size()));
+      }
+    }
+    for (size_t t = 0; t < transforms.size(); ++t) {
+      if (std::find(blocks.begin(), blocks.end(), transforms[t].data()) != blocks.end()) {
+        result.transforms[t] = sigmas(transforms[t].data(), 6);
+      }
+    }
+    return result;
+  }
 };
 
 CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, CalibrationOptions options)
     : state_(std::make_unique<State>()) {
+  check_image_sizes(config);
+  check_enough_shots(config);
   State& s = *state_;
   s.config = config;
   s.options = options;
@@ -210,204 +476,18 @@ CalibrationProblem::CalibrationProblem(const CalibrationConfig& config, Calibrat
     s.transforms.push_back(
         to_pose6(config.transformations[i].value.value_or(Eigen::Isometry3d::Identity())));
   }
-
   // Intrinsics: pinhole with 4 values is solved without distortion (held at 0).
   for (const CameraSpec& camera : config.cameras) {
     std::vector<double> value = camera.value;
     if (camera.type == "pinhole" && value.size() == 4) value.resize(kPinholeParameters, 0.0);
     s.cameras.push_back(std::move(value));
   }
-
-  // "images" entries get their shots and image size from the images (find_board_shots in
-  // mocap_calibrate): without them nothing would say what went wrong.
-  for (size_t d = 0; d < config.data.size(); ++d) {
-    const DataSpec& data = config.data[d];
-    if (data.image_width <= 0 || data.image_height <= 0) {
-      throw CalibrationError(fmt::format(
-          "{}: data[{}] ({}): no image size{}", config.source, d, data.camera,
-          data.type == "images" ? ": the board has not been looked for in its images" : ""));
-    }
-  }
-
-  // Enough data for each camera: each shot of n points adds 2n measurements and 6 unknowns.
-  for (size_t c = 0; c < config.cameras.size(); ++c) {
-    const CameraSpec& camera = config.cameras[c];
-    int shots = 0, net = 0, points = 4;
-    for (const DataSpec& data : config.data) {
-      if (data.camera != camera.name) continue;
-      for (const Shot& shot : data.shots) {
-        ++shots;
-        points = static_cast<int>(shot.points.size());
-        net += 2 * points - 6;
-      }
-    }
-    const int unknowns = free_intrinsics(camera);
-    if (unknowns > 0 && net <= unknowns) {
-      const int needed = unknowns / std::max(1, 2 * points - 6) + 1;
-      throw CalibrationError(fmt::format(
-          "{}: camera {}: {} shots are too few for its {} intrinsics: each shot of {} points "
-          "adds {} measurements and 6 unknowns (its board pose), so {} shots are needed at least "
-          "(seed 002 §2.3); more, from different angles, make the result reliable",
-          config.source, camera.name, shots, unknowns, points, 2 * points, needed));
-    }
-  }
-
-  // Starting values of the per-shot transforms: a planar PnP of the first view of each frame
-  // through the initial camera, moved through the chain's other (global) links.
-  for (size_t d = 0; d < config.data.size(); ++d) {
-    const DataSpec& data = config.data[d];
-    const size_t c = s.camera_index.at(data.camera);
-    const CameraSpec& spec = config.cameras[c];
-    std::shared_ptr<const CameraModel> model;
-    try {
-      model = make_camera_model(spec.type, data.image_width, data.image_height, s.cameras[c]);
-    } catch (const std::invalid_argument& e) {
-      throw CalibrationError(fmt::format("{}: camera {}: {}", config.source, spec.name, e.what()));
-    }
-    const size_t link = s.shot_link(data);
-    const size_t t = s.transform_index.at(data.transform_chain[link].name);
-    Eigen::Isometry3d prefix = Eigen::Isometry3d::Identity(), suffix = prefix;
-    for (size_t i = 0; i < link; ++i) prefix = prefix * s.link_value(data.transform_chain[i]);
-    for (size_t i = link + 1; i < data.transform_chain.size(); ++i) {
-      suffix = suffix * s.link_value(data.transform_chain[i]);
-    }
-    std::vector<cv::Point3d> object;
-    for (int corner : data.corners) {
-      const Eigen::Vector3d& p = data.object_points[static_cast<size_t>(corner)];
-      object.emplace_back(p.x(), p.y(), p.z());
-    }
-    for (const Shot& shot : data.shots) {
-      const auto key = std::make_tuple(t, data.data_path, shot.frame);
-      if (s.shot_poses.count(key)) continue;
-      const std::string where = fmt::format("{}: data[{}] ({}), frame {} of {}", config.source, d,
-                                            data.camera, shot.frame, data.data_file);
-      if (!spans_an_area(shot.points)) {
-        throw CalibrationError(where + ": the points are (nearly) on one line or in one spot");
-      }
-      Eigen::Isometry3d camera_from_board = Eigen::Isometry3d::Identity();
-      if (data.init) {
-        camera_from_board = *data.init;
-      } else {
-        std::vector<cv::Point2d> normalised;
-        for (const Eigen::Vector2d& pixel : shot.points) {
-          auto ray = model->unproject(pixel);
-          if (!ray) throw CalibrationError(where + ": a point is outside the initial lens model");
-          normalised.emplace_back(ray->x(), ray->y());
-        }
-        const bool planar = std::all_of(object.begin(), object.end(),
-                                        [&](const cv::Point3d& p) { return p.z == object[0].z; });
-        // A planar target has two poses that fit about equally (IPPE gives both); of those
-        // with the whole board in front of the camera, the one that fits best.
-        std::vector<cv::Mat> rvecs, tvecs;
-        std::vector<double> errors;
-        cv::solvePnPGeneric(object, normalised, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rvecs, tvecs,
-                            false, planar ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE,
-                            cv::noArray(), cv::noArray(), errors);
-        std::optional<Eigen::Isometry3d> best;
-        double best_error = 0;
-        for (size_t k = 0; k < rvecs.size(); ++k) {
-          const Pose6 pose = {tvecs[k].at<double>(0), tvecs[k].at<double>(1),
-                              tvecs[k].at<double>(2), rvecs[k].at<double>(0),
-                              rvecs[k].at<double>(1), rvecs[k].at<double>(2)};
-          const Eigen::Isometry3d candidate = to_isometry(pose);
-          const bool in_front =
-              std::all_of(object.begin(), object.end(), [&](const cv::Point3d& p) {
-                return (candidate * Eigen::Vector3d(p.x, p.y, p.z)).z() > 0;
-              });
-          const double error = k < errors.size() ? errors[k] : 0.0;
-          if (in_front && (!best || error < best_error)) {
-            best = candidate;
-            best_error = error;
-          }
-        }
-        if (!best) {
-          throw CalibrationError(where +
-                                 ": no board pose in front of the camera fits the points (are "
-                                 "they the board's points, in the order of its corners?)");
-        }
-        camera_from_board = *best;
-      }
-      Eigen::Isometry3d shot_pose = prefix.inverse() * camera_from_board * suffix.inverse();
-      if (!data.transform_chain[link].direct) shot_pose = shot_pose.inverse();
-      s.shot_poses[key] = to_pose6(shot_pose);
-    }
-  }
-
-  // Residuals.
-  ceres::LossFunction* loss = nullptr;  // the problem owns it (one instance, shared)
-  if (options.robust_scale_px > 0) loss = new ceres::HuberLoss(options.robust_scale_px);
-  for (size_t d = 0; d < config.data.size(); ++d) {
-    const DataSpec& data = config.data[d];
-    const size_t c = s.camera_index.at(data.camera);
-    std::vector<bool> direct;
-    for (const ChainLink& link : data.transform_chain) direct.push_back(link.direct);
-    for (size_t k = 0; k < data.shots.size(); ++k) {
-      const Shot& shot = data.shots[k];
-      State::ShotResiduals residuals{d, k, {}};
-      std::vector<double*> blocks = {s.cameras[c].data()};
-      for (size_t i = 0; i < data.transform_chain.size(); ++i) {
-        blocks.push_back(s.pose_block(data, i, shot.frame));
-      }
-      for (size_t p = 0; p < shot.points.size(); ++p) {
-        auto* cost = new ceres::DynamicAutoDiffCostFunction<PointResidual, 4>(new PointResidual{
-            lens_of(config.cameras[c].type),
-            data.object_points[static_cast<size_t>(data.corners[p])], shot.points[p], direct});
-        cost->AddParameterBlock(static_cast<int>(s.cameras[c].size()));
-        for (size_t i = 0; i < data.transform_chain.size(); ++i) cost->AddParameterBlock(6);
-        cost->SetNumResiduals(2);
-        residuals.points.push_back(s.problem.AddResidualBlock(cost, loss, blocks));
-      }
-      s.shot_residuals.push_back(std::move(residuals));
-    }
-  }
+  for (size_t d = 0; d < config.data.size(); ++d) s.initialize_shot_poses(d);
+  s.add_point_residuals();
   if (s.shot_residuals.empty()) {
     throw CalibrationError(config.source + ": no shots: the data files hold no usable frames");
   }
-
-  // Priors, constants, bounds.
-  for (size_t t = 0; t < config.transformations.size(); ++t) {
-    const TransformSpec& spec = config.transformations[t];
-    if (!spec.global || !s.problem.HasParameterBlock(s.transforms[t].data())) continue;
-    if (spec.constant) s.problem.SetParameterBlockConstant(s.transforms[t].data());
-    if (spec.prior && !spec.constant) {
-      s.problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<PriorResidual, 6, 6>(new PriorResidual{
-              spec.value.value_or(Eigen::Isometry3d::Identity()), spec.prior_stiffness}),
-          nullptr, s.transforms[t].data());
-    }
-  }
-  for (size_t c = 0; c < config.cameras.size(); ++c) {
-    double* block = s.cameras[c].data();
-    if (!s.problem.HasParameterBlock(block)) continue;
-    const CameraSpec& spec = config.cameras[c];
-    if (spec.constant) {
-      s.problem.SetParameterBlockConstant(block);
-      continue;
-    }
-    if (spec.type == "eucm") {
-      s.problem.SetParameterLowerBound(block, 0, 0.0);  // alpha in [0, 1]
-      s.problem.SetParameterUpperBound(block, 0, 1.0);
-      // beta > 0, and not beyond 100: in a narrow view only alpha and beta's combined bending
-      // shows, and without a ceiling the fit creeps along that valley for hundreds of
-      // iterations towards alpha = 0, beta -> infinity, changing nothing that can be seen.
-      s.problem.SetParameterLowerBound(block, 1, 1e-6);
-      s.problem.SetParameterUpperBound(block, 1, 100.0);
-      s.problem.SetParameterLowerBound(block, 2, 1.0);  // focal lengths
-      s.problem.SetParameterLowerBound(block, 3, 1.0);
-    } else if (spec.type == "ucm" || spec.type == "mei") {
-      s.problem.SetParameterLowerBound(block, 0, 0.0);  // xi
-      const int fu = static_cast<int>(spec.value.size()) - 4;
-      s.problem.SetParameterLowerBound(block, fu, 1.0);
-      s.problem.SetParameterLowerBound(block, fu + 1, 1.0);
-    } else {
-      s.problem.SetParameterLowerBound(block, 0, 1.0);
-      s.problem.SetParameterLowerBound(block, 1, 1.0);
-      if (spec.value.size() == 4) {
-        s.problem.SetManifold(block,
-                              new ceres::SubsetManifold(kPinholeParameters, {4, 5, 6, 7, 8}));
-      }
-    }
-  }
+  s.add_priors_and_bounds();
 }
 
 CalibrationProblem::~CalibrationProblem() = default;
@@ -453,63 +533,16 @@ CalibrationReport CalibrationProblem::solve() {
   }
   report.rms_px = std::sqrt(total / static_cast<double>(report.points));
 
-  // Standard deviations, scaled by the residuals' own spread (the pixel noise is not given).
-  std::vector<std::vector<double>> camera_sigma(s.config.cameras.size());
-  std::vector<std::vector<double>> transform_sigma(s.config.transformations.size());
   // Only at a solution: after a failed solve the Jacobian may not even be finite.
+  State::Deviations deviations;
   if (s.options.compute_covariance && report.converged) {
-    std::vector<const double*> blocks;
-    for (auto& camera : s.cameras) {
-      if (s.problem.HasParameterBlock(camera.data()) &&
-          !s.problem.IsParameterBlockConstant(camera.data())) {
-        blocks.push_back(camera.data());
-      }
-    }
-    for (size_t t = 0; t < s.transforms.size(); ++t) {
-      if (s.config.transformations[t].global &&
-          s.problem.HasParameterBlock(s.transforms[t].data()) &&
-          !s.problem.IsParameterBlockConstant(s.transforms[t].data())) {
-        blocks.push_back(s.transforms[t].data());
-      }
-    }
-    std::vector<std::pair<const double*, const double*>> pairs;
-    for (const double* block : blocks) pairs.emplace_back(block, block);
-    ceres::Covariance::Options covariance_options;
-    // Sparse: a rig has thousands of per-shot pose values (a dense SVD of them took a minute).
-    // A rank-deficient Jacobian makes Compute fail, reported below, rather than guess.
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    ceres::Covariance covariance(covariance_options);
-    const double dof = s.degrees_of_freedom();
-    const double variance = dof > 0 ? 2 * summary.final_cost / dof : 1.0;
-    if (pairs.empty()) {
-      // Nothing free: nothing to report.
-    } else if (covariance.Compute(pairs, &s.problem)) {
-      auto sigmas = [&](const double* block, int size) {
-        std::vector<double> result(static_cast<size_t>(size));
-        std::vector<double> matrix(static_cast<size_t>(size * size));
-        covariance.GetCovarianceBlock(block, block, matrix.data());
-        for (int i = 0; i < size; ++i) {
-          result[static_cast<size_t>(i)] =
-              std::sqrt(std::max(0.0, matrix[static_cast<size_t>(i * size + i)] * variance));
-        }
-        return result;
-      };
-      for (size_t c = 0; c < s.cameras.size(); ++c) {
-        if (std::find(blocks.begin(), blocks.end(), s.cameras[c].data()) != blocks.end()) {
-          camera_sigma[c] = sigmas(s.cameras[c].data(), static_cast<int>(s.cameras[c].size()));
-        }
-      }
-      for (size_t t = 0; t < s.transforms.size(); ++t) {
-        if (std::find(blocks.begin(), blocks.end(), s.transforms[t].data()) != blocks.end()) {
-          transform_sigma[t] = sigmas(s.transforms[t].data(), 6);
-        }
-      }
-    } else {
-      report.covariance_problem =
-          "the parameters are not all determined by the data (rank-deficient): more shots, "
-          "from more different angles, are needed";
-    }
+    deviations = s.standard_deviations(summary.final_cost);
+    report.covariance_problem = deviations.problem;
   }
+  std::vector<std::vector<double>>& camera_sigma = deviations.cameras;
+  std::vector<std::vector<double>>& transform_sigma = deviations.transforms;
+  camera_sigma.resize(s.config.cameras.size());
+  transform_sigma.resize(s.config.transformations.size());
 
   for (size_t c = 0; c < s.config.cameras.size(); ++c) {
     const CameraSpec& spec = s.config.cameras[c];

@@ -90,17 +90,20 @@ int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
+// What the command line asks for.
+struct Options {
   std::optional<std::string> file, group, describe_plugin;
-  std::vector<std::string> set_texts;
+  std::vector<std::string> set_texts;  // --set C.P=V, as given
   std::optional<double> duration;
-  const char* health_file_variable = std::getenv("MOCAP_HEALTH_FILE");
-  std::string health_file = health_file_variable ? health_file_variable : "";
-  bool check = false, list_plugins = false;
+  std::string health_file;
+  bool check = false, list_plugins = false, help = false;
+};
 
+// Exits with a usage error for a bad command line.
+Options parse_arguments(const std::vector<std::string>& args) {
+  Options options;
+  const char* health_file_variable = std::getenv("MOCAP_HEALTH_FILE");
+  options.health_file = health_file_variable ? health_file_variable : "";
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     auto value = [&](std::string_view option) -> const std::string& {
@@ -108,12 +111,12 @@ int main(int argc, char** argv) {
       return args[++i];
     };
     if (arg == "--help" || arg == "-h") {
-      fmt::print("{}", kUsage);
-      return 0;
+      options.help = true;
+      return options;
     } else if (arg == "--group") {
-      group = value(arg);
+      options.group = value(arg);
     } else if (arg == "--set") {
-      set_texts.push_back(value(arg));
+      options.set_texts.push_back(value(arg));
     } else if (arg == "--duration") {
       const std::string& text = value(arg);
       double seconds = 0;
@@ -122,100 +125,117 @@ int main(int argc, char** argv) {
         usage_error(fmt::format("--duration {}: expected a number of seconds >= 0", text));
       }
       // The last one given counts, so a wrapper's default can be overridden; 0 means none.
-      duration = seconds > 0 ? std::optional<double>(seconds) : std::nullopt;
+      options.duration = seconds > 0 ? std::optional<double>(seconds) : std::nullopt;
     } else if (arg == "--health-file") {
-      health_file = value(arg);
+      options.health_file = value(arg);
     } else if (arg == "--check") {
-      check = true;
+      options.check = true;
     } else if (arg == "--describe") {
-      describe_plugin = value(arg);
+      options.describe_plugin = value(arg);
     } else if (arg == "--plugins") {
-      list_plugins = true;
+      options.list_plugins = true;
     } else if (arg.starts_with("-")) {
       usage_error(fmt::format("unknown option {}", arg));
-    } else if (file) {
-      usage_error(fmt::format("one launch file at a time ({} and {})", *file, arg));
+    } else if (options.file) {
+      usage_error(fmt::format("one launch file at a time ({} and {})", *options.file, arg));
     } else {
-      file = arg;
+      options.file = arg;
     }
   }
+  return options;
+}
 
-  mocap::PluginLoader plugins;
-  if (list_plugins) {
-    for (const std::string& name : plugins.available()) {
-      try {
-        const mocap::LoadedPlugin& plugin = plugins.load(name);
-        fmt::print("{:28} {}\n", name, plugin.spec.description());
-      } catch (const mocap::PluginError& e) {
-        fmt::print("{:28} (cannot load: {})\n", name, e.what());
-      }
+void list_plugins(mocap::PluginLoader& plugins) {
+  for (const std::string& name : plugins.available()) {
+    try {
+      const mocap::LoadedPlugin& plugin = plugins.load(name);
+      fmt::print("{:28} {}\n", name, plugin.spec.description());
+    } catch (const mocap::PluginError& e) {
+      fmt::print("{:28} (cannot load: {})\n", name, e.what());
     }
+  }
+}
+
+// One child process per group, each running this program with --group, supervised.
+int run_groups(const mocap::LaunchFile& launch, const Options& options) {
+  std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::vector<mocap::ChildProcess> children;
+  for (const mocap::LaunchGroup& g : launch.groups) {
+    mocap::ChildProcess child{g.name, {self, *options.file, "--group", g.name}};
+    for (const std::string& text : options.set_texts) {
+      child.argv.push_back("--set");
+      child.argv.push_back(text);
+    }
+    if (options.duration) {
+      child.argv.push_back("--duration");
+      child.argv.push_back(fmt::format("{}", *options.duration));
+    }
+    if (!options.health_file.empty()) {
+      child.argv.push_back("--health-file");
+      child.argv.push_back(options.health_file + "." + g.name);
+    }
+    children.push_back(std::move(child));
+  }
+  std::optional<std::chrono::steady_clock::duration> timeout;
+  if (options.duration) {
+    // The groups stop themselves; this is for a group that does not.
+    timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(*options.duration + 15.0));
+  }
+  return mocap::supervise(children, timeout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options options = parse_arguments({argv + 1, argv + argc});
+  if (options.help) {
+    fmt::print("{}", kUsage);
     return 0;
   }
-  if (describe_plugin) {
+  mocap::PluginLoader plugins;
+  if (options.list_plugins) {
+    list_plugins(plugins);
+    return 0;
+  }
+  if (options.describe_plugin) {
     try {
-      fmt::print("{}", describe(plugins.load(*describe_plugin)));
+      fmt::print("{}", describe(plugins.load(*options.describe_plugin)));
       return 0;
     } catch (const mocap::PluginError& e) {
       fmt::print(stderr, "mocap_launch: {}\n", e.what());
       return 1;
     }
   }
-  if (!file) usage_error("no launch file given");
+  if (!options.file) usage_error("no launch file given");
 
   mocap::LaunchFile launch;
   try {
     std::vector<mocap::ParameterOverride> overrides;
-    for (const std::string& text : set_texts) {
+    for (const std::string& text : options.set_texts) {
       overrides.push_back(mocap::parse_parameter_override(text));
     }
-    launch = mocap::load_launch_file(*file, plugins, overrides);
+    launch = mocap::load_launch_file(*options.file, plugins, overrides);
   } catch (const mocap::LaunchError& e) {
     for (const std::string& problem : e.problems()) fmt::print(stderr, "{}\n", problem);
-    fmt::print(stderr, "{}: {} problem(s); nothing was started\n", *file, e.problems().size());
+    fmt::print(stderr, "{}: {} problem(s); nothing was started\n", *options.file,
+               e.problems().size());
     return 1;
   }
-  if (group && launch.find_group(*group) == nullptr) {
+  const mocap::LaunchGroup* group = nullptr;
+  if (options.group && (group = launch.find_group(*options.group)) == nullptr) {
     std::vector<std::string> names;
     for (const auto& g : launch.groups) names.push_back(g.name);
-    fmt::print(stderr, "{}: no group named '{}' (groups: {})\n", launch.path, *group,
+    fmt::print(stderr, "{}: no group named '{}' (groups: {})\n", launch.path, *options.group,
                fmt::join(names, ", "));
     return 1;
   }
-  if (check) {
+  if (options.check) {
     fmt::print("{}: valid ({} group(s), {} component(s))\n", launch.path, launch.groups.size(),
                launch.component_count());
     return 0;
   }
-  if (group) return run_group(launch, *launch.find_group(*group), duration, health_file);
-  if (launch.groups.size() == 1) {
-    return run_group(launch, launch.groups.front(), duration, health_file);
-  }
-
-  // One child process per group, each running this program with --group.
-  std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  std::vector<mocap::ChildProcess> children;
-  for (const mocap::LaunchGroup& g : launch.groups) {
-    mocap::ChildProcess child{g.name, {self, *file, "--group", g.name}};
-    for (const std::string& text : set_texts) {
-      child.argv.push_back("--set");
-      child.argv.push_back(text);
-    }
-    if (duration) {
-      child.argv.push_back("--duration");
-      child.argv.push_back(fmt::format("{}", *duration));
-    }
-    if (!health_file.empty()) {
-      child.argv.push_back("--health-file");
-      child.argv.push_back(health_file + "." + g.name);
-    }
-    children.push_back(std::move(child));
-  }
-  std::optional<std::chrono::steady_clock::duration> timeout;
-  if (duration) {
-    // The groups stop themselves; this is for a group that does not.
-    timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(*duration + 15.0));
-  }
-  return mocap::supervise(children, timeout);
+  if (!group && launch.groups.size() == 1) group = &launch.groups.front();
+  if (group) return run_group(launch, *group, options.duration, options.health_file);
+  return run_groups(launch, options);
 }
