@@ -120,12 +120,10 @@ class DriveFollowerComponent final : public Component {
   explicit DriveFollowerComponent(Context& context)
       : Component(context),
         turret_(turret::load_turret(settings_.turret)),
-        follower_(follower_options()),
-        constellation_(settings_.constellation),
-        pan_joint_(settings_.pan_joint),
-        tilt_joint_(settings_.tilt_joint) {
-    if (pan_joint_ == tilt_joint_) {
-      throw std::invalid_argument("pan_joint and tilt_joint are both '" + pan_joint_ + "'");
+        follower_(follower_options()) {
+    if (settings_.pan_joint == settings_.tilt_joint) {
+      throw std::invalid_argument("pan_joint and tilt_joint are both '" + settings_.pan_joint +
+                                  "'");
     }
     command_publisher_ = create_publisher<Twist>(topics::kCmdVel);
     alert_publisher_ = create_publisher<Alert>(topics::kAlerts);
@@ -139,7 +137,8 @@ class DriveFollowerComponent final : public Component {
                  [this] { control(); });
     const DriveOptions& drive = follower_.options().drive;
     log().info("following {} at {} m, {} Hz, stopping after {} s without it (turret {})",
-               constellation_.empty() ? std::string("the first constellation") : constellation_,
+               settings_.constellation.empty() ? std::string("the first constellation")
+                                               : settings_.constellation,
                drive.goal_distance_m, rate, follower_.options().lost_after_s, turret_.source());
   }
 
@@ -163,13 +162,13 @@ class DriveFollowerComponent final : public Component {
   void on_joint_state(const JointState& state) {
     std::optional<double> pan, tilt;
     for (size_t i = 0; i < state.name().size() && i < state.position().size(); ++i) {
-      if (state.name()[i] == pan_joint_) pan = state.position()[i];
-      if (state.name()[i] == tilt_joint_) tilt = state.position()[i];
+      if (state.name()[i] == settings_.pan_joint) pan = state.position()[i];
+      if (state.name()[i] == settings_.tilt_joint) tilt = state.position()[i];
     }
     if (!pan || !tilt || !std::isfinite(*pan) || !std::isfinite(*tilt)) {
       if (joint_states_without_++ == 0) {
-        log().warn("joint states without finite positions of '{}' and '{}' are ignored", pan_joint_,
-                   tilt_joint_);
+        log().warn("joint states without finite positions of '{}' and '{}' are ignored",
+                   settings_.pan_joint, settings_.tilt_joint);
       }
       return;
     }
@@ -180,7 +179,7 @@ class DriveFollowerComponent final : public Component {
   void on_poses(const ConstellationPoseArray& poses) {
     const ConstellationPose* followed = nullptr;
     for (const ConstellationPose& pose : poses.poses()) {
-      if (constellation_.empty() || pose.name() == constellation_) {
+      if (settings_.constellation.empty() || pose.name() == settings_.constellation) {
         followed = &pose;
         break;
       }
@@ -194,7 +193,7 @@ class DriveFollowerComponent final : public Component {
     if (!joints) {
       if (poses_before_joints_++ == 0) {
         log().warn("poses are not used until {} carries the angles of '{}' and '{}'",
-                   topics::kTurretJointStates, pan_joint_, tilt_joint_);
+                   topics::kTurretJointStates, settings_.pan_joint, settings_.tilt_joint);
       }
       return;
     }
@@ -247,9 +246,6 @@ class DriveFollowerComponent final : public Component {
 
   turret::TurretModel turret_;
   DriveFollower follower_;
-  std::string constellation_;
-  std::string pan_joint_;
-  std::string tilt_joint_;
   Publisher<Twist> command_publisher_;
   Publisher<Alert> alert_publisher_;
   turret::JointHistory joints_;

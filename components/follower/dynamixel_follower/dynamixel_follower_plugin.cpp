@@ -130,11 +130,9 @@ class DynamixelFollower final : public Component {
 
   explicit DynamixelFollower(Context& context)
       : Component(context), follower_(load_turret(settings_.turret), settings_) {
-    constellation_ = settings_.constellation;
-    pan_id_ = static_cast<uint8_t>(settings_.pan_id);
-    tilt_id_ = static_cast<uint8_t>(settings_.tilt_id);
-    if (pan_id_ == tilt_id_) {
-      throw std::invalid_argument("pan_id and tilt_id are both " + std::to_string(pan_id_) +
+    if (settings_.pan_id == settings_.tilt_id) {
+      throw std::invalid_argument("pan_id and tilt_id are both " +
+                                  std::to_string(settings_.pan_id) +
                                   "; each servo needs its own ID");
     }
     period_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -148,9 +146,9 @@ class DynamixelFollower final : public Component {
     // The bus is driven from a worker of its own, started with the graph, so that blocking
     // serial I/O never holds up the executor.
     create_worker("bus", [this](std::stop_token stop) { run(stop); });
-    log().info("servos {} (pan) and {} (tilt) on {} at {} bit/s, {} Hz; turret {}", pan_id_,
-               tilt_id_, settings_.port, settings_.bus.baud_rate, settings_.rate_hz,
-               follower_.turret().source());
+    log().info("servos {} (pan) and {} (tilt) on {} at {} bit/s, {} Hz; turret {}",
+               settings_.pan_id, settings_.tilt_id, settings_.port, settings_.bus.baud_rate,
+               settings_.rate_hz, follower_.turret().source());
   }
 
   ~DynamixelFollower() override {
@@ -162,11 +160,15 @@ class DynamixelFollower final : public Component {
   }
 
  private:
+  // The servos' IDs on the bus (range-checked to 0..253 by the parameter list).
+  uint8_t pan_id() const { return static_cast<uint8_t>(settings_.pan_id); }
+  uint8_t tilt_id() const { return static_cast<uint8_t>(settings_.tilt_id); }
+
   // --- executor side ----------------------------------------------------------------------
 
   void on_poses(const mocap_msgs::msg::ConstellationPoseArray& poses) {
     for (const auto& pose : poses.poses()) {
-      if (!constellation_.empty() && pose.name() != constellation_) continue;
+      if (!settings_.constellation.empty() && pose.name() != settings_.constellation) continue;
       const auto& p = pose.pose().pose().position();
       const int64_t stamp_ns = to_nanoseconds(pose.pose().header().stamp());
       std::lock_guard lock(mutex_);
@@ -230,15 +232,15 @@ class DynamixelFollower final : public Component {
     options.reply_timeout = std::chrono::milliseconds(settings_.reply_timeout_ms);
     bus_ = std::make_unique<dynamixel::DynamixelBus>(settings_.port, options);
     if (connections_++ > 0) ++reconnects_;
-    for (uint8_t id : {pan_id_, tilt_id_}) {
+    for (uint8_t id : {pan_id(), tilt_id()}) {
       if (uint8_t errors = bus_->ping(id); errors != 0) {
         log().warn("servo {} reports {}", id, dynamixel::describe_errors(errors));
       }
     }
     // A servo that reports overheating or overload refuses nothing but says so: the caller
     // switches both off again (shut_down).
-    for (uint8_t id : {pan_id_, tilt_id_}) bus_->write_u8(id, ax12::kTorqueEnable, 1);
-    log().info("servos {} and {} answer on {}; torque on", pan_id_, tilt_id_, bus_->device());
+    for (uint8_t id : {pan_id(), tilt_id()}) bus_->write_u8(id, ax12::kTorqueEnable, 1);
+    log().info("servos {} and {} answer on {}; torque on", pan_id(), tilt_id(), bus_->device());
   }
 
   struct ServoReading {
@@ -263,7 +265,7 @@ class DynamixelFollower final : public Component {
 
   // Reads both joints, publishes them and keeps them for the poses. Returns the angles.
   JointAngles read_joints() {
-    const ServoReading pan = read_servo(pan_id_), tilt = read_servo(tilt_id_);
+    const ServoReading pan = read_servo(pan_id()), tilt = read_servo(tilt_id());
     const int64_t stamp_ns = clock_ns();
     const TurretModel& turret = follower_.turret();
     const JointAngles angles{joint_angle(turret.pan(), pan.position),
@@ -302,9 +304,9 @@ class DynamixelFollower final : public Component {
                                        uint8_t(speed & 0xFF), uint8_t(speed >> 8)}};
     };
     const dynamixel::SyncWriteItem items[] = {
-        item(pan_id_, servo_position(turret.pan(), command.goal.pan),
+        item(pan_id(), servo_position(turret.pan(), command.goal.pan),
              ax12::rad_s_to_moving_speed(command.speed.pan)),
-        item(tilt_id_, servo_position(turret.tilt(), command.goal.tilt),
+        item(tilt_id(), servo_position(turret.tilt(), command.goal.tilt),
              ax12::rad_s_to_moving_speed(command.speed.tilt))};
     bus_->sync_write(ax12::kGoalPosition, 4, items);
     ++cycles_;
@@ -322,7 +324,7 @@ class DynamixelFollower final : public Component {
 
   void shut_down(const BusError& error) {
     faulted_ = true;
-    for (uint8_t id : {pan_id_, tilt_id_}) {
+    for (uint8_t id : {pan_id(), tilt_id()}) {
       try {
         bus_->write_u8(id, ax12::kTorqueEnable, 0);
       } catch (const BusError& e) {
@@ -363,8 +365,6 @@ class DynamixelFollower final : public Component {
   bool faulted_ = false;
   uint64_t cycles_ = 0, bus_errors_ = 0, connections_ = 0, reconnects_ = 0;
 
-  std::string constellation_;
-  uint8_t pan_id_ = 1, tilt_id_ = 2;
   std::chrono::nanoseconds period_{20'000'000};
   Publisher<JointState> states_;
   Publisher<JointState> commands_;

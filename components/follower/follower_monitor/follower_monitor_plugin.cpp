@@ -96,8 +96,6 @@ class FollowerMonitor final : public Component {
   }
 
   explicit FollowerMonitor(Context& context) : Component(context) {
-    constellation_ = settings_.constellation;
-    summary_file_ = settings_.summary_file;
     evaluator_ = FollowEvaluator(settings_);
     create_subscription<PoseStamped>(topics::kSimCameraPose, [this](const PoseStamped& pose) {
       const std::optional<Eigen::Isometry3d> world_from_camera = to_isometry(pose.pose());
@@ -115,7 +113,7 @@ class FollowerMonitor final : public Component {
               camera_pose_at(to_nanoseconds(truth.header().stamp()));
           if (!world_from_camera) return;
           for (const auto& pose : truth.poses()) {
-            if (pose.name() != constellation_) continue;
+            if (pose.name() != settings_.constellation) continue;
             const auto& p = pose.pose().pose().position();
             evaluator_.add_truth(to_nanoseconds(pose.pose().header().stamp()),
                                  Eigen::Vector3d(p.x(), p.y(), p.z()), *world_from_camera,
@@ -125,7 +123,8 @@ class FollowerMonitor final : public Component {
     create_subscription<ConstellationPoseArray>(topics::kPoses,
                                                 [this](const ConstellationPoseArray& poses) {
                                                   for (const auto& pose : poses.poses()) {
-                                                    if (pose.name() != constellation_) continue;
+                                                    if (pose.name() != settings_.constellation)
+                                                      continue;
                                                     const int64_t now = steady_ns();
                                                     evaluator_.add_pose(now);
                                                     rates_["poses"].add(now);
@@ -212,8 +211,8 @@ class FollowerMonitor final : public Component {
 
   void write_summary(const Spread& pointing, const Spread& walking, const Spread& distance,
                      double within_percent, const Spread& stop) {
-    if (summary_file_.empty()) return;
-    std::ofstream out(summary_file_);
+    if (settings_.summary_file.empty()) return;
+    std::ofstream out(settings_.summary_file);
     out << fmt::format(
         "pointing_error_deg: {{median: {:.4f}, p95: {:.4f}, max: {:.4f}}}\n"
         "pointing_error_walking_deg: {{median: {:.4f}, p95: {:.4f}, max: {:.4f}}}\n"
@@ -226,11 +225,9 @@ class FollowerMonitor final : public Component {
         evaluator_.figures().stop_latency_s.size(), stop.median, stop.max,
         rates_["camera"].overall_hz(), rates_["poses"].overall_hz(), rates_["turret"].overall_hz(),
         rates_["drive"].overall_hz(), alerts_);
-    if (!out) log().error("cannot write {}", summary_file_);
+    if (!out) log().error("cannot write {}", settings_.summary_file);
   }
 
-  std::string constellation_;
-  std::string summary_file_;
   FollowEvaluator evaluator_;
   std::deque<std::pair<int64_t, Eigen::Isometry3d>> camera_poses_;  // stamp, pose; oldest first
   std::map<std::string, RateCounter> rates_;

@@ -136,9 +136,6 @@ class PoseOutputs final : public Component {
   explicit PoseOutputs(Context& context)
       : Component(context),
         in_world_(settings_.parent == "world"),
-        world_frame_(settings_.world_frame),
-        optical_frame_(settings_.optical_frame),
-        child_prefix_(settings_.child_frame_prefix),
         pose_rate_(settings_.pose_rate_hz),
         odom_rate_(settings_.odom_rate_hz),
         tf_rate_(settings_.tf_rate_hz) {
@@ -147,9 +144,9 @@ class PoseOutputs final : public Component {
       throw std::invalid_argument("parent: '" + parent + "'; expected camera or world");
     }
     const std::string camera_frame = settings_.camera_frame;
-    for (const auto& [name, value] : {std::pair{"world_frame", world_frame_},
+    for (const auto& [name, value] : {std::pair{"world_frame", settings_.world_frame},
                                       {"camera_frame", camera_frame},
-                                      {"optical_frame", optical_frame_}}) {
+                                      {"optical_frame", settings_.optical_frame}}) {
       if (value.empty()) throw std::invalid_argument(std::string(name) + " is empty");
     }
     const Eigen::Isometry3d world_from_camera =
@@ -166,24 +163,26 @@ class PoseOutputs final : public Component {
     TFMessage mounted;
     std_msgs::msg::Header header;
     header.stamp(to_time_msg(now()));
-    header.frame_id(world_frame_);
+    header.frame_id(settings_.world_frame);
     mounted.transforms().push_back(to_transform(header, camera_frame, world_from_camera));
     header.frame_id(camera_frame);
-    mounted.transforms().push_back(to_transform(header, optical_frame_, camera_from_optical));
+    mounted.transforms().push_back(
+        to_transform(header, settings_.optical_frame, camera_from_optical));
     create_publisher<TFMessage>(topics::kTfStatic).publish(mounted);
 
     log().info(
         "boards of {} in frame {} on /mocap/<board>/pose, /mocap/<board>/odom and /tf; "
         "{} -> {} -> {} on /tf_static",
-        topics::kPoses, in_world_ ? world_frame_ : optical_frame_, world_frame_, camera_frame,
-        optical_frame_);
+        topics::kPoses, in_world_ ? settings_.world_frame : settings_.optical_frame,
+        settings_.world_frame, camera_frame, settings_.optical_frame);
   }
 
   ~PoseOutputs() override {
     log().info(
         "{} pose arrays: {} boards published; {} poses in another frame than {}, {} "
         "invalid, {} boards without per-board topics",
-        arrays_, boards_published_, wrong_frame_, optical_frame_, invalid_, unpublishable_.size());
+        arrays_, boards_published_, wrong_frame_, settings_.optical_frame, invalid_,
+        unpublishable_.size());
   }
 
  private:
@@ -198,11 +197,11 @@ class PoseOutputs final : public Component {
     for (const ConstellationPose& pose : poses.poses()) {
       std_msgs::msg::Header header = pose.pose().header();
       if (header.frame_id().empty()) header.frame_id(poses.header().frame_id());
-      if (header.frame_id().empty()) header.frame_id(optical_frame_);
-      if (header.frame_id() != optical_frame_) {
+      if (header.frame_id().empty()) header.frame_id(settings_.optical_frame);
+      if (header.frame_id() != settings_.optical_frame) {
         if (wrong_frame_++ == 0) {
           log().warn("a pose in frame '{}', not optical_frame '{}': skipped (and counted)",
-                     header.frame_id(), optical_frame_);
+                     header.frame_id(), settings_.optical_frame);
         }
         continue;
       }
@@ -214,10 +213,10 @@ class PoseOutputs final : public Component {
       BodyState board = *measured;
       if (in_world_) {
         board = seen_from(world_from_optical_, board);
-        header.frame_id(world_frame_);
+        header.frame_id(settings_.world_frame);
       }
       const int64_t stamp_ns = to_nanoseconds(header.stamp());
-      const std::string child = child_prefix_ + pose.name();
+      const std::string child = settings_.child_frame_prefix + pose.name();
       ++boards_published_;
       if (tf_rate_.due(pose.name(), stamp_ns)) {
         transforms.transforms().push_back(to_transform(header, child, board.parent_from_body));
@@ -265,9 +264,6 @@ class PoseOutputs final : public Component {
   }
 
   const bool in_world_;
-  const std::string world_frame_;
-  const std::string optical_frame_;
-  const std::string child_prefix_;
   Eigen::Isometry3d world_from_optical_ = Eigen::Isometry3d::Identity();
   StampRate pose_rate_, odom_rate_, tf_rate_;
   Publisher<TFMessage> tf_;

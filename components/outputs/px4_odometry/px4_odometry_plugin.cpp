@@ -96,12 +96,10 @@ class Px4OdometryComponent final : public Component {
                                     "the vehicle's odometry");
   }
 
-  explicit Px4OdometryComponent(Context& context)
-      : Component(context),
-        board_(settings_.board),
-        optical_frame_(settings_.optical_frame),
-        rate_(settings_.rate_hz) {
-    if (board_.empty()) throw std::invalid_argument("board: name the board the vehicle carries");
+  explicit Px4OdometryComponent(Context& context) : Component(context), rate_(settings_.rate_hz) {
+    if (settings_.board.empty()) {
+      throw std::invalid_argument("board: name the board the vehicle carries");
+    }
     const std::string frame = settings_.pose_frame;
     if (frame != "frd" && frame != "ned") {
       throw std::invalid_argument("pose_frame: '" + frame + "'; expected frd or ned");
@@ -114,7 +112,7 @@ class Px4OdometryComponent final : public Component {
     publisher_ = create_publisher<VehicleOdometry>(topics::kPx4VisualOdometry);
     create_subscription<ConstellationPoseArray>(
         topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
-    log().info("{} as PX4 odometry ({} world, FRD body) at {} on {}", board_,
+    log().info("{} as PX4 odometry ({} world, FRD body) at {} on {}", settings_.board,
                frame == "ned" ? "NED" : "FRD",
                rate > 0 ? fmt::format("{} Hz at most", rate) : std::string("every frame"),
                topics::kPx4VisualOdometry);
@@ -122,26 +120,26 @@ class Px4OdometryComponent final : public Component {
 
   ~Px4OdometryComponent() override {
     log().info("{} messages sent; {} poses of {} skipped for the rate, {} in another frame", sent_,
-               skipped_for_rate_, board_, wrong_frame_);
+               skipped_for_rate_, settings_.board, wrong_frame_);
   }
 
  private:
   void on_poses(const ConstellationPoseArray& poses) {
     for (const ConstellationPose& pose : poses.poses()) {
-      if (pose.name() != board_) continue;
+      if (pose.name() != settings_.board) continue;
       std::string frame_id = pose.pose().header().frame_id();
       if (frame_id.empty()) frame_id = poses.header().frame_id();
-      if (!frame_id.empty() && frame_id != optical_frame_) {
+      if (!frame_id.empty() && frame_id != settings_.optical_frame) {
         if (wrong_frame_++ == 0) {
-          log().warn("{} in frame '{}', not optical_frame '{}': skipped (and counted)", board_,
-                     frame_id, optical_frame_);
+          log().warn("{} in frame '{}', not optical_frame '{}': skipped (and counted)",
+                     settings_.board, frame_id, settings_.optical_frame);
         }
         continue;
       }
       const std::optional<BodyState> board = body_state(pose);
       if (!board) continue;
       const int64_t stamp_ns = to_nanoseconds(pose.pose().header().stamp());
-      if (!rate_.due(board_, stamp_ns)) {
+      if (!rate_.due(settings_.board, stamp_ns)) {
         ++skipped_for_rate_;
         continue;
       }
@@ -170,8 +168,6 @@ class Px4OdometryComponent final : public Component {
     }
   }
 
-  const std::string board_;
-  const std::string optical_frame_;
   Px4Frame frame_ = Px4Frame::Frd;
   Eigen::Isometry3d world_from_optical_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d board_from_vehicle_ = Eigen::Isometry3d::Identity();

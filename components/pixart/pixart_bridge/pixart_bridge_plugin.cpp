@@ -72,19 +72,18 @@ class PixartBridge final : public Component {
   }
 
   explicit PixartBridge(Context& context) : Component(context), decoder_(settings_) {
-    source_kind_ = settings_.source;
-    if (source_kind_ != "slcan" && source_kind_ != "socketcan" && source_kind_ != "candump") {
-      throw std::invalid_argument("parameter 'source' is '" + source_kind_ +
+    if (settings_.source != "slcan" && settings_.source != "socketcan" &&
+        settings_.source != "candump") {
+      throw std::invalid_argument("parameter 'source' is '" + settings_.source +
                                   "'; expected slcan, socketcan or candump");
     }
-    camera_names_ = settings_.camera_names;
     raw_ = create_publisher<mocap_msgs::msg::PixartRawPointArray>(topics::kPixartRaw);
     for (int camera = 0; camera < 4 * settings_.boxes; ++camera) {
       fiducials_.push_back(create_publisher<mocap_msgs::msg::FiducialArray>(
           topics::member_of(topics::kPixartFiducials, camera_name(camera))));
     }
     // A log must exist now: a typo is an error at start, not a retry loop.
-    if (source_kind_ == "candump") source_ = open();
+    if (settings_.source == "candump") source_ = open();
     // Reading starts with the graph (once the host has started every component), so no frame
     // is published before the subscribers exist.
     create_worker("reader", [this](std::stop_token stop) { read_loop(stop); });
@@ -109,15 +108,17 @@ class PixartBridge final : public Component {
   }
 
   std::string camera_name(int camera) const {
-    if (camera < static_cast<int>(camera_names_.size())) return camera_names_[camera];
+    if (camera < static_cast<int>(settings_.camera_names.size())) {
+      return settings_.camera_names[camera];
+    }
     return "camera" + std::to_string(camera);
   }
 
   std::unique_ptr<can::CanSource> open() {
-    if (source_kind_ == "slcan") {
+    if (settings_.source == "slcan") {
       return can::open_slcan(settings_.slcan);
     }
-    if (source_kind_ == "socketcan") return can::open_socketcan(settings_.interface);
+    if (settings_.source == "socketcan") return can::open_socketcan(settings_.interface);
     return can::open_candump(settings_.candump);
   }
 
@@ -126,7 +127,7 @@ class PixartBridge final : public Component {
   void read_loop(const std::stop_token& stop) {
     // A log replayed as fast as possible would be over before subscribers in other processes
     // are discovered: it waits for one.
-    while (source_kind_ == "candump" && !subscribed()) {
+    while (settings_.source == "candump" && !subscribed()) {
       if (!wait_for_stop(stop, std::chrono::milliseconds(10))) return;
     }
     std::chrono::milliseconds backoff(100);
@@ -198,8 +199,6 @@ class PixartBridge final : public Component {
 
   PixartDecoder decoder_;
   CameraSampleAssembler assembler_;
-  std::string source_kind_;
-  std::vector<std::string> camera_names_;
   std::unique_ptr<can::CanSource> source_;
   Publisher<mocap_msgs::msg::PixartRawPointArray> raw_;
   std::vector<Publisher<mocap_msgs::msg::FiducialArray>> fiducials_;

@@ -42,7 +42,6 @@ class FiducialPatternSource final : public Component {
   }
 
   explicit FiducialPatternSource(Context& context) : Component(context) {
-    frame_id_ = settings_.frame_id;
     publisher_ = create_publisher<mocap_msgs::msg::FiducialArray>(topics::kDemoFiducials);
     auto period = std::chrono::duration<double>(1.0 / settings_.rate_hz);
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), [this] { tick(); });
@@ -56,7 +55,7 @@ class FiducialPatternSource final : public Component {
     double t = std::chrono::duration<double>(now - start_).count();
     auto message = std::make_shared<mocap_msgs::msg::FiducialArray>();
     message->header().stamp(to_time_msg(now));
-    message->header().frame_id(frame_id_);
+    message->header().frame_id(settings_.frame_id);
     for (const PatternPoint& point : fiducial_pattern(settings_, t)) {
       mocap_msgs::msg::Fiducial fiducial;
       fiducial.x(static_cast<float>(point.x));
@@ -68,7 +67,6 @@ class FiducialPatternSource final : public Component {
     publisher_.publish(std::move(message));
   }
 
-  std::string frame_id_;
   Clock::time_point start_ = Clock::now();
   Publisher<mocap_msgs::msg::FiducialArray> publisher_;
 };

@@ -107,9 +107,7 @@ class MobileBaseSim final : public Component {
               {settings_.max_linear_mps, settings_.max_angular_rps}),
         turret_(turret::load_turret(settings_.turret)),
         timeout_(std::chrono::duration_cast<SteadyClock::duration>(
-            std::chrono::duration<double>(settings_.cmd_vel_timeout_s))),
-        pan_joint_(settings_.pan_joint),
-        tilt_joint_(settings_.tilt_joint) {
+            std::chrono::duration<double>(settings_.cmd_vel_timeout_s))) {
     base_publisher_ = create_publisher<PoseStamped>(topics::kBasePose);
     camera_publisher_ = create_publisher<PoseStamped>(topics::kSimCameraPose);
     create_subscription<Twist>(topics::kCmdVel, [this](const Twist& twist) { on_command(twist); });
@@ -144,8 +142,8 @@ class MobileBaseSim final : public Component {
   void on_joint_state(const JointState& state) {
     std::optional<double> pan, tilt;
     for (size_t i = 0; i < state.name().size() && i < state.position().size(); ++i) {
-      if (state.name()[i] == pan_joint_) pan = state.position()[i];
-      if (state.name()[i] == tilt_joint_) tilt = state.position()[i];
+      if (state.name()[i] == settings_.pan_joint) pan = state.position()[i];
+      if (state.name()[i] == settings_.tilt_joint) tilt = state.position()[i];
     }
     if (pan && std::isfinite(*pan)) joints_.pan = *pan;
     if (tilt && std::isfinite(*tilt)) joints_.tilt = *tilt;
@@ -184,8 +182,6 @@ class MobileBaseSim final : public Component {
   UnicycleBase base_;
   turret::TurretModel turret_;
   SteadyClock::duration timeout_;
-  std::string pan_joint_;
-  std::string tilt_joint_;
   Publisher<PoseStamped> base_publisher_;
   Publisher<PoseStamped> camera_publisher_;
   std::optional<std::pair<double, double>> command_;  // linear, angular

@@ -145,25 +145,23 @@ class PixartBoxSim final : public Component {
   }
 
   explicit PixartBoxSim(Context& context) : Component(context) {
-    output_ = settings_.output;
-    if (output_ != "pty" && output_ != "candump") {
-      throw std::invalid_argument("parameter 'output' is '" + output_ +
+    if (settings_.output != "pty" && settings_.output != "candump") {
+      throw std::invalid_argument("parameter 'output' is '" + settings_.output +
                                   "'; expected pty or candump");
     }
     Rig rig = load_rig(settings_.rig);
     PixartScene scene = load_pixart_scene(settings_.scene, rig);
     const size_t cameras = rig.cameras.size(), objects = scene.objects.size();
     simulator_ = std::make_unique<PixartBoxSimulator>(std::move(rig), std::move(scene), settings_);
-    rate_hz_ = settings_.rate_hz;
     scene_start_ = Steady::now();
     scene_start_wall_ns_ = wall_clock_ns();
 
-    if (output_ == "candump") {
+    if (settings_.output == "candump") {
       start_log(cameras, objects);
       return;
     }
-    bitrate_ = settings_.bitrate;
-    can::slcan_open_commands(bitrate_);  // throws, naming the supported bitrates, for others
+    // Checks the bitrate: throws, naming the supported ones, for any other.
+    can::slcan_open_commands(settings_.bitrate);
     truths_ = create_publisher<mocap_msgs::msg::RobotPoseArray>(topics::kPixartGroundTruth);
     pty_.emplace(serial::PseudoTerminalOptions{.write_timeout = kPtyWriteTimeout});
     const std::string link = settings_.device_link;
@@ -172,7 +170,7 @@ class PixartBoxSim final : public Component {
     }
     log().info("simulated SLCAN adaptor on {}{}: {} cameras, {} objects, {} Hz, {} bit/s",
                pty_->slave_path(), link.empty() ? "" : " (link " + link + ")", cameras, objects,
-               rate_hz_, bitrate_);
+               settings_.rate_hz, settings_.bitrate);
     if (const double truth_rate = settings_.truth_rate_hz; truth_rate > 0) {
       create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
                        std::chrono::duration<double>(1 / truth_rate)),
@@ -210,13 +208,13 @@ class PixartBoxSim final : public Component {
     const double start_s = settings_.start_stamp_s;
     CandumpRecordingOptions options{
         .duration_s = settings_.duration_s,
-        .rate_hz = rate_hz_,
+        .rate_hz = settings_.rate_hz,
         .start_ns =
             start_s > 0 ? static_cast<int64_t>(std::llround(start_s * 1e9)) : wall_clock_ns(),
         .truth = truth_file.empty() ? nullptr : &truth_stream_,
         .truth_rate_hz = truth_rate};
     log().info("writing {} s of {} cameras, {} objects at {} Hz to {}{}", options.duration_s,
-               cameras, objects, rate_hz_, file,
+               cameras, objects, settings_.rate_hz, file,
                truth_file.empty() ? "" : ", ground truth to " + truth_file);
     create_worker("candump log", [this, options, file, partial, truth_file](std::stop_token stop) {
       try {
@@ -252,7 +250,7 @@ class PixartBoxSim final : public Component {
   // Plays the adaptor until stopped: answers the host's commands as they come and sends each
   // sample when its time comes.
   void play_adaptor(std::stop_token stop) {
-    const SampleSchedule schedule(rate_hz_);
+    const SampleSchedule schedule(settings_.rate_hz);
     uint64_t next = 0;
     char buffer[512];
     while (!stop.stop_requested()) {
@@ -277,7 +275,7 @@ class PixartBoxSim final : public Component {
       // those in between are skipped.
       uint64_t first = due->index;
       if (adaptor_.timestamps()) {
-        first -= std::min(due->skipped, static_cast<uint64_t>(kCatchUp_s * rate_hz_));
+        first -= std::min(due->skipped, static_cast<uint64_t>(kCatchUp_s * settings_.rate_hz));
       }
       skipped_ += first - next;
       for (uint64_t index = first; index <= due->index; ++index) {
@@ -297,9 +295,9 @@ class PixartBoxSim final : public Component {
     if (adaptor_.is_open() != was_open) {
       if (adaptor_.is_open()) {
         log().info("host opened the channel at {} bit/s", *adaptor_.bitrate());
-        if (*adaptor_.bitrate() != bitrate_) {
-          log().warn("the box sends at {} bit/s: the host at {} bit/s receives nothing", bitrate_,
-                     *adaptor_.bitrate());
+        if (*adaptor_.bitrate() != settings_.bitrate) {
+          log().warn("the box sends at {} bit/s: the host at {} bit/s receives nothing",
+                     settings_.bitrate, *adaptor_.bitrate());
         }
       } else {
         log().info("host closed the channel");
@@ -314,7 +312,7 @@ class PixartBoxSim final : public Component {
   }
 
   void send_sample(double time_s) {
-    if (!adaptor_.is_open() || adaptor_.bitrate() != bitrate_ || !pty_->peer_connected()) {
+    if (!adaptor_.is_open() || adaptor_.bitrate() != settings_.bitrate || !pty_->peer_connected()) {
       ++held_back_;
       return;
     }
@@ -350,10 +348,7 @@ class PixartBoxSim final : public Component {
     truths_.publish(std::move(message));
   }
 
-  std::string output_;
   std::unique_ptr<PixartBoxSimulator> simulator_;
-  double rate_hz_ = 270;
-  int bitrate_ = 1000000;
   Steady::time_point scene_start_;
   int64_t scene_start_wall_ns_ = 0;  // scene_start_ on the wall clock, for frame timestamps
   Publisher<mocap_msgs::msg::RobotPoseArray> truths_;

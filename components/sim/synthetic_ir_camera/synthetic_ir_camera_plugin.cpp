@@ -129,7 +129,6 @@ class SyntheticIrCamera final : public Component {
 
     frame_id_ = settings_.frame_id;
     if (frame_id_.empty()) frame_id_ = camera.frame_id;
-    max_frames_ = settings_.max_frames;
     wait_for_subscriber_ = settings_.wait_for_subscriber;
     double rate_hz = settings_.rate_hz;
     time_step_s_ = settings_.time_step_s;
@@ -172,7 +171,7 @@ class SyntheticIrCamera final : public Component {
       }
       wait_for_subscriber_ = false;
     }
-    if (max_frames_ > 0 && frames_ >= static_cast<uint64_t>(max_frames_)) {
+    if (settings_.max_frames > 0 && frames_ >= static_cast<uint64_t>(settings_.max_frames)) {
       if (!reported_end_) {
         log().info("published {} frames (max_frames); no more", frames_);
         reported_end_ = true;
@@ -227,7 +226,6 @@ class SyntheticIrCamera final : public Component {
   std::unique_ptr<IrRenderer> renderer_;
   sensor_msgs::msg::CameraInfo camera_info_;  // without header
   std::string frame_id_;
-  int64_t max_frames_ = 0;
   bool wait_for_subscriber_ = true;
   bool reported_waiting_ = false;
   double time_step_s_ = 0;

@@ -76,16 +76,14 @@ class CameraSource final : public Component {
 
   explicit CameraSource(Context& context) : Component(context) {
     source_ = open_source();
-    frame_id_ = settings_.frame_id;
-    rate_hz_ = settings_.rate_hz;
     wait_for_subscriber_ = settings_.wait_for_subscriber && !source_->is_live();
     publisher_ = create_publisher<sensor_msgs::msg::Image>(topics::kCameraImage);
     if (source_->is_live()) {
       log().info("publishing {} on {} at the device's rate", source_->description(),
                  publisher_.topic());
-    } else if (rate_hz_ > 0) {
+    } else if (settings_.rate_hz > 0) {
       log().info("publishing {} on {} at {} Hz", source_->description(), publisher_.topic(),
-                 rate_hz_);
+                 settings_.rate_hz);
     } else {
       log().info("publishing {} on {} as fast as possible", source_->description(),
                  publisher_.topic());
@@ -126,9 +124,10 @@ class CameraSource final : public Component {
       while (wait_for_subscriber_ && publisher_.matched_subscribers() == 0) {
         if (!wait_for_stop(stop, std::chrono::milliseconds(10))) return;
       }
-      const auto period = rate_hz_ > 0 ? std::chrono::duration_cast<Steady::duration>(
-                                             std::chrono::duration<double>(1.0 / rate_hz_))
-                                       : Steady::duration::zero();
+      const auto period = settings_.rate_hz > 0
+                              ? std::chrono::duration_cast<Steady::duration>(
+                                    std::chrono::duration<double>(1.0 / settings_.rate_hz))
+                              : Steady::duration::zero();
       Steady::time_point next = Steady::now();
       cv::Mat frame;
       while (!stop.stop_requested()) {
@@ -138,7 +137,7 @@ class CameraSource final : public Component {
         }
         auto message = std::make_shared<sensor_msgs::msg::Image>();
         message->header().stamp(to_time_msg(now()));
-        message->header().frame_id(frame_id_);
+        message->header().frame_id(settings_.frame_id);
         fill_image_message(frame, *message);
         publisher_.publish(std::move(message));
         published_.fetch_add(1);
@@ -155,8 +154,6 @@ class CameraSource final : public Component {
   }
 
   std::unique_ptr<FrameSource> source_;
-  std::string frame_id_;
-  double rate_hz_ = 0;
   bool wait_for_subscriber_ = true;
   Publisher<sensor_msgs::msg::Image> publisher_;
   std::atomic<uint64_t> published_{0};

@@ -33,7 +33,6 @@ class FiducialMonitor final : public Component {
   }
 
   explicit FiducialMonitor(Context& context) : Component(context) {
-    period_s_ = settings_.report_period_s;
     create_subscription<mocap_msgs::msg::FiducialArray>(
         topics::kDemoFiducials, [this](const mocap_msgs::msg::FiducialArray& array) {
           double latency =
@@ -41,7 +40,7 @@ class FiducialMonitor final : public Component {
           statistics_.add(latency, array.fiducials().size());
         });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::duration<double>(period_s_)),
+                     std::chrono::duration<double>(settings_.report_period_s)),
                  [this] { report(); });
   }
 
@@ -53,17 +52,16 @@ class FiducialMonitor final : public Component {
   void report() {
     auto r = statistics_.report();
     if (!r) {
-      log().info("nothing received in the last {} s", period_s_);
+      log().info("nothing received in the last {} s", settings_.report_period_s);
       return;
     }
     log().info(
         "{} arrays ({:.1f}/s), {:.1f} fiducials each, latency median {:.3f} ms, "
         "p99 {:.3f} ms, max {:.3f} ms",
-        r->messages, static_cast<double>(r->messages) / period_s_, r->mean_items,
+        r->messages, static_cast<double>(r->messages) / settings_.report_period_s, r->mean_items,
         r->latency_median_s * 1e3, r->latency_p99_s * 1e3, r->latency_max_s * 1e3);
   }
 
-  double period_s_;
   StreamStatistics statistics_;
 };
 

@@ -65,10 +65,11 @@ class OverlayComponent final : public Component {
 
   explicit OverlayComponent(Context& context) : Component(context) {
     camera_ = calibration::load_camera_file(settings_.camera);
-    snapshot_directory_ = settings_.snapshot_directory;
     snapshot_period_ = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(settings_.snapshot_period_s));
-    if (!snapshot_directory_.empty()) std::filesystem::create_directories(snapshot_directory_);
+    if (!settings_.snapshot_directory.empty()) {
+      std::filesystem::create_directories(settings_.snapshot_directory);
+    }
     publisher_ = create_publisher<sensor_msgs::msg::Image>(topics::kOverlay);
     create_subscription<sensor_msgs::msg::Image>(
         topics::kCameraImage, [this](const std::shared_ptr<const sensor_msgs::msg::Image>& image) {
@@ -147,16 +148,16 @@ class OverlayComponent final : public Component {
   }
 
   void save_snapshot(const cv::Mat& picture) {
-    if (snapshot_directory_.empty()) return;
+    if (settings_.snapshot_directory.empty()) return;
     Clock::time_point t = now();
     if (snapshots_ > 0 && t - last_snapshot_ < snapshot_period_) return;
     last_snapshot_ = t;
-    std::string path = fmt::format("{}/overlay_{:05d}.png", snapshot_directory_, snapshots_++);
+    std::string path =
+        fmt::format("{}/overlay_{:05d}.png", settings_.snapshot_directory, snapshots_++);
     if (std::string error = write_png(path, picture); !error.empty()) log().warn("{}", error);
   }
 
   calibration::CameraFile camera_;
-  std::string snapshot_directory_;
   Clock::duration snapshot_period_{};
   Clock::time_point last_snapshot_{};
   int snapshots_ = 0;

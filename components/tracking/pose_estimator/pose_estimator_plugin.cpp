@@ -59,8 +59,7 @@ class PoseEstimatorComponent final : public Component {
   explicit PoseEstimatorComponent(Context& context)
       : Component(context),
         database_(settings_.boards.load()),
-        camera_(calibration::load_camera_file(settings_.camera)),
-        options_(settings_) {
+        camera_(calibration::load_camera_file(settings_.camera)) {
     publisher_ = create_publisher<mocap_msgs::msg::ConstellationPoseArray>(topics::kPoses);
     create_subscription<mocap_msgs::msg::ConstellationArray>(
         topics::kConstellations,
@@ -102,7 +101,7 @@ class PoseEstimatorComponent final : public Component {
         continue;
       }
       PlanarPose pose =
-          estimate_planar_pose(*camera_.model, pairs.object_points, pairs.pixels, options_);
+          estimate_planar_pose(*camera_.model, pairs.object_points, pairs.pixels, settings_);
       if (!pose.valid) {
         reject(constellation.name(), pose.rejection);
         continue;
@@ -139,7 +138,6 @@ class PoseEstimatorComponent final : public Component {
 
   constellations::ConstellationDatabase database_;
   calibration::CameraFile camera_;
-  PlanarPoseOptions options_;
   Publisher<mocap_msgs::msg::ConstellationPoseArray> publisher_;
   uint64_t published_ = 0, rejected_ = 0;
   Clock::time_point last_rejection_log_{};

@@ -84,9 +84,6 @@ class PoseEvaluatorComponent final : public Component {
 
   explicit PoseEvaluatorComponent(Context& context) : Component(context) {
     evaluator_ = PoseEvaluator(settings_);
-    stop_after_ = settings_.stop_after_frames;
-    summary_file_ = settings_.summary_file;
-    period_s_ = settings_.report_period_s;
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         topics::kGroundTruth, [this](const mocap_msgs::msg::ConstellationPoseArray& truth) {
           // Once stopping, frames still in flight are not counted: the summary covers
@@ -105,7 +102,7 @@ class PoseEvaluatorComponent final : public Component {
           check_done();
         });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                     std::chrono::duration<double>(period_s_)),
+                     std::chrono::duration<double>(settings_.report_period_s)),
                  [this] { report(); });
   }
 
@@ -119,14 +116,15 @@ class PoseEvaluatorComponent final : public Component {
                             window_latencies_s_.end());
     latencies_s_.clear();
     if (window.frames == 0) {
-      log().info("no frames evaluated in the last {} s ({} truth arrays so far)", period_s_,
-                 truth_arrays_);
+      log().info("no frames evaluated in the last {} s ({} truth arrays so far)",
+                 settings_.report_period_s, truth_arrays_);
       return;
     }
     log().info(
         "{:.1f} frames/s, latency {:.2f} ms (p99 {:.2f} ms), {} frame(s) lost, tracked {:.1f} %, "
         "position error {:.2f} mm, orientation error {:.3f} deg, false identifications {}",
-        window.frames / period_s_, EvaluationSummary::quantile(window_latencies_s_, 0.5) * 1e3,
+        window.frames / settings_.report_period_s,
+        EvaluationSummary::quantile(window_latencies_s_, 0.5) * 1e3,
         EvaluationSummary::quantile(window_latencies_s_, 0.99) * 1e3, window.frames_lost,
         window.tracked_percent(), EvaluationSummary::quantile(window.position_errors_m, 0.5) * 1e3,
         EvaluationSummary::quantile(window.orientation_errors_deg, 0.5),
@@ -134,7 +132,8 @@ class PoseEvaluatorComponent final : public Component {
   }
 
   void check_done() {
-    if (stop_after_ > 0 && !stopping_ && evaluator_.total().frames >= stop_after_) {
+    if (settings_.stop_after_frames > 0 && !stopping_ &&
+        evaluator_.total().frames >= settings_.stop_after_frames) {
       stopping_ = true;
       log().info("{} frames evaluated, stopping", evaluator_.total().frames);
       request_shutdown(0);
@@ -160,8 +159,8 @@ class PoseEvaluatorComponent final : public Component {
         q(total.velocity_errors_mps, 0.5) * 100, q(total.angular_velocity_errors_dps, 0.5),
         total.false_identifications, q(all_latencies_s_, 0.5) * 1e3,
         q(all_latencies_s_, 0.99) * 1e3);
-    if (summary_file_.empty()) return;
-    std::ofstream out(summary_file_);
+    if (settings_.summary_file.empty()) return;
+    std::ofstream out(settings_.summary_file);
     out << "frames: " << total.frames << "\nframes_lost: " << total.frames_lost
         << "\nexpected: " << total.expected << "\ntracked: " << total.tracked
         << "\nfalse_identifications: " << total.false_identifications
@@ -173,14 +172,11 @@ class PoseEvaluatorComponent final : public Component {
         << "\nvelocity_error_median_mps: " << q(total.velocity_errors_mps, 0.5)
         << "\nangular_velocity_error_median_dps: " << q(total.angular_velocity_errors_dps, 0.5)
         << "\nlatency_median_s: " << q(all_latencies_s_, 0.5) << "\n";
-    if (!out) log().error("cannot write {}", summary_file_);
+    if (!out) log().error("cannot write {}", settings_.summary_file);
   }
 
   PoseEvaluator evaluator_;
-  uint64_t stop_after_ = 0;
   bool stopping_ = false;
-  std::string summary_file_;
-  double period_s_ = 1;
   uint64_t truth_arrays_ = 0;
   std::vector<double> latencies_s_, window_latencies_s_, all_latencies_s_;
 };

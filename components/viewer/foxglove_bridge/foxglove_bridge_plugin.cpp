@@ -118,9 +118,6 @@ class FoxgloveBridge final : public Component {
       image_period_ = std::chrono::duration_cast<Clock::duration>(
           std::chrono::duration<double>(1.0 / image_rate));
     }
-    queue_options_ = settings_.queue;
-
-    client_publish_ = settings_.client_publish;
     const std::vector<KnownTopic> declared = context.known_topics();
     for (const KnownTopic& topic : declared) {
       if (offered(topic)) declared_.insert(topic.topic);
@@ -161,7 +158,7 @@ class FoxgloveBridge final : public Component {
         "Foxglove WebSocket server on {0}://{1}:{2} offering {3} topic(s){4}{5}; the viewer: "
         "{6}://{1}:{2}/",
         tls ? "wss" : "ws", options.address, server_->port(), channels_.size(),
-        client_publish_ ? ", clients may publish" : "",
+        settings_.client_publish ? ", clients may publish" : "",
         options.token.empty() ? "" : ", token required", tls ? "https" : "http");
     if (server_->loopback_only()) {
       log().info("{} (this machine only)", served);
@@ -300,14 +297,14 @@ class FoxgloveBridge final : public Component {
   void opened(ClientId client) {
     std::string session = std::to_string(getpid());
     std::vector<std::string> capabilities;
-    if (client_publish_) capabilities.push_back("clientPublish");
+    if (settings_.client_publish) capabilities.push_back("clientPublish");
     std::lock_guard lock(mutex_);
     server_->send_text(client, server_info("mocap-graph", capabilities, {"cdr"},
                                            {{"graph", context().name()}}, session));
     std::vector<Channel> list;
     for (const auto& [id, state] : channels_) list.push_back(state.channel);
     server_->send_text(client, advertise(list));
-    clients_.emplace(client, ClientState(queue_options_));
+    clients_.emplace(client, ClientState(settings_.queue));
     ++clients_served_;
   }
 
@@ -356,7 +353,7 @@ class FoxgloveBridge final : public Component {
                              unsubscribe->subscription_ids.end());
       std::erase_if(state->second.subscription_of_channel,
                     [&](const auto& entry) { return ids.contains(entry.second); });
-    } else if (!client_publish_) {
+    } else if (!settings_.client_publish) {
       refuse(client, "client publishing is off (client_publish: false)");
     } else if (auto* advertised = std::get_if<ClientAdvertise>(&*request)) {
       client_advertised(client, *advertised);
@@ -406,7 +403,7 @@ class FoxgloveBridge final : public Component {
   // A client's Message Data: decoded here, so that a malformed payload closes that client,
   // and published on the bridge's next turn.
   void received_binary(ClientId client, const std::string& frame) {
-    if (!client_publish_) {
+    if (!settings_.client_publish) {
       refuse(client, "client publishing is off (client_publish: false)");
       return;
     }
@@ -555,11 +552,9 @@ class FoxgloveBridge final : public Component {
   }
 
   std::regex allowed_;
-  bool client_publish_ = false;
   std::set<std::string> declared_;      // offered topics of the launch file: always present
   std::set<std::string> warned_types_;  // topics published with two types, warned about once
   Clock::duration image_period_{};
-  ClientQueueOptions queue_options_;
   std::map<std::string, std::shared_ptr<PublisherPort>> publishers_;  // for clients, by topic
   std::mutex mutex_;                                                  // guards what follows
   std::map<std::string, TopicState> topics_;
