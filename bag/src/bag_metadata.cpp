@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
+#include <mocap/config_reader.hpp>
 
 namespace mocap::bag {
 namespace {
@@ -65,35 +66,39 @@ std::string yaml_scalar(std::string_view text) {
   return out;
 }
 
-// Walks a parsed metadata.yaml, naming the key in every error.
-class Reader {
+// Walks a parsed metadata.yaml, naming the line and the key's path in every error
+// ("metadata.yaml:3: rosbag2_bagfile_information.version: 10 is not supported"). Keys it does
+// not know are left alone: rosbag2 adds keys from version to version.
+class Reader : public ConfigReader<BagError> {
  public:
-  explicit Reader(const std::string& source) : source_(source) {}
+  using ConfigReader::ConfigReader;
 
-  [[noreturn]] void fail(const std::string& key, std::string_view why) const {
-    throw BagError(fmt::format("{}: {}: {}", source_, key, why));
+  // `path` at `node` is wrong: `why`.
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
+                         std::string_view why) const {
+    ConfigReader::fail(node, fmt::format("{}: {}", path, why));
   }
 
   YAML::Node required(const YAML::Node& map, const std::string& key,
                       const std::string& path) const {
     YAML::Node node = optional(map, key, path);
-    if (!node) fail(path + "." + key, "missing");
+    if (!node) fail(map, path + "." + key, "missing");
     return node;
   }
 
   YAML::Node optional(const YAML::Node& map, const std::string& key,
                       const std::string& path) const {
-    if (!map.IsMap()) fail(path, "not a map");
+    if (!map.IsMap()) fail(map, path, "not a map");
     return map[key];
   }
 
   template <typename T>
   T value(const YAML::Node& node, const std::string& path, std::string_view expected) const {
-    if (!node.IsScalar()) fail(path, fmt::format("not {}", expected));
+    if (!node.IsScalar()) fail(node, path, fmt::format("not {}", expected));
     try {
       return node.as<T>();
     } catch (const YAML::Exception&) {
-      fail(path, fmt::format("\"{}\" is not {}", node.Scalar(), expected));
+      fail(node, path, fmt::format("\"{}\" is not {}", node.Scalar(), expected));
     }
   }
 
@@ -110,12 +115,9 @@ class Reader {
   YAML::Node sequence(const YAML::Node& map, const std::string& key,
                       const std::string& path) const {
     YAML::Node node = optional(map, key, path);
-    if (node && !node.IsNull() && !node.IsSequence()) fail(path + "." + key, "not a list");
+    if (node && !node.IsNull() && !node.IsSequence()) fail(node, path + "." + key, "not a list");
     return node;
   }
-
- private:
-  const std::string& source_;
 };
 
 std::optional<int64_t> int_at(const YAML::Node& map, const char* key) {
@@ -138,6 +140,68 @@ std::optional<int64_t> policy_at(const YAML::Node& map, const char* key,
     if (node.Scalar() == name) return value;
   }
   return std::nullopt;
+}
+
+// rosbag2_bagfile_information.topics_with_message_count.
+std::vector<BagTopic> read_topics(const Reader& reader, const YAML::Node& root,
+                                  const std::string& root_path) {
+  std::vector<BagTopic> topics_read;
+  const std::string topics_path = root_path + ".topics_with_message_count";
+  if (YAML::Node topics = reader.sequence(root, "topics_with_message_count", root_path);
+      topics && topics.IsSequence()) {
+    for (size_t i = 0; i < topics.size(); ++i) {
+      const std::string entry_path = fmt::format("{}[{}]", topics_path, i);
+      const YAML::Node entry = topics[i];
+      const std::string topic_path = entry_path + ".topic_metadata";
+      YAML::Node topic_node = reader.required(entry, "topic_metadata", entry_path);
+      BagTopic topic;
+      topic.name = reader.value<std::string>(reader.required(topic_node, "name", topic_path),
+                                             topic_path + ".name", "a string");
+      topic.type = reader.value<std::string>(reader.required(topic_node, "type", topic_path),
+                                             topic_path + ".type", "a string");
+      if (YAML::Node format = reader.optional(topic_node, "serialization_format", topic_path)) {
+        topic.serialization_format =
+            reader.value<std::string>(format, topic_path + ".serialization_format", "a string");
+      }
+      if (YAML::Node qos = reader.optional(topic_node, "offered_qos_profiles", topic_path)) {
+        // Jazzy writes the profiles as a YAML list rather than a string holding one.
+        topic.offered_qos = qos.IsScalar() ? parse_offered_qos_profiles(qos.Scalar())
+                                           : parse_offered_qos_profiles(YAML::Dump(qos));
+      }
+      if (YAML::Node count = reader.optional(entry, "message_count", entry_path)) {
+        topic.message_count =
+            reader.value<uint64_t>(count, entry_path + ".message_count", "a count");
+      }
+      topics_read.push_back(std::move(topic));
+    }
+  }
+
+  return topics_read;
+}
+
+// rosbag2_bagfile_information.files.
+std::vector<BagFile> read_files(const Reader& reader, const YAML::Node& root,
+                                const std::string& root_path) {
+  std::vector<BagFile> files_read;
+  const std::string files_path = root_path + ".files";
+  if (YAML::Node files = reader.sequence(root, "files", root_path); files && files.IsSequence()) {
+    for (size_t i = 0; i < files.size(); ++i) {
+      const std::string entry_path = fmt::format("{}[{}]", files_path, i);
+      const YAML::Node entry = files[i];
+      BagFile file;
+      file.path = reader.value<std::string>(reader.required(entry, "path", entry_path),
+                                            entry_path + ".path", "a string");
+      file.start_ns =
+          reader.nested_int(entry, "starting_time", "nanoseconds_since_epoch", entry_path, 0);
+      file.duration_ns = reader.nested_int(entry, "duration", "nanoseconds", entry_path, 0);
+      if (YAML::Node count = reader.optional(entry, "message_count", entry_path)) {
+        file.message_count =
+            reader.value<uint64_t>(count, entry_path + ".message_count", "a count");
+      }
+      files_read.push_back(std::move(file));
+    }
+  }
+  return files_read;
 }
 
 }  // namespace
@@ -282,29 +346,24 @@ std::string format_metadata_yaml(const BagMetadata& metadata) {
 }
 
 BagMetadata parse_metadata_yaml(const std::string& text, const std::string& source) {
-  YAML::Node document;
-  try {
-    document = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw BagError(fmt::format("{}: not YAML: line {}: {}", source, e.mark.line + 1, e.msg));
-  }
   Reader reader(source);
-  if (!document.IsMap()) reader.fail("rosbag2_bagfile_information", "missing");
+  YAML::Node document = reader.parse(text);
   const std::string root_path = "rosbag2_bagfile_information";
+  if (!document.IsMap()) reader.fail(document, root_path, "missing");
   YAML::Node root = reader.required(document, root_path, "");
-  if (!root.IsMap()) reader.fail(root_path, "not a map");
+  if (!root.IsMap()) reader.fail(root, root_path, "not a map");
 
   const auto version = reader.value<int64_t>(reader.required(root, "version", root_path),
                                              root_path + ".version", "an integer");
   if (version < 4 || version > 9) {
-    reader.fail(root_path + ".version",
+    reader.fail(root["version"], root_path + ".version",
                 fmt::format("{} is not supported (rosbag2 versions 4 to 9 are)", version));
   }
   std::string identifier = "sqlite3";
   if (YAML::Node storage = reader.optional(root, "storage_identifier", root_path)) {
     identifier = reader.value<std::string>(storage, root_path + ".storage_identifier", "a string");
     if (identifier != "sqlite3" && identifier != "mcap") {
-      reader.fail(root_path + ".storage_identifier",
+      reader.fail(storage, root_path + ".storage_identifier",
                   fmt::format("\"{}\" is not supported (sqlite3 and mcap are)", identifier));
     }
   }
@@ -312,7 +371,7 @@ BagMetadata parse_metadata_yaml(const std::string& text, const std::string& sour
     auto format =
         reader.value<std::string>(compression, root_path + ".compression_format", "a string");
     if (!format.empty()) {
-      reader.fail(root_path + ".compression_format",
+      reader.fail(compression, root_path + ".compression_format",
                   fmt::format("\"{}\": compressed bags are not supported", format));
     }
   }
@@ -326,54 +385,8 @@ BagMetadata parse_metadata_yaml(const std::string& text, const std::string& sour
     metadata.message_count = reader.value<uint64_t>(count, root_path + ".message_count", "a count");
   }
 
-  const std::string topics_path = root_path + ".topics_with_message_count";
-  if (YAML::Node topics = reader.sequence(root, "topics_with_message_count", root_path);
-      topics && topics.IsSequence()) {
-    for (size_t i = 0; i < topics.size(); ++i) {
-      const std::string entry_path = fmt::format("{}[{}]", topics_path, i);
-      const YAML::Node entry = topics[i];
-      const std::string topic_path = entry_path + ".topic_metadata";
-      YAML::Node topic_node = reader.required(entry, "topic_metadata", entry_path);
-      BagTopic topic;
-      topic.name = reader.value<std::string>(reader.required(topic_node, "name", topic_path),
-                                             topic_path + ".name", "a string");
-      topic.type = reader.value<std::string>(reader.required(topic_node, "type", topic_path),
-                                             topic_path + ".type", "a string");
-      if (YAML::Node format = reader.optional(topic_node, "serialization_format", topic_path)) {
-        topic.serialization_format =
-            reader.value<std::string>(format, topic_path + ".serialization_format", "a string");
-      }
-      if (YAML::Node qos = reader.optional(topic_node, "offered_qos_profiles", topic_path)) {
-        // Jazzy writes the profiles as a YAML list rather than a string holding one.
-        topic.offered_qos = qos.IsScalar() ? parse_offered_qos_profiles(qos.Scalar())
-                                           : parse_offered_qos_profiles(YAML::Dump(qos));
-      }
-      if (YAML::Node count = reader.optional(entry, "message_count", entry_path)) {
-        topic.message_count =
-            reader.value<uint64_t>(count, entry_path + ".message_count", "a count");
-      }
-      metadata.topics.push_back(std::move(topic));
-    }
-  }
-
-  const std::string files_path = root_path + ".files";
-  if (YAML::Node files = reader.sequence(root, "files", root_path); files && files.IsSequence()) {
-    for (size_t i = 0; i < files.size(); ++i) {
-      const std::string entry_path = fmt::format("{}[{}]", files_path, i);
-      const YAML::Node entry = files[i];
-      BagFile file;
-      file.path = reader.value<std::string>(reader.required(entry, "path", entry_path),
-                                            entry_path + ".path", "a string");
-      file.start_ns =
-          reader.nested_int(entry, "starting_time", "nanoseconds_since_epoch", entry_path, 0);
-      file.duration_ns = reader.nested_int(entry, "duration", "nanoseconds", entry_path, 0);
-      if (YAML::Node count = reader.optional(entry, "message_count", entry_path)) {
-        file.message_count =
-            reader.value<uint64_t>(count, entry_path + ".message_count", "a count");
-      }
-      metadata.files.push_back(std::move(file));
-    }
-  }
+  metadata.topics = read_topics(reader, root, root_path);
+  metadata.files = read_files(reader, root, root_path);
   // Version 4 has only the paths; later versions have both, and the paths are what rosbag2
   // opens.
   const std::string paths_path = root_path + ".relative_file_paths";

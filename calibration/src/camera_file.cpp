@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <mocap/calibration/camera_factory.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
+#include <mocap/config_reader.hpp>
 
 namespace mocap::calibration {
 namespace {
@@ -23,47 +24,21 @@ namespace {
 // decimals pass, a wrong element or a missing sign does not.
 constexpr double kQuaternionNormTolerance = 1e-3;
 
-class Reader {
+// The camera file's own fields over the common configuration reader. Keys the reader does not
+// know at the top are left alone: camera_info files hold rectification and projection matrices.
+class Reader : public ConfigReader<CameraFileError> {
  public:
-  Reader(const YAML::Node& root, std::string source) : root_(root), source_(std::move(source)) {}
+  Reader(const YAML::Node& root, std::string source)
+      : ConfigReader(std::move(source)), root_(root) {}
 
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    std::string where = source_;
-    if (node && node.Mark().line >= 0) where += ":" + std::to_string(node.Mark().line + 1);
-    throw CameraFileError(where + ": " + what);
-  }
-
-  YAML::Node required(const char* key) const { return required(root_, key, ""); }
-
-  // `map[key]`; `prefix` ("eucm.") completes the field's name in the error.
-  YAML::Node required(const YAML::Node& map, const char* key, const std::string& prefix) const {
-    YAML::Node node = map[key];
-    if (!node) fail(map, "missing field '" + prefix + key + "'");
-    return node;
-  }
-
-  // A map whose keys are all in `allowed`.
-  void check_map(const YAML::Node& node, const std::string& field,
-                 const std::vector<std::string_view>& allowed) const {
-    if (!node.IsMap()) fail(node, "'" + field + "' must be a map");
-    for (const auto& entry : node) {
-      std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "(not a name)";
-      bool known = false;
-      for (std::string_view name : allowed) known = known || key == name;
-      if (!known) {
-        std::string names;
-        for (std::string_view name : allowed)
-          names += (names.empty() ? "" : ", ") + std::string(name);
-        fail(entry.first, "unknown key '" + key + "' in '" + field + "' (" + names + ")");
-      }
-    }
-  }
+  using ConfigReader::required;
+  YAML::Node required(const char* key) const { return required(root_, key, "a camera file"); }
 
   int positive_int(const char* key) const {
     YAML::Node node = required(key);
     int value = 0;
     if (!node.IsScalar() || !YAML::convert<int>::decode(node, value) || value <= 0) {
-      fail(node, std::string("'") + key + "' must be a positive integer");
+      fail(node, fmt::format("'{}' must be a positive integer, not {}", key, describe(node)));
     }
     return value;
   }
@@ -71,43 +46,21 @@ class Reader {
   std::string text(const char* key, std::string fallback) const {
     YAML::Node node = root_[key];
     if (!node) return fallback;
-    if (!node.IsScalar()) fail(node, std::string("'") + key + "' must be a string");
+    if (!node.IsScalar())
+      fail(node, fmt::format("'{}' must be a text, not {}", key, describe(node)));
     return node.Scalar();
-  }
-
-  double number(const YAML::Node& node, const std::string& field) const {
-    double value = 0;
-    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
-      fail(node, "'" + field + "' holds '" + (node.IsScalar() ? node.Scalar() : "a non-number") +
-                     "', not a finite number");
-    }
-    return value;
-  }
-
-  // A list of `count` finite numbers.
-  std::vector<double> numbers(const YAML::Node& node, const std::string& field,
-                              size_t count) const {
-    if (!node.IsSequence()) fail(node, "'" + field + "' must be a list of numbers");
-    if (node.size() != count) {
-      fail(node, "'" + field + "' must have " + std::to_string(count) + " numbers, has " +
-                     std::to_string(node.size()));
-    }
-    std::vector<double> values;
-    for (const YAML::Node& element : node) values.push_back(number(element, field));
-    return values;
   }
 
   // The `data` of a {rows, cols, data} matrix, checked to hold `count` finite numbers.
   std::vector<double> matrix(const char* key, size_t count) const {
     YAML::Node node = required(key);
     YAML::Node data = node.IsMap() ? node["data"] : YAML::Node();
-    if (!data || !data.IsSequence()) fail(node, std::string("'") + key + "' needs a 'data' list");
+    if (!data || !data.IsSequence()) fail(node, fmt::format("'{}' needs a 'data' list", key));
     return numbers(data, std::string(key) + ".data", count);
   }
 
  private:
   YAML::Node root_;
-  std::string source_;
 };
 
 std::shared_ptr<const CameraModel> read_pinhole(const Reader& reader, const YAML::Node& root,
@@ -140,12 +93,13 @@ std::shared_ptr<const CameraModel> read_named_parameters(const Reader& reader,
                                                          int height) {
   const std::span<const std::string_view> keys = camera_parameter_names(model);
   YAML::Node node = reader.required(model.c_str());
-  reader.check_map(node, model, {keys.begin(), keys.end()});
+  const std::string what = "'" + model + "'";
+  reader.check_keys(node, std::vector<std::string>(keys.begin(), keys.end()), what);
   std::vector<double> parameters;
   for (std::string_view key : keys) {
     const std::string name(key);
     parameters.push_back(
-        reader.number(reader.required(node, name.c_str(), model + "."), model + "." + name));
+        reader.to_number(reader.required(node, name.c_str(), what), model + "." + name));
   }
   try {
     return make_camera_model(model, width, height, parameters);
@@ -155,10 +109,10 @@ std::shared_ptr<const CameraModel> read_named_parameters(const Reader& reader,
 }
 
 Eigen::Isometry3d read_pose(const Reader& reader, const YAML::Node& node) {
-  reader.check_map(node, "pose", {"translation", "rotation"});
+  reader.check_keys(node, {"translation", "rotation"}, "'pose'");
   std::vector<double> t =
-      reader.numbers(reader.required(node, "translation", "pose."), "pose.translation", 3);
-  YAML::Node rotation_node = reader.required(node, "rotation", "pose.");
+      reader.numbers(reader.required(node, "translation", "'pose'"), "pose.translation", 3);
+  YAML::Node rotation_node = reader.required(node, "rotation", "'pose'");
   std::vector<double> q = reader.numbers(rotation_node, "pose.rotation", 4);
   Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
   double norm = rotation.norm();
@@ -189,15 +143,7 @@ std::string quoted(const std::string& text) {
   return emitter.c_str();
 }
 
-}  // namespace
-
-CameraFile parse_camera_file(const std::string& text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw CameraFileError(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+CameraFile read_camera_file(const YAML::Node& root, const std::string& source) {
   if (!root.IsMap()) throw CameraFileError(source + ": a camera file is a YAML map");
   Reader reader(root, source);
   CameraFile camera;
@@ -219,14 +165,14 @@ CameraFile parse_camera_file(const std::string& text, const std::string& source)
   return camera;
 }
 
+}  // namespace
+
+CameraFile parse_camera_file(const std::string& text, const std::string& source) {
+  return read_camera_file(ConfigReader<CameraFileError>(source).parse(text), source);
+}
+
 CameraFile load_camera_file(const std::string& path) {
-  std::ifstream stream(path);
-  if (!stream) {
-    throw CameraFileError(path + ": cannot read the camera file: " + std::strerror(errno));
-  }
-  std::stringstream text;
-  text << stream.rdbuf();
-  return parse_camera_file(text.str(), path);
+  return read_camera_file(ConfigReader<CameraFileError>(path).load(), path);
 }
 
 std::string format_camera_file(const CameraFile& camera) {

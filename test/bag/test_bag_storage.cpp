@@ -2,7 +2,7 @@
 // schema, bags as ROS 2 Humble and Jazzy write them, a writer killed with SIGKILL, a full disk
 // (max_bytes and a real tmpfs), damaged files, and the writer's errors.
 //
-// Malformed metadata.yaml: the reader does not throw; it reports the parse error (file and
+// Malformed metadata.yaml: the reader does not throw; it reports the parse error (file, line and
 // key) in problems() and reads the directory's .db3 files instead (ReadDamage.
 // MalformedMetadataYamlFallsBackToTheDatabases).
 #include <fcntl.h>
@@ -1284,7 +1284,7 @@ TEST(ReadDamage, MalformedMetadataYamlFallsBackToTheDatabases) {
   EXPECT_EQ(back.sequences.size(), 50u);
   EXPECT_TRUE(consecutive_from_one(back.sequences));
 
-  // Other keys are named as precisely.
+  // Other keys are named as precisely, with their line.
   try {
     parse_metadata_yaml(
         "rosbag2_bagfile_information:\n  version: 5\n  topics_with_message_count:\n    - "
@@ -1292,7 +1292,7 @@ TEST(ReadDamage, MalformedMetadataYamlFallsBackToTheDatabases) {
         "m.yaml");
     FAIL();
   } catch (const BagError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("m.yaml: rosbag2_bagfile_information."
+    EXPECT_THAT(e.what(), HasSubstr("m.yaml:5: rosbag2_bagfile_information."
                                     "topics_with_message_count[0].topic_metadata.name: missing"));
   }
   EXPECT_THROW(parse_metadata_yaml("key: [unclosed", "m.yaml"), BagError);

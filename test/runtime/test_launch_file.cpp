@@ -215,7 +215,7 @@ TEST_F(LaunchFileTest, DuplicateNamesAndKeys) {
         name: twin
 )");
   ASSERT_EQ(list.size(), 3u);
-  EXPECT_EQ(list[0], "launch.yaml:6: duplicate key 'expect' in 'parameters'");
+  EXPECT_EQ(list[0], "launch.yaml:6: 'expect' appears twice in 'parameters'");
   EXPECT_EQ(list[1], "launch.yaml:7: duplicate group name 'g' (first at line 2)");
   EXPECT_EQ(list[2], "launch.yaml:10: duplicate component name 'twin' (first at line 5)");
 }

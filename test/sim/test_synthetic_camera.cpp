@@ -382,7 +382,8 @@ TEST(SceneFile, ErrorsNameTheFileTheLineAndTheProblem) {
             "bad.yaml:5: 'count' must be an integer, not '2.5'");
   EXPECT_EQ(scene_error(std::string(kObject) + "seed: 1\nseed: 2\n"),
             "bad.yaml:5: 'seed' appears twice in the scene");
-  EXPECT_EQ(scene_error("objects: [\n"), "bad.yaml:2: end of sequence flow not found");
+  EXPECT_EQ(scene_error("objects: [\n"),
+            "bad.yaml:2:1: YAML error: end of sequence flow not found");
   EXPECT_EQ(scene_error("render: {}\n"), "bad.yaml:1: the scene needs 'objects'");
 }
 

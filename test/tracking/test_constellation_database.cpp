@@ -169,7 +169,21 @@ TEST(ConstellationDatabase, MalformedFilesNameTheLine) {
   expect_error([] { parse_database_yaml("constellations: []\n", "d.yaml"); },
                "d.yaml: the database has no constellations");
   expect_error([] { parse_database_yaml("constelations: []\n", "d.yaml"); },
-               "d.yaml:1: unknown key 'constelations'");
+               "d.yaml:1: unknown key 'constelations' in the database (did you mean "
+               "'constellations'?)");
+  // Inside a constellation too, and a coordinate that is not a number, by line.
+  expect_error(
+      [] { parse_database_yaml("constellations:\n  - name: a\n    line: []\n", "d.yaml"); },
+      "d.yaml:3: unknown key 'line' in a constellation (did you mean 'lines'?)");
+  expect_error(
+      [] {
+        parse_database_yaml(
+            "constellations:\n  - name: a\n    lines:\n"
+            "      - name: P\n        points: [[0, 0, 0], [0.1, 0, 0], [0.2, zero, 0], [0.4, 0, "
+            "0]]\n",
+            "d.yaml");
+      },
+      "d.yaml:5: 'a point [x, y, z]' must be a number, not 'zero'");
   expect_error(
       [] {
         parse_database_yaml(

@@ -252,13 +252,13 @@ TEST(TrackingPipeline, BadConfigurationFilesAreOneLineErrors) {
   };
   std::vector<Case> cases = {
       {"pose_estimator", "camera", (dir / "camera.yaml").string(),
-       "camera.yaml:1: missing field 'camera_matrix'"},
+       "camera.yaml:1: a camera file needs 'camera_matrix'"},
       {"constellation_identifier", "database", (dir / "db.csv").string(),
        "db.csv: line 'L' needs 4 point rows ',x,y,z', found 0"},
       {"pose_estimator", "database", (dir / "missing.yaml").string(),
        "missing.yaml: cannot read the constellation database"},
       {"constellation_tracker", "camera", (dir / "camera.yaml").string(),
-       "camera.yaml:1: missing field 'camera_matrix'"},
+       "camera.yaml:1: a camera file needs 'camera_matrix'"},
       {"constellation_tracker", "database", (dir / "db.csv").string(),
        "db.csv: line 'L' needs 4 point rows ',x,y,z', found 0"},
   };

@@ -167,12 +167,7 @@ Aim TurretModel::aim_at(const Eigen::Vector3d& target, const JointAngles& start)
 
 TurretModel parse_turret(const std::string& text, const std::string& source) {
   Reader reader(source);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw TurretError(fmt::format("{}:{}: {}", source, e.mark.line + 1, e.msg));
-  }
+  YAML::Node root = reader.parse(text);
   reader.check_keys(root, {"pan", "tilt", "camera"}, "the turret");
   Joint pan = read_joint(reader, root, "pan");
   Joint tilt = read_joint(reader, root, "tilt");

@@ -75,12 +75,7 @@ std::optional<Eigen::Vector2d> pixel_to_plane(const RigCamera& camera, const Eig
 Rig parse_rig(const std::string& text, const std::string& source,
               const std::string& base_directory) {
   Reader reader(source);
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw RigError(fmt::format("{}:{}: {}", source, e.mark.line + 1, e.msg));
-  }
+  YAML::Node root = reader.parse(text);
   reader.check_keys(root, {"led_plane_height_m", "cameras", "robots"}, "the rig");
   Rig rig;
   rig.source = source;

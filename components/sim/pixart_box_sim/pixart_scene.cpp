@@ -173,12 +173,7 @@ std::vector<Led> calibration_board_leds(double size_m, double on_s, double off_s
 }
 
 PixartScene parse_pixart_scene(const std::string& text, const std::string& source, const Rig& rig) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw PixartSceneError(fmt::format("{}:{}: {}", source, e.mark.line + 1, e.msg));
-  }
+  YAML::Node root = YamlReader<PixartSceneError>(source).parse(text);
   return SceneReader(source, rig).read(root);
 }
 

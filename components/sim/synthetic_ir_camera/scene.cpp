@@ -233,12 +233,7 @@ class SceneReader : YamlReader<SceneError> {
 
 Scene parse_scene(const std::string& text, const std::string& source,
                   const constellations::ConstellationDatabase& database) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& error) {
-    throw SceneError(fmt::format("{}:{}: {}", source, error.mark.line + 1, error.msg));
-  }
+  YAML::Node root = YamlReader<SceneError>(source).parse(text);
   if (!root || root.IsNull()) throw SceneError(source + ": the scene is empty");
   return SceneReader(source, database).read(root);
 }

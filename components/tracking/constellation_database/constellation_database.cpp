@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 #include <Eigen/SVD>
+#include <mocap/config_reader.hpp>
 
 #include "cross_ratio.hpp"
 
@@ -205,23 +206,6 @@ void complete(ConstellationModel& model, const std::vector<LinePattern>& pattern
   }
 }
 
-double yaml_number(const YAML::Node& node, const std::string& source, const char* what) {
-  double value = 0;
-  if (!node || !node.IsScalar() || !YAML::convert<double>::decode(node, value) ||
-      !std::isfinite(value)) {
-    fail(source, node ? node.Mark().line + 1 : 0, fmt::format("{} must be a number", what));
-  }
-  return value;
-}
-
-std::string yaml_name(const YAML::Node& node, const std::string& source, int line,
-                      const char* what) {
-  if (!node || !node.IsScalar() || node.Scalar().empty()) {
-    fail(source, node ? node.Mark().line + 1 : line, fmt::format("{} needs a 'name'", what));
-  }
-  return node.Scalar();
-}
-
 }  // namespace
 
 std::vector<std::string> ConstellationModel::line_names() const {
@@ -382,70 +366,46 @@ std::vector<ConstellationModel> parse_constellation_csv(std::string_view text,
 
 ConstellationDatabase parse_database_yaml(const std::string& text, const std::string& source,
                                           std::vector<LinePattern> more_patterns) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    fail(source, e.mark.line + 1, e.msg);
-  }
+  ConfigReader<DatabaseError> reader(source);
+  YAML::Node root = reader.parse(text);
   if (!root.IsMap()) fail(source, 0, "a database is a map with 'constellations'");
-  for (const auto& entry : root) {
-    std::string key = entry.first.Scalar();
-    if (key != "line_patterns" && key != "constellations") {
-      fail(source, entry.first.Mark().line + 1,
-           fmt::format("unknown key '{}' (line_patterns, constellations)", key));
-    }
-  }
+  reader.check_keys(root, {"line_patterns", "constellations"}, "the database");
   std::vector<LinePattern> patterns;
-  if (YAML::Node list = root["line_patterns"]) {
-    if (!list.IsSequence()) fail(source, list.Mark().line + 1, "'line_patterns' must be a list");
-    for (const YAML::Node& node : list) {
-      int line = node.Mark().line + 1;
-      if (!node.IsMap()) fail(source, line, "a line pattern is a map with 'name' and 'positions'");
-      LinePattern pattern;
-      pattern.name = yaml_name(node["name"], source, line, "a line pattern");
-      YAML::Node positions = node["positions"];
-      if (!positions || !positions.IsSequence() || positions.size() != 4) {
-        fail(source, line,
-             fmt::format("line pattern '{}' needs 'positions': 4 distances in metres",
-                         pattern.name));
-      }
-      std::array<double, 4> p{};
-      for (int i = 0; i < 4; ++i) p[i] = yaml_number(positions[i], source, "a position");
-      pattern.positions_m = checked_positions(p, source, line, pattern.name);
-      const auto& q = pattern.positions_m;
-      pattern.cross_ratio = cross_ratio(q[0], q[1], q[2], q[3]);
-      patterns.push_back(pattern);
-    }
+  for (const YAML::Node& node : reader.list(root, "line_patterns")) {
+    reader.check_keys(node, {"name", "positions"}, "a line pattern");
+    LinePattern pattern;
+    pattern.name = reader.text(reader.required(node, "name", "a line pattern"), "name");
+    std::vector<double> p = reader.numbers(
+        reader.required(node, "positions", fmt::format("line pattern '{}'", pattern.name)),
+        "positions", 4);
+    pattern.positions_m = checked_positions({p[0], p[1], p[2], p[3]}, source,
+                                            ConfigReader<>::line_of(node), pattern.name);
+    const auto& q = pattern.positions_m;
+    pattern.cross_ratio = cross_ratio(q[0], q[1], q[2], q[3]);
+    patterns.push_back(pattern);
   }
-  YAML::Node list = root["constellations"];
-  if (!list || !list.IsSequence()) fail(source, 0, "'constellations' must be a list");
   std::vector<ConstellationModel> models;
-  for (const YAML::Node& node : list) {
-    int line = node.Mark().line + 1;
-    if (!node.IsMap()) fail(source, line, "a constellation is a map with 'name' and 'lines'");
+  for (const YAML::Node& node : reader.list(root, "constellations")) {
+    reader.check_keys(node, {"name", "lines"}, "a constellation");
     ConstellationModel model;
-    model.name = yaml_name(node["name"], source, line, "a constellation");
-    YAML::Node lines = node["lines"];
-    if (!lines || !lines.IsSequence() || lines.size() == 0) {
-      fail(source, line, fmt::format("constellation '{}' needs 'lines'", model.name));
+    model.name = reader.text(reader.required(node, "name", "a constellation"), "name");
+    const std::string what = fmt::format("constellation '{}'", model.name);
+    YAML::Node lines = reader.required(node, "lines", what);
+    if (!lines.IsSequence() || lines.size() == 0) {
+      reader.fail(lines, fmt::format("{} needs 'lines', a list of lines", what));
     }
     for (const YAML::Node& line_node : lines) {
-      int at = line_node.Mark().line + 1;
-      if (!line_node.IsMap()) fail(source, at, "a line is a map with 'name' and 'points'");
-      std::string name = yaml_name(line_node["name"], source, at, "a line");
-      YAML::Node points = line_node["points"];
-      if (!points || !points.IsSequence() || points.size() != 4) {
-        fail(source, at,
-             fmt::format("line '{}' needs 'points': 4 points [x, y, z] in metres", name));
+      reader.check_keys(line_node, {"name", "points"}, "a line");
+      std::string name = reader.text(reader.required(line_node, "name", "a line"), "name");
+      YAML::Node points = reader.required(line_node, "points", fmt::format("line '{}'", name));
+      if (!points.IsSequence() || points.size() != 4) {
+        reader.fail(points,
+                    fmt::format("line '{}' needs 'points': 4 points [x, y, z] in metres", name));
       }
       std::array<Eigen::Vector3d, 4> p;
       for (int i = 0; i < 4; ++i) {
-        if (!points[i].IsSequence() || points[i].size() != 3) {
-          fail(source, points[i].Mark().line + 1,
-               fmt::format("line '{}': a point is [x, y, z]", name));
-        }
-        for (int k = 0; k < 3; ++k) p[i][k] = yaml_number(points[i][k], source, "a coordinate");
+        std::vector<double> xyz = reader.numbers(points[i], "a point [x, y, z]", 3);
+        p[i] = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
       }
       model.lines.push_back(raw_line(model, name, p, std::nullopt));
     }

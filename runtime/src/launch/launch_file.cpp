@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include <mocap/config_reader.hpp>
 #include "core/names.hpp"
 #include "dds/dds_options.hpp"
 #include "dds/dds_transport.hpp"
@@ -23,57 +24,20 @@ namespace {
 
 int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
 
-// Problems in file order; those of --set options last.
-class Problems {
- public:
-  explicit Problems(std::string file) : file_(std::move(file)) {}
+// Every problem of the file, in file order; those of --set options last.
+using Problems = ConfigReader<ConfigError>;
 
-  void add(int line, std::string message) {
-    list_.emplace_back(line, fmt::format("{}:{}: {}", file_, line, message));
-  }
-  void add(const YAML::Node& at, std::string message) { add(line_of(at), std::move(message)); }
-  void add_plain(std::string message) {
-    list_.emplace_back(std::numeric_limits<int>::max(), std::move(message));
-  }
-  bool empty() const { return list_.empty(); }
-  std::vector<std::string> take() {
-    std::stable_sort(list_.begin(), list_.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<std::string> messages;
-    for (auto& [line, message] : list_) messages.push_back(std::move(message));
-    list_.clear();
-    return messages;
-  }
-
- private:
-  std::string file_;
-  std::vector<std::pair<int, std::string>> list_;
-};
-
-// Flags repeated keys and, when `allowed` is given, keys outside it. `what` names the map in
+// Records repeated keys and, when `allowed` is given, keys outside it. `what` names the map in
 // messages.
 void check_keys(const YAML::Node& map, const std::optional<std::vector<std::string>>& allowed,
                 std::string_view what, Problems& problems) {
-  std::set<std::string> seen;
-  for (const auto& entry : map) {
-    if (!entry.first.IsScalar()) {
-      problems.add(entry.first, fmt::format("a key in {} is not a name", what));
-      continue;
-    }
-    std::string key = entry.first.Scalar();
-    if (!seen.insert(key).second) {
-      problems.add(entry.first, fmt::format("duplicate key '{}' in {}", key, what));
-    } else if (allowed && std::find(allowed->begin(), allowed->end(), key) == allowed->end()) {
-      problems.add(entry.first, fmt::format("unknown key '{}' in {}{}", key, what,
-                                            did_you_mean(key, *allowed, "keys")));
-    }
-  }
+  problems.report_keys(map, allowed ? &*allowed : nullptr, what);
 }
 
 std::optional<std::string> string_value(const YAML::Node& node, std::string_view key,
                                         Problems& problems) {
   if (!node.IsScalar()) {
-    problems.add(node, fmt::format("'{}' must be a text value", key));
+    problems.record(node, fmt::format("'{}' must be a text value", key));
     return std::nullopt;
   }
   return node.Scalar();
@@ -89,7 +53,7 @@ std::optional<int64_t> int_value(const YAML::Node& node, std::string_view key, i
     }
   } catch (const std::invalid_argument&) {
   }
-  problems.add(node, fmt::format("'{}' must be an integer in [{}, {}]", key, min, max));
+  problems.record(node, fmt::format("'{}' must be an integer in [{}, {}]", key, min, max));
   return std::nullopt;
 }
 
@@ -99,14 +63,14 @@ std::optional<bool> bool_value(const YAML::Node& node, std::string_view key, Pro
     if (const bool* flag = std::get_if<bool>(&value)) return *flag;
   } catch (const std::invalid_argument&) {
   }
-  problems.add(node, fmt::format("'{}' must be true or false", key));
+  problems.record(node, fmt::format("'{}' must be true or false", key));
   return std::nullopt;
 }
 
 std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Problems& problems) {
   auto unknown_profile = [&](const YAML::Node& at, const std::string& name) {
-    problems.add(at, fmt::format("QoS for '{}': unknown profile '{}' (profiles: {})", topic, name,
-                                 Qos::profile_names));
+    problems.record(at, fmt::format("QoS for '{}': unknown profile '{}' (profiles: {})", topic,
+                                    name, Qos::profile_names));
   };
   if (node.IsScalar()) {
     if (auto qos = Qos::from_profile(node.Scalar())) return qos;
@@ -114,9 +78,9 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
     return std::nullopt;
   }
   if (!node.IsMap()) {
-    problems.add(node, fmt::format("QoS for '{}' must be a profile name or {{profile, depth, "
-                                   "max_blocking_s}}",
-                                   topic));
+    problems.record(node, fmt::format("QoS for '{}' must be a profile name or {{profile, depth, "
+                                      "max_blocking_s}}",
+                                      topic));
     return std::nullopt;
   }
   check_keys(node, std::vector<std::string>{"profile", "depth", "max_blocking_s"},
@@ -128,7 +92,7 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
       return std::nullopt;
     }
   } else {
-    problems.add(node, fmt::format("QoS for '{}' needs a 'profile'", topic));
+    problems.record(node, fmt::format("QoS for '{}' needs a 'profile'", topic));
     return std::nullopt;
   }
   if (YAML::Node depth = node["depth"]) {
@@ -138,9 +102,9 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
   }
   if (YAML::Node limit = node["max_blocking_s"]) {
     if (!publisher_may_wait(*qos, *qos)) {
-      problems.add(limit, fmt::format("QoS for '{}': max_blocking_s applies to the reliable "
-                                      "profile (keep_all), not to {}",
-                                      topic, node["profile"].Scalar()));
+      problems.record(limit, fmt::format("QoS for '{}': max_blocking_s applies to the reliable "
+                                         "profile (keep_all), not to {}",
+                                         topic, node["profile"].Scalar()));
       return std::nullopt;
     }
     std::optional<double> seconds;
@@ -151,7 +115,7 @@ std::optional<Qos> qos_value(const YAML::Node& node, std::string_view topic, Pro
     } catch (const std::invalid_argument&) {
     }
     if (!seconds || !(*seconds >= 0.001 && *seconds <= 3600)) {
-      problems.add(limit, "'max_blocking_s' must be a number of seconds in [0.001, 3600]");
+      problems.record(limit, "'max_blocking_s' must be a number of seconds in [0.001, 3600]");
       return std::nullopt;
     }
     qos->max_blocking = std::chrono::milliseconds(std::llround(*seconds * 1000));
@@ -173,12 +137,12 @@ void check_qos(const std::string& topic, const std::vector<TopicUse>& subscriber
     for (const TopicUse& publisher : publishers) {
       if (publisher.spec->direction != TopicDirection::Publish) continue;
       if (auto why = qos_mismatch(publisher.qos, subscriber.qos)) {
-        problems.add(subscriber.component->line,
-                     fmt::format("topic '{}': component '{}' ({}) would receive nothing from "
-                                 "component '{}' (line {}, {}): {}",
-                                 topic, subscriber.component->config.name,
-                                 subscriber.qos.to_string(), publisher.component->config.name,
-                                 publisher.component->line, publisher.qos.to_string(), *why));
+        problems.record(subscriber.component->line,
+                        fmt::format("topic '{}': component '{}' ({}) would receive nothing from "
+                                    "component '{}' (line {}, {}): {}",
+                                    topic, subscriber.component->config.name,
+                                    subscriber.qos.to_string(), publisher.component->config.name,
+                                    publisher.component->line, publisher.qos.to_string(), *why));
       }
     }
   }
@@ -207,12 +171,12 @@ void check_topics(const std::vector<const LaunchComponent*>& components, Problem
       const Use& first = a->second.front();
       for (const Use& use : b->second) {
         if (use.spec->type != first.spec->type) {
-          problems.add(use.component->line,
-                       fmt::format("topic '{}' is {} for component '{}' but {} for component "
-                                   "'{}' (line {})",
-                                   topic, use.spec->type->name(), use.component->config.name,
-                                   first.spec->type->name(), first.component->config.name,
-                                   first.component->line));
+          problems.record(use.component->line,
+                          fmt::format("topic '{}' is {} for component '{}' but {} for component "
+                                      "'{}' (line {})",
+                                      topic, use.spec->type->name(), use.component->config.name,
+                                      first.spec->type->name(), first.component->config.name,
+                                      first.component->line));
           break;
         }
       }
@@ -230,14 +194,14 @@ class Reader {
 
   LaunchFile read(const YAML::Node& root, const std::vector<ParameterOverride>& overrides) {
     if (!root.IsMap()) {
-      problems_.add(root, "a launch file is a map with 'groups' (and optionally 'dds')");
-      throw LaunchError(problems_.take());
+      problems_.record(root, "a launch file is a map with 'groups' (and optionally 'dds')");
+      throw LaunchError(problems_.problems());
     }
     check_keys(root, std::vector<std::string>{"dds", "groups"}, "the launch file", problems_);
     if (YAML::Node dds = root["dds"]) read_dds(dds);
     YAML::Node groups = root["groups"];
     if (!groups || !groups.IsSequence() || groups.size() == 0) {
-      problems_.add(groups ? groups : root, "'groups' must be a non-empty list of groups");
+      problems_.record(groups ? groups : root, "'groups' must be a non-empty list of groups");
     } else {
       for (const YAML::Node& group : groups) read_group(group);
     }
@@ -254,16 +218,16 @@ class Reader {
     }
     check_topics(loaded, problems_);
     check_implementations();
-    if (!problems_.empty()) throw LaunchError(problems_.take());
+    if (!problems_.problems().empty()) throw LaunchError(problems_.problems());
     return std::move(result_);
   }
 
  private:
   void read_dds(const YAML::Node& dds) {
     if (!dds.IsMap()) {
-      problems_.add(dds,
-                    "'dds' must be a map (implementation, enabled, domain_id, shared_memory, "
-                    "discovery, security)");
+      problems_.record(dds,
+                       "'dds' must be a map (implementation, enabled, domain_id, shared_memory, "
+                       "discovery, security)");
       return;
     }
     check_keys(dds,
@@ -300,7 +264,7 @@ class Reader {
     try {
       if (!name.empty()) return std::string(resolve_dds_implementation(name).name);
     } catch (const std::runtime_error& e) {
-      problems_.add(node, e.what());
+      problems_.record(node, e.what());
     }
     return "";
   }
@@ -315,26 +279,26 @@ class Reader {
       try {
         implementation = &resolve_dds_implementation(result_.dds_of(group).implementation);
       } catch (const std::runtime_error& e) {
-        problems_.add(group.line, e.what());
+        problems_.record(group.line, e.what());
         continue;
       }
       first_on.emplace(implementation->name, &group);
       if (!implementation->takes_fastdds_options &&
           !result_.dds.fastdds.discovery_servers.empty()) {
-        problems_.add(discovery_line_,
-                      fmt::format("dds.discovery.server: Fast DDS Discovery Servers do not work "
-                                  "with {} (group '{}'{}); run that group on fastdds, or use "
-                                  "multicast discovery, or give Cyclone DDS its peers "
-                                  "(Discovery/Peers) through CYCLONEDDS_URI",
-                                  implementation->name, group.name, where_chosen(group)));
+        problems_.record(discovery_line_,
+                         fmt::format("dds.discovery.server: Fast DDS Discovery Servers do not work "
+                                     "with {} (group '{}'{}); run that group on fastdds, or use "
+                                     "multicast discovery, or give Cyclone DDS its peers "
+                                     "(Discovery/Peers) through CYCLONEDDS_URI",
+                                     implementation->name, group.name, where_chosen(group)));
       }
     }
     if (result_.dds.security_identity.empty()) return;
     auto governance = security_files(result_.dds.security_directory, "").governance;
     for (const auto& [name, group] : first_on) {
       if (auto problem = resolve_dds_implementation(name).governance_problem(governance)) {
-        problems_.add(security_line_, fmt::format("dds.security: {} (group '{}' runs on {})",
-                                                  *problem, group->name, name));
+        problems_.record(security_line_, fmt::format("dds.security: {} (group '{}' runs on {})",
+                                                     *problem, group->name, name));
       }
     }
     // One identity on both sides: which side starts the handshake is chance, and Fast DDS 2.9
@@ -342,7 +306,7 @@ class Reader {
     if (first_on.count("fastdds") > 0 && first_on.count("cyclonedds") > 0) {
       const LaunchGroup& fast = *first_on.at("fastdds");
       const LaunchGroup& cyclone = *first_on.at("cyclonedds");
-      problems_.add(
+      problems_.record(
           security_line_,
           fmt::format("dds.security: group '{}' (fastdds{}) and group '{}' (cyclonedds{}) "
                       "would authenticate each other only when the Cyclone DDS side "
@@ -364,7 +328,7 @@ class Reader {
   // discovery: {server: "host:port"} or {server: ["host:port", ...]}
   void read_discovery(const YAML::Node& node) {
     if (!node.IsMap()) {
-      problems_.add(node, "dds.discovery must be a map with 'server'");
+      problems_.record(node, "dds.discovery must be a map with 'server'");
       return;
     }
     check_keys(node, std::vector<std::string>{"server"}, "'dds.discovery'", problems_);
@@ -375,16 +339,16 @@ class Reader {
     } else if (server && server.IsSequence() && server.size() > 0) {
       for (const YAML::Node& entry : server) entries.push_back(entry);
     } else {
-      problems_.add(server ? server : node,
-                    "dds.discovery.server must be \"host:port\" or a non-empty list of them");
+      problems_.record(server ? server : node,
+                       "dds.discovery.server must be \"host:port\" or a non-empty list of them");
       return;
     }
     for (const YAML::Node& entry : entries) {
       if (entry.IsScalar() && parse_host_port(entry.Scalar())) {
         result_.dds.fastdds.discovery_servers.push_back(entry.Scalar());
       } else {
-        problems_.add(entry, fmt::format("dds.discovery.server: '{}' is not host:port",
-                                         entry.IsScalar() ? entry.Scalar() : "?"));
+        problems_.record(entry, fmt::format("dds.discovery.server: '{}' is not host:port",
+                                            entry.IsScalar() ? entry.Scalar() : "?"));
       }
     }
   }
@@ -392,7 +356,7 @@ class Reader {
   // security: {directory: PATH, identity: NAME}; a relative PATH is taken from the file's folder.
   void read_security(const YAML::Node& node) {
     if (!node.IsMap()) {
-      problems_.add(node, "dds.security must be a map with 'directory' and 'identity'");
+      problems_.record(node, "dds.security must be a map with 'directory' and 'identity'");
       return;
     }
     check_keys(node, std::vector<std::string>{"directory", "identity"}, "'dds.security'",
@@ -400,7 +364,7 @@ class Reader {
     YAML::Node directory = node["directory"];
     YAML::Node identity = node["identity"];
     if (!directory || !identity) {
-      problems_.add(node, "dds.security needs 'directory' and 'identity'");
+      problems_.record(node, "dds.security needs 'directory' and 'identity'");
       return;
     }
     auto folder = string_value(directory, "dds.security.directory", problems_);
@@ -411,8 +375,8 @@ class Reader {
     if (path.is_relative()) path = fs::absolute(result_.path).parent_path() / path;
     path = path.lexically_normal();
     if (auto problem = check_security(path, *name)) {
-      problems_.add(problem->key == "directory" ? directory : identity,
-                    fmt::format("dds.security.{}: {}", problem->key, problem->message));
+      problems_.record(problem->key == "directory" ? directory : identity,
+                       fmt::format("dds.security.{}: {}", problem->key, problem->message));
       return;
     }
     result_.dds.security_directory = path.string();
@@ -421,7 +385,7 @@ class Reader {
 
   void read_group(const YAML::Node& node) {
     if (!node.IsMap()) {
-      problems_.add(node, "a group is a map with 'name' and 'components'");
+      problems_.record(node, "a group is a map with 'name' and 'components'");
       return;
     }
     LaunchGroup group;
@@ -430,7 +394,7 @@ class Reader {
                problems_);
     if (YAML::Node dds = node["dds"]) {
       if (!dds.IsMap()) {
-        problems_.add(dds, "a group's 'dds' must be a map with 'implementation'");
+        problems_.record(dds, "a group's 'dds' must be a map with 'implementation'");
       } else {
         check_keys(dds, std::vector<std::string>{"implementation"}, "a group's 'dds'", problems_);
         if (YAML::Node n = dds["implementation"])
@@ -440,17 +404,17 @@ class Reader {
     if (YAML::Node name = node["name"]) {
       group.name = string_value(name, "name", problems_).value_or("");
       if (!valid_component_name(group.name)) {
-        problems_.add(
+        problems_.record(
             name, fmt::format("group name '{}' must use letters, digits, '_' and '-'", group.name));
       }
       for (const LaunchGroup& other : result_.groups) {
         if (other.name == group.name) {
-          problems_.add(name, fmt::format("duplicate group name '{}' (first at line {})",
-                                          group.name, other.line));
+          problems_.record(name, fmt::format("duplicate group name '{}' (first at line {})",
+                                             group.name, other.line));
         }
       }
     } else {
-      problems_.add(node, "a group needs a 'name'");
+      problems_.record(node, "a group needs a 'name'");
     }
     if (YAML::Node threads = node["threads"]) {
       group.threads =
@@ -459,8 +423,8 @@ class Reader {
     YAML::Node components = node["components"];
     bool has_components = components && components.IsSequence() && components.size() > 0;
     if (!has_components) {
-      problems_.add(components ? components : node,
-                    fmt::format("group '{}' needs 'components', a non-empty list", group.name));
+      problems_.record(components ? components : node,
+                       fmt::format("group '{}' needs 'components', a non-empty list", group.name));
     }
     result_.groups.push_back(std::move(group));  // read_component() adds to the last group
     if (has_components) {
@@ -470,7 +434,7 @@ class Reader {
 
   void read_component(const YAML::Node& node) {
     if (!node.IsMap()) {
-      problems_.add(node, "a component is a map with 'plugin' and 'name'");
+      problems_.record(node, "a component is a map with 'plugin' and 'name'");
       return;
     }
     check_keys(node, std::vector<std::string>{"plugin", "name", "parameters", "remap", "qos"},
@@ -479,34 +443,34 @@ class Reader {
     component.line = line_of(node);
     YAML::Node name = node["name"];
     if (!name) {
-      problems_.add(node, "a component needs a 'name'");
+      problems_.record(node, "a component needs a 'name'");
     } else if (auto text = string_value(name, "name", problems_)) {
       component.config.name = *text;
       component.line = line_of(name);
       if (!valid_component_name(*text)) {
-        problems_.add(name, fmt::format("component name '{}' must use letters, digits, '_' "
-                                        "and '-'",
-                                        *text));
+        problems_.record(name, fmt::format("component name '{}' must use letters, digits, '_' "
+                                           "and '-'",
+                                           *text));
       }
       if (auto [it, fresh] = component_lines_.emplace(*text, component.line); !fresh) {
-        problems_.add(name, fmt::format("duplicate component name '{}' (first at line {})", *text,
-                                        it->second));
+        problems_.record(name, fmt::format("duplicate component name '{}' (first at line {})",
+                                           *text, it->second));
       }
     }
     YAML::Node plugin = node["plugin"];
     if (!plugin) {
-      problems_.add(node, "a component needs a 'plugin'");
+      problems_.record(node, "a component needs a 'plugin'");
     } else if (auto text = string_value(plugin, "plugin", problems_)) {
       try {
         component.plugin = &plugins_.load(*text);
       } catch (const PluginError& e) {
-        problems_.add(plugin, e.what());
+        problems_.record(plugin, e.what());
       }
     }
     std::string who = fmt::format("component '{}'", component.config.name);
     if (YAML::Node parameters = node["parameters"]) {
       if (!parameters.IsMap()) {
-        problems_.add(parameters, "'parameters' must be a map of name: value");
+        problems_.record(parameters, "'parameters' must be a map of name: value");
       } else {
         check_keys(parameters, std::nullopt, "'parameters'", problems_);
         for (const auto& entry : parameters) {
@@ -516,8 +480,8 @@ class Reader {
             component.config.parameters[key] = parameter_value_from_yaml(entry.second);
             component.parameter_lines[key] = line_of(entry.first);
           } catch (const std::invalid_argument& e) {
-            problems_.add(entry.second,
-                          fmt::format("{}: parameter '{}' has {}", who, key, e.what()));
+            problems_.record(entry.second,
+                             fmt::format("{}: parameter '{}' has {}", who, key, e.what()));
           }
         }
       }
@@ -544,7 +508,7 @@ class Reader {
   void read_topic_map(const YAML::Node& map, std::string_view key,
                       std::map<std::string, int>& lines, Each each) {
     if (!map.IsMap()) {
-      problems_.add(map, fmt::format("'{}' must be a map of topic: value", key));
+      problems_.record(map, fmt::format("'{}' must be a map of topic: value", key));
       return;
     }
     check_keys(map, std::nullopt, fmt::format("'{}'", key), problems_);
@@ -565,15 +529,16 @@ class Reader {
         }
       }
       if (target == nullptr) {
-        problems_.add_plain(fmt::format("--set {}: no component named '{}' in {}", o.text,
-                                        o.component, result_.path));
+        problems_.record_outside(fmt::format("--set {}: no component named '{}' in {}", o.text,
+                                             o.component, result_.path));
         continue;
       }
       try {
         target->config.parameters[o.parameter] = parameter_value_from_yaml(YAML::Load(o.value));
         set_texts_[{target, o.parameter}] = o.text;
       } catch (const std::exception& e) {
-        problems_.add_plain(fmt::format("--set {}: the value is not valid: {}", o.text, e.what()));
+        problems_.record_outside(
+            fmt::format("--set {}: the value is not valid: {}", o.text, e.what()));
       }
     }
   }
@@ -603,22 +568,22 @@ class Reader {
       ComponentConfig one{config.name, {{name, value}}, {}, {}};
       for (const std::string& problem : check_component_config(spec, one)) {
         if (auto set = set_texts_.find({&component, name}); set != set_texts_.end()) {
-          problems_.add_plain(fmt::format("--set {}: {}: {}", set->second, who, problem));
+          problems_.record_outside(fmt::format("--set {}: {}: {}", set->second, who, problem));
         } else {
-          problems_.add(component.parameter_lines.at(name), fmt::format("{}: {}", who, problem));
+          problems_.record(component.parameter_lines.at(name), fmt::format("{}: {}", who, problem));
         }
       }
     }
     for (const auto& [from, to] : config.remaps) {
       ComponentConfig one{config.name, {}, {{from, to}}, {}};
       for (const std::string& problem : check_component_config(spec, one)) {
-        problems_.add(component.remap_lines.at(from), fmt::format("{}: {}", who, problem));
+        problems_.record(component.remap_lines.at(from), fmt::format("{}: {}", who, problem));
       }
     }
     for (const auto& [topic, qos] : config.qos) {
       ComponentConfig one{config.name, {}, {}, {{topic, qos}}};
       for (const std::string& problem : check_component_config(spec, one)) {
-        problems_.add(component.qos_lines.at(topic), fmt::format("{}: {}", who, problem));
+        problems_.record(component.qos_lines.at(topic), fmt::format("{}: {}", who, problem));
       }
     }
   }
@@ -679,10 +644,11 @@ LaunchFile load_launch_file(const std::filesystem::path& path, PluginLoader& plu
   }
   std::stringstream text;
   text << stream.rdbuf();
-  YAML::Node root;
   try {
-    root = YAML::Load(text.str());
+    YAML::Node root = Problems(path.string()).parse(text.str());
     return Reader(path.string(), plugins).read(root, overrides);
+  } catch (const ConfigError& e) {
+    throw LaunchError({e.what()});
   } catch (const YAML::Exception& e) {
     // Syntax errors, and anything else yaml-cpp refuses, with the place it names.
     throw LaunchError({fmt::format("{}:{}:{}: YAML error: {}", path.string(), e.mark.line + 1,
