@@ -82,6 +82,8 @@ struct RecordedTopic {
   uint32_t id = 0;
 };
 
+// Kept whole (about 90 lines): subscribing, the loop and the summary share the subscriptions
+// and the writer, and read as one story.
 int record(const std::string& directory, const std::set<std::string>& wanted, bool all,
            std::optional<double> duration, const std::string& storage) {
   auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_bag");

@@ -411,6 +411,50 @@ bool IrRenderer::hidden_by_a_board(const Eigen::Vector3d& point, size_t own,
   return false;
 }
 
+ObjectTruth IrRenderer::object_truth(const SceneObject& object, double time_s) const {
+  ObjectTruth truth;
+  truth.constellation = object.constellation;
+  truth.pose = object_pose(object, time_s);
+  truth.in_front = truth.pose.translation().z() > 0;
+  truth.facing_camera = truth.pose.linear().col(2).dot(truth.pose.translation()) < 0;
+  // Velocities by central differences over a millisecond: exact for the piecewise-smooth
+  // trajectories but at their corners.
+  constexpr double kStep = 5e-4;
+  const Eigen::Isometry3d before = object_pose(object, time_s - kStep);
+  const Eigen::Isometry3d after = object_pose(object, time_s + kStep);
+  truth.linear_velocity = (after.translation() - before.translation()) / (2 * kStep);
+  const Eigen::AngleAxisd turn(after.linear() * before.linear().transpose());
+  truth.angular_velocity = turn.angle() * turn.axis() / (2 * kStep);
+  for (const Eigen::Vector3d& marker : object.markers) {
+    MarkerTruth marker_truth;
+    if (auto pixel = camera_->project(truth.pose * marker)) {
+      marker_truth.pixel = *pixel;
+      DiscView view;
+      marker_truth.visible = view_disc(truth.pose, marker, view) && camera_->in_image(*pixel);
+    }
+    truth.markers.push_back(marker_truth);
+  }
+  return truth;
+}
+
+// Hot pixels are in the sensor: they show on top of everything.
+void IrRenderer::add_hot_points(std::mt19937_64& random) {
+  const HotPoints& hot = scene_.distractors.hot_points;
+  auto add_hot_point = [&](int u, int v) {
+    work_.at<float>(v, u) += static_cast<float>(hot.brightness_dn);
+  };
+  if (hot.fixed) {
+    for (const cv::Point& point : fixed_hot_points_) add_hot_point(point.x, point.y);
+  } else {
+    std::uniform_int_distribution<int> column(0, camera_->width() - 1);
+    std::uniform_int_distribution<int> row(0, camera_->height() - 1);
+    for (int i = 0; i < hot.count; ++i) {
+      int u = column(random);
+      add_hot_point(u, row(random));
+    }
+  }
+}
+
 RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
                                  const Eigen::Isometry3d& camera_from_world) {
   camera_from_world_ = camera_from_world;
@@ -425,29 +469,7 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
   RenderedFrame frame;
   frame.time_s = time_s;
   for (const SceneObject& object : scene_.objects) {
-    ObjectTruth truth;
-    truth.constellation = object.constellation;
-    truth.pose = object_pose(object, time_s);
-    truth.in_front = truth.pose.translation().z() > 0;
-    truth.facing_camera = truth.pose.linear().col(2).dot(truth.pose.translation()) < 0;
-    // Velocities by central differences over a millisecond: exact for the piecewise-smooth
-    // trajectories but at their corners.
-    constexpr double kStep = 5e-4;
-    const Eigen::Isometry3d before = object_pose(object, time_s - kStep);
-    const Eigen::Isometry3d after = object_pose(object, time_s + kStep);
-    truth.linear_velocity = (after.translation() - before.translation()) / (2 * kStep);
-    const Eigen::AngleAxisd turn(after.linear() * before.linear().transpose());
-    truth.angular_velocity = turn.angle() * turn.axis() / (2 * kStep);
-    for (const Eigen::Vector3d& marker : object.markers) {
-      MarkerTruth marker_truth;
-      if (auto pixel = camera_->project(truth.pose * marker)) {
-        marker_truth.pixel = *pixel;
-        DiscView view;
-        marker_truth.visible = view_disc(truth.pose, marker, view) && camera_->in_image(*pixel);
-      }
-      truth.markers.push_back(marker_truth);
-    }
-    frame.objects.push_back(std::move(truth));
+    frame.objects.push_back(object_truth(object, time_s));
   }
 
   // Boards are opaque: a marker whose line of sight crosses a nearer board is not drawn.
@@ -496,22 +518,7 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
     }
   }
 
-  // Hot pixels are in the sensor: they show on top of everything.
-  const HotPoints& hot = scene_.distractors.hot_points;
-  auto add_hot_point = [&](int u, int v) {
-    work_.at<float>(v, u) += static_cast<float>(hot.brightness_dn);
-  };
-  if (hot.fixed) {
-    for (const cv::Point& point : fixed_hot_points_) add_hot_point(point.x, point.y);
-  } else {
-    std::uniform_int_distribution<int> column(0, camera_->width() - 1);
-    std::uniform_int_distribution<int> row(0, camera_->height() - 1);
-    for (int i = 0; i < hot.count; ++i) {
-      int u = column(random);
-      add_hot_point(u, row(random));
-    }
-  }
-
+  add_hot_points(random);
   work_.convertTo(frame.image, CV_8U);  // rounds and saturates to 0..255
   return frame;
 }

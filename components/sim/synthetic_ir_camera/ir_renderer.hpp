@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,10 @@ class IrRenderer {
   void draw_static_layer();
   void occlude(const Rect& rect, double level_dn, const cv::Mat& noise, cv::Mat& image) const;
   Rect object_occlusion(const SceneObject& object, const ObjectTruth& truth, double time_s) const;
+  // Where `object` is at `time_s`, how fast it moves, and where its markers project.
+  ObjectTruth object_truth(const SceneObject& object, double time_s) const;
+  // The sensor's hot pixels, on top of everything in work_.
+  void add_hot_points(std::mt19937_64& random);
   bool hidden_by_a_board(const Eigen::Vector3d& point, size_t own,
                          const std::vector<ObjectTruth>& objects) const;
   Rect clip(double x0, double y0, double x1, double y1) const;

@@ -349,6 +349,77 @@ class ConstellationSearch {
   std::vector<IdentifiedLine> best_lines_;
 };
 
+// Four-point candidates in order along each group (from at most `window` consecutive points),
+// sorted into line types by cross-ratio: per type, those within `tolerance` of
+// `type_ratios[type]`.
+std::vector<std::vector<Candidate>> candidates_by_type(const std::vector<Eigen::Vector2d>& points,
+                                                       const std::vector<CollinearGroup>& groups,
+                                                       const std::vector<double>& type_ratios,
+                                                       int window, double tolerance,
+                                                       IdentificationStats& s) {
+  std::vector<std::vector<Candidate>> by_type(type_ratios.size());
+  for (const CollinearGroup& group : groups) {
+    const auto& g = group.points;
+    const int n = static_cast<int>(g.size());
+    for (int a = 0; a + 3 < n; ++a) {
+      int end = std::min(n, a + window);
+      for (int b = a + 1; b < end; ++b) {
+        for (int c = b + 1; c < end; ++c) {
+          for (int d = c + 1; d < end; ++d) {
+            ++s.candidates;
+            Candidate candidate{{g[a], g[b], g[c], g[d]}, 0};
+            candidate.cross_ratio =
+                cross_ratio(points[g[a]], points[g[b]], points[g[c]], points[g[d]]);
+            bool matched = false;
+            for (size_t t = 0; t < type_ratios.size(); ++t) {
+              if (relative_difference(candidate.cross_ratio, type_ratios[t]) <= tolerance) {
+                by_type[t].push_back(candidate);
+                matched = true;
+              }
+            }
+            s.matched += matched;
+          }
+        }
+      }
+    }
+  }
+  return by_type;
+}
+
+// The boards found from one line, best first, without those that explain the same points as
+// well as another: boards of one size hinged on a side of one line type share their corners,
+// and neither can be told from the other, so neither is named (counted as conflicts).
+std::vector<IdentifiedConstellation> unambiguous(std::vector<IdentifiedConstellation> found,
+                                                 IdentificationStats& s) {
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
+    if (a.points_identified() != b.points_identified()) {
+      return a.points_identified() > b.points_identified();
+    }
+    return a.fit_rms_px < b.fit_rms_px;
+  });
+  std::vector<bool> ambiguous(found.size(), false);
+  for (size_t a = 0; a < found.size(); ++a) {
+    for (size_t b = a + 1; b < found.size(); ++b) {
+      const auto& first = found[a].image_point_of;
+      const auto& second = found[b].image_point_of;
+      if (found[a].points_identified() != found[b].points_identified()) continue;
+      bool overlap = std::any_of(first.begin(), first.end(), [&](int i) {
+        return i >= 0 && std::find(second.begin(), second.end(), i) != second.end();
+      });
+      if (overlap) ambiguous[a] = ambiguous[b] = true;
+    }
+  }
+  std::vector<IdentifiedConstellation> clear;
+  for (size_t k = 0; k < found.size(); ++k) {
+    if (ambiguous[k]) {
+      ++s.conflicts;
+    } else {
+      clear.push_back(std::move(found[k]));
+    }
+  }
+  return clear;
+}
+
 }  // namespace
 
 int IdentifiedConstellation::points_identified() const {
@@ -391,35 +462,11 @@ std::vector<IdentifiedConstellation> ConstellationIdentifier::identify(
   std::vector<CollinearGroup> groups = find_collinear_groups(points, options_.line_search);
   s.groups = groups.size();
 
-  // Four-point candidates in order along each group, sorted into line types by cross-ratio.
-  std::vector<std::vector<Candidate>> by_type(line_types_.size());
-  const int window = std::max(4, options_.candidate_window);
-  for (const CollinearGroup& group : groups) {
-    const auto& g = group.points;
-    const int n = static_cast<int>(g.size());
-    for (int a = 0; a + 3 < n; ++a) {
-      int end = std::min(n, a + window);
-      for (int b = a + 1; b < end; ++b) {
-        for (int c = b + 1; c < end; ++c) {
-          for (int d = c + 1; d < end; ++d) {
-            ++s.candidates;
-            Candidate candidate{{g[a], g[b], g[c], g[d]}, 0};
-            candidate.cross_ratio =
-                cross_ratio(points[g[a]], points[g[b]], points[g[c]], points[g[d]]);
-            bool matched = false;
-            for (size_t t = 0; t < line_types_.size(); ++t) {
-              if (relative_difference(candidate.cross_ratio, line_types_[t].cross_ratio) <=
-                  options_.cross_ratio_tolerance) {
-                by_type[t].push_back(candidate);
-                matched = true;
-              }
-            }
-            s.matched += matched;
-          }
-        }
-      }
-    }
-  }
+  std::vector<double> type_ratios;
+  for (const LineType& type : line_types_) type_ratios.push_back(type.cross_ratio);
+  const std::vector<std::vector<Candidate>> by_type =
+      candidates_by_type(points, groups, type_ratios, std::max(4, options_.candidate_window),
+                         options_.cross_ratio_tolerance, s);
 
   std::vector<TypeChoices> choices_by_type;
   choices_by_type.reserve(by_type.size());
@@ -468,34 +515,7 @@ std::vector<IdentifiedConstellation> ConstellationIdentifier::identify(
         from_one_line.push_back(std::move(*result));
       }
     }
-    std::sort(from_one_line.begin(), from_one_line.end(), [](const auto& a, const auto& b) {
-      if (a.points_identified() != b.points_identified()) {
-        return a.points_identified() > b.points_identified();
-      }
-      return a.fit_rms_px < b.fit_rms_px;
-    });
-    // Two boards that explain the same points equally well cannot be told apart: boards of one
-    // size hinged on a side of one line type share their corners. Neither is named.
-    std::vector<bool> ambiguous(from_one_line.size(), false);
-    for (size_t a = 0; a < from_one_line.size(); ++a) {
-      for (size_t b = a + 1; b < from_one_line.size(); ++b) {
-        const auto& first = from_one_line[a].image_point_of;
-        const auto& second = from_one_line[b].image_point_of;
-        if (from_one_line[a].points_identified() != from_one_line[b].points_identified()) continue;
-        bool overlap = std::any_of(first.begin(), first.end(), [&](int i) {
-          return i >= 0 && std::find(second.begin(), second.end(), i) != second.end();
-        });
-        if (overlap) ambiguous[a] = ambiguous[b] = true;
-      }
-    }
-    std::vector<IdentifiedConstellation> clear;
-    for (size_t k = 0; k < from_one_line.size(); ++k) {
-      if (ambiguous[k]) {
-        ++s.conflicts;
-      } else {
-        clear.push_back(std::move(from_one_line[k]));
-      }
-    }
+    std::vector<IdentifiedConstellation> clear = unambiguous(std::move(from_one_line), s);
     accept_free(clear);
   }
   for (auto& constellation : accepted) {

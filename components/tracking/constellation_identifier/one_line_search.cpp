@@ -106,6 +106,66 @@ std::optional<Eigen::Vector2d> to_normalised(const Eigen::Vector3d& point) {
   return Eigen::Vector2d(point.x() / point.z(), point.y() / point.z());
 }
 
+// A circle in the image, pixels.
+struct ImageDisc {
+  Eigen::Vector2d centre;
+  double radius = 0;
+};
+
+// The votes of the free points within `reach` for the turn of `board` about its line: each
+// pairs a marker off the line with a point that turn puts it on, within `tolerance_px`.
+void collect_votes(const ConstellationModel& model, const ConstellationLine& line,
+                   const BoardOnLine& board, const Candidate& candidate,
+                   const std::vector<Eigen::Vector2d>& points, const std::vector<bool>& taken,
+                   double focal, const ImageDisc& reach, double tolerance_px,
+                   std::vector<Vote>& votes) {
+  votes.clear();
+  for (size_t m = 0; m < model.points.size(); ++m) {
+    if (std::find(line.points.begin(), line.points.end(), static_cast<int>(m)) !=
+        line.points.end()) {
+      continue;
+    }
+    const Eigen::Vector2d offsets = board.offsets(static_cast<int>(m));
+    if (std::abs(offsets.y()) < 1e-3) continue;  // on the line itself
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (taken[i] || (points[i] - reach.centre).norm() > reach.radius) continue;
+      if (std::find(candidate.points.begin(), candidate.points.end(), static_cast<int>(i)) !=
+          candidate.points.end()) {
+        continue;
+      }
+      for (double angle : board.angles_towards(offsets, points[i] / focal)) {
+        auto at = to_normalised(board.position(offsets, angle));
+        if (!at || (*at * focal - points[i]).norm() > tolerance_px) continue;
+        votes.push_back({angle, static_cast<int>(m), static_cast<int>(i)});
+      }
+    }
+  }
+}
+
+// Gives each marker `image_of` leaves unassigned (-1) the free point nearest where `homography`
+// puts it, within `completion_px`; -1 where there is none.
+void complete_with_homography(const ConstellationModel& model, const Eigen::Matrix3d& homography,
+                              const std::vector<Eigen::Vector2d>& points,
+                              const std::vector<bool>& taken, double completion_px,
+                              std::vector<int>& image_of) {
+  for (size_t m = 0; m < model.points.size(); ++m) {
+    if (image_of[m] >= 0) continue;
+    const Eigen::Vector2d at = apply_homography(homography, model.plane_points[m]);
+    int nearest = -1;
+    double nearest_distance = completion_px;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (taken[i]) continue;
+      const double distance = (points[i] - at).norm();
+      if (distance <= nearest_distance &&
+          std::find(image_of.begin(), image_of.end(), static_cast<int>(i)) == image_of.end()) {
+        nearest = static_cast<int>(i);
+        nearest_distance = distance;
+      }
+    }
+    image_of[m] = nearest;
+  }
+}
+
 }  // namespace
 
 std::optional<LineInSpace> place_line(const std::array<Eigen::Vector2d, 4>& normalised,
@@ -141,6 +201,9 @@ std::optional<LineInSpace> place_line(const std::array<Eigen::Vector2d, 4>& norm
   return line;
 }
 
+// Kept whole (about 95 lines): every hypothesis (a line, a direction), its votes and the
+// completions share the line's placement and the best board so far; the parts that stand
+// alone are collect_votes and complete_with_homography.
 std::optional<IdentifiedConstellation> find_from_one_line(
     const ConstellationModel& model, const std::vector<int>& type_of_line,
     const std::vector<std::vector<Candidate>>& by_type, const std::vector<Eigen::Vector2d>& points,
@@ -186,28 +249,8 @@ std::optional<IdentifiedConstellation> find_from_one_line(
             reach_m;
         const double radius_px = nearest_depth > 0.05 ? 1.5 * focal * reach_m / nearest_depth
                                                       : std::numeric_limits<double>::infinity();
-        const Eigen::Vector2d centre_px = points[choice.image_point(0)];
-        votes.clear();
-        for (size_t m = 0; m < model.points.size(); ++m) {
-          if (std::find(line.points.begin(), line.points.end(), static_cast<int>(m)) !=
-              line.points.end()) {
-            continue;
-          }
-          const Eigen::Vector2d offsets = board.offsets(static_cast<int>(m));
-          if (std::abs(offsets.y()) < 1e-3) continue;  // on the line itself
-          for (size_t i = 0; i < points.size(); ++i) {
-            if (taken[i] || (points[i] - centre_px).norm() > radius_px) continue;
-            if (std::find(candidate.points.begin(), candidate.points.end(), static_cast<int>(i)) !=
-                candidate.points.end()) {
-              continue;
-            }
-            for (double angle : board.angles_towards(offsets, points[i] / focal)) {
-              auto at = to_normalised(board.position(offsets, angle));
-              if (!at || (*at * focal - points[i]).norm() > tolerance_px) continue;
-              votes.push_back({angle, static_cast<int>(m), static_cast<int>(i)});
-            }
-          }
-        }
+        collect_votes(model, line, board, candidate, points, taken, focal,
+                      {points[choice.image_point(0)], radius_px}, tolerance_px, votes);
         if (static_cast<int>(votes.size()) < 2) continue;
         // Two votes that agree on the turn, with the line, fix the plane's homography, exactly
         // and without the line's tilt; the markers it puts on free points complete the board.
@@ -225,24 +268,8 @@ std::optional<IdentifiedConstellation> find_from_one_line(
             image_of[b.marker] = b.point;
             auto seeded = plane_fit(model, image_of, points);
             if (!seeded || seeded->max > completion_px) continue;
-            for (size_t m = 0; m < model.points.size(); ++m) {
-              if (image_of[m] >= 0) continue;
-              const Eigen::Vector2d at =
-                  apply_homography(seeded->homography, model.plane_points[m]);
-              int nearest = -1;
-              double nearest_distance = completion_px;
-              for (size_t i = 0; i < points.size(); ++i) {
-                if (taken[i]) continue;
-                const double distance = (points[i] - at).norm();
-                if (distance <= nearest_distance &&
-                    std::find(image_of.begin(), image_of.end(), static_cast<int>(i)) ==
-                        image_of.end()) {
-                  nearest = static_cast<int>(i);
-                  nearest_distance = distance;
-                }
-              }
-              image_of[m] = nearest;
-            }
+            complete_with_homography(model, seeded->homography, points, taken, completion_px,
+                                     image_of);
             const int identified = static_cast<int>(
                 std::count_if(image_of.begin(), image_of.end(), [](int i) { return i >= 0; }));
             if (identified < 4 + options.min_loose_markers) continue;

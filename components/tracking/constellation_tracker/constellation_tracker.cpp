@@ -133,6 +133,9 @@ ConstellationTracker::ConstellationTracker(const constellations::ConstellationDa
   if (!camera_) throw std::invalid_argument("ConstellationTracker: no camera model");
 }
 
+// One frame: follow the tracks (predict, associate; seed 000 §7.4.3) and verify them, identify
+// the boards no track holds and verify those, then update the tracks. Kept whole (about 90
+// lines) so that the order reads in one place; each step is a function of its own.
 std::vector<TrackedConstellation> ConstellationTracker::update(
     int64_t stamp_ns, const std::vector<ImageFiducial>& detected, TrackerStats* stats_out) {
   pixels_.resize(detected.size());
@@ -230,11 +233,7 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
                                          const std::vector<ImageFiducial>& detected,
                                          std::vector<Candidate>& candidates, TrackerStats& stats) {
   const std::vector<Eigen::Vector2d>& fiducials = pixels_;
-  // Every tracked board's markers where the camera should see them now.
-  std::vector<PredictedMarker> predictions;
-  std::vector<std::pair<int, int>> predicted_marker;  // (track, marker) of each prediction
   std::vector<BodyState> predicted(tracks_.size());
-  const double fiducial_variance = options_.fiducial_sigma_px * options_.fiducial_sigma_px;
   for (size_t t = 0; t < tracks_.size(); ++t) {
     predicted[t] = tracks_[t].motion.predicted(stamp_ns);
   }
@@ -242,31 +241,10 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
   // its pattern shifted by a marker's spacing can lie nearer the prediction than the true one.
   // Its gated association is therefore weighed against the picture's shift (relock), below.
   auto settled = [&](size_t t) { return tracks_[t].motion.corrections() > 1; };
-  for (size_t t = 0; t < tracks_.size(); ++t) {
-    const Eigen::Isometry3d& pose = predicted[t].camera_from_body;
-    const Matrix6d pose_covariance = predicted[t].pose_covariance();
-    const ConstellationModel& model = *tracks_[t].model;
-    const auto images = marker_images(*camera_, model, pose, options_.visibility);
-    for (size_t m = 0; m < model.points.size(); ++m) {
-      if (images[m].sight != MarkerSight::InView) continue;
-      // A marker behind another tracked board is not looked for: boards are opaque.
-      bool covered = false;
-      for (size_t u = 0; u < tracks_.size() && !covered; ++u) {
-        covered = u != t && behind_board(pose * model.points[m], *tracks_[u].model,
-                                         predicted[u].camera_from_body);
-      }
-      if (covered) continue;
-      const Eigen::Vector3d lever = pose.linear() * model.points[m];
-      auto jacobian = image_jacobian(*camera_, pose * model.points[m], lever, images[m].pixel);
-      if (!jacobian) continue;
-      PredictedMarker marker;
-      marker.pixel = images[m].pixel;
-      marker.covariance = *jacobian * pose_covariance * jacobian->transpose() +
-                          fiducial_variance * Eigen::Matrix2d::Identity();
-      predictions.push_back(marker);
-      predicted_marker.emplace_back(static_cast<int>(t), static_cast<int>(m));
-    }
-  }
+  // Every tracked board's markers where the camera should see them now.
+  std::vector<PredictedMarker> predictions;
+  std::vector<std::pair<int, int>> predicted_marker;  // (track, marker) of each prediction
+  predict_markers(predicted, predictions, predicted_marker);
   const std::vector<int> fiducial_of =
       associate_markers(predictions, fiducials, options_.association_gate);
 
@@ -279,29 +257,7 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
     image_point_of[predicted_marker[p].first][predicted_marker[p].second] = fiducial_of[p];
     if (fiducial_of[p] >= 0) track_of_fiducial[fiducial_of[p]] = predicted_marker[p].first;
   }
-  // The markers found again by the picture's shift, and the pose they give.
-  auto find_shifted = [&](size_t t, pose::PlanarPose& pose_out, std::vector<int>& image_of) {
-    std::vector<bool> taken(fiducials.size());
-    for (size_t i = 0; i < fiducials.size(); ++i) {
-      taken[i] = track_of_fiducial[i] >= 0 && track_of_fiducial[i] != static_cast<int>(t);
-    }
-    const ConstellationModel& model = *tracks_[t].model;
-    const auto images =
-        marker_images(*camera_, model, predicted[t].camera_from_body, options_.visibility);
-    auto found = relock(model, images, fiducials, taken);
-    if (!found) return false;
-    pose::PlanarPoseOptions relock_options = options_.pose;
-    relock_options.min_points = options_.relock_min_markers;
-    IdentifiedConstellation shifted;
-    shifted.model = &model;
-    shifted.image_point_of = *found;
-    pose::PlanarPose pose = pose::estimate_planar_pose(
-        *camera_, marker_points(shifted), marker_pixels(shifted, fiducials), relock_options);
-    if (!pose.valid) return false;
-    pose_out = pose;
-    image_of = *found;
-    return true;
-  };
+
   for (size_t t = 0; t < tracks_.size(); ++t) {
     const ConstellationModel& model = *tracks_[t].model;
     std::vector<int>& image_of = image_point_of[t];
@@ -318,13 +274,14 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
     }
     if (!candidate.pose.valid) {
       // Lost by its prediction: the picture may have moved as a whole.
-      candidate.relocked = find_shifted(t, candidate.pose, image_of) && settled(t);
+      candidate.relocked =
+          find_shifted(t, predicted[t], track_of_fiducial, candidate.pose, image_of) && settled(t);
     } else if (!settled(t)) {
       // A loose prediction: the shift's markers win when they are more, or as many and fit
       // better.
       pose::PlanarPose shifted;
       std::vector<int> shifted_image_of;
-      if (find_shifted(t, shifted, shifted_image_of) &&
+      if (find_shifted(t, predicted[t], track_of_fiducial, shifted, shifted_image_of) &&
           (shifted.points_used > candidate.pose.points_used ||
            (shifted.points_used == candidate.pose.points_used &&
             shifted.reprojection_rms_px < candidate.pose.reprojection_rms_px))) {
@@ -348,6 +305,64 @@ void ConstellationTracker::follow_tracks(int64_t stamp_ns,
         marker_images(*camera_, model, candidate.pose.camera_from_object, options_.visibility);
     candidates.push_back(std::move(candidate));
   }
+}
+
+void ConstellationTracker::predict_markers(const std::vector<BodyState>& predicted,
+                                           std::vector<PredictedMarker>& markers,
+                                           std::vector<std::pair<int, int>>& track_marker) const {
+  const double fiducial_variance = options_.fiducial_sigma_px * options_.fiducial_sigma_px;
+  for (size_t t = 0; t < tracks_.size(); ++t) {
+    const Eigen::Isometry3d& pose = predicted[t].camera_from_body;
+    const Matrix6d pose_covariance = predicted[t].pose_covariance();
+    const ConstellationModel& model = *tracks_[t].model;
+    const auto images = marker_images(*camera_, model, pose, options_.visibility);
+    for (size_t m = 0; m < model.points.size(); ++m) {
+      if (images[m].sight != MarkerSight::InView) continue;
+      // A marker behind another tracked board is not looked for: boards are opaque.
+      bool covered = false;
+      for (size_t u = 0; u < tracks_.size() && !covered; ++u) {
+        covered = u != t && behind_board(pose * model.points[m], *tracks_[u].model,
+                                         predicted[u].camera_from_body);
+      }
+      if (covered) continue;
+      const Eigen::Vector3d lever = pose.linear() * model.points[m];
+      auto jacobian = image_jacobian(*camera_, pose * model.points[m], lever, images[m].pixel);
+      if (!jacobian) continue;
+      PredictedMarker marker;
+      marker.pixel = images[m].pixel;
+      marker.covariance = *jacobian * pose_covariance * jacobian->transpose() +
+                          fiducial_variance * Eigen::Matrix2d::Identity();
+      markers.push_back(marker);
+      track_marker.emplace_back(static_cast<int>(t), static_cast<int>(m));
+    }
+  }
+}
+
+bool ConstellationTracker::find_shifted(size_t t, const BodyState& predicted,
+                                        const std::vector<int>& track_of_fiducial,
+                                        pose::PlanarPose& pose_out,
+                                        std::vector<int>& image_of) const {
+  const std::vector<Eigen::Vector2d>& fiducials = pixels_;
+  std::vector<bool> taken(fiducials.size());
+  for (size_t i = 0; i < fiducials.size(); ++i) {
+    taken[i] = track_of_fiducial[i] >= 0 && track_of_fiducial[i] != static_cast<int>(t);
+  }
+  const ConstellationModel& model = *tracks_[t].model;
+  const auto images =
+      marker_images(*camera_, model, predicted.camera_from_body, options_.visibility);
+  auto found = relock(model, images, fiducials, taken);
+  if (!found) return false;
+  pose::PlanarPoseOptions relock_options = options_.pose;
+  relock_options.min_points = options_.relock_min_markers;
+  IdentifiedConstellation shifted;
+  shifted.model = &model;
+  shifted.image_point_of = *found;
+  pose::PlanarPose pose = pose::estimate_planar_pose(
+      *camera_, marker_points(shifted), marker_pixels(shifted, fiducials), relock_options);
+  if (!pose.valid) return false;
+  pose_out = pose;
+  image_of = *found;
+  return true;
 }
 
 std::optional<std::vector<int>> ConstellationTracker::relock(

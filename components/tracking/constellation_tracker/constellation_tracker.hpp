@@ -33,6 +33,7 @@
 #include "body_motion.hpp"
 #include "constellation_database.hpp"
 #include "constellation_identifier.hpp"
+#include "marker_association.hpp"
 #include "marker_visibility.hpp"
 #include "planar_pose.hpp"
 
@@ -157,6 +158,16 @@ class ConstellationTracker {
 
   void follow_tracks(int64_t stamp_ns, const std::vector<ImageFiducial>& fiducials,
                      std::vector<Candidate>& candidates, TrackerStats& stats);
+  // Every tracked board's markers where the camera should see them with the boards at
+  // `predicted` (per track), with their uncertainty, and the (track, marker) of each; markers
+  // out of view or behind another tracked board are left out.
+  void predict_markers(const std::vector<BodyState>& predicted,
+                       std::vector<PredictedMarker>& markers,
+                       std::vector<std::pair<int, int>>& track_marker) const;
+  // The markers of track t found again by the picture's shift (relock) on fiducials no other
+  // track holds (`track_of_fiducial`), and the pose they give; false when there are none.
+  bool find_shifted(size_t t, const BodyState& predicted, const std::vector<int>& track_of_fiducial,
+                    pose::PlanarPose& pose, std::vector<int>& image_of) const;
   // The pose of track t from the fiducials associated with its markers (`image_of`, a marker
   // left out when its fit shows it is not the marker's), refined from the prediction.
   void fit_associated(size_t t, const BodyState& predicted,

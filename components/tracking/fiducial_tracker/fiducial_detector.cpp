@@ -85,6 +85,65 @@ void validate(const FiducialDetectorOptions& o) {
   check(o.uncertainty_floor_px >= 0, "uncertainty_floor_px must not be negative");
 }
 
+// The length and twice the area of the outline where `values` (a patch of `height` rows of
+// `stride`) crosses zero, by marching squares (FiducialDetector::circularity says how).
+struct Outline {
+  double length = 0, twice_area = 0;
+};
+Outline outline_of_patch(const float* values, int stride, int patch_height, bool join_diagonals) {
+  double length = 0, twice_area = 0;
+  // Adds the segment p-q, oriented so that `reference` lies on its right if
+  // `reference_inside`, on its left otherwise (y down: right of east is south).
+  auto add_segment = [&](cv::Point2d p, cv::Point2d q, cv::Point2d reference,
+                         bool reference_inside) {
+    const double side = (q.x - p.x) * (reference.y - p.y) - (q.y - p.y) * (reference.x - p.x);
+    if ((side > 0) != reference_inside) std::swap(p, q);
+    // sqrt, not std::hypot: hypot guards against overflow at several times the cost.
+    length += std::sqrt((q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y));
+    twice_area += p.x * q.y - q.x * p.y;
+  };
+  for (int py = 0; py + 1 < patch_height; ++py) {
+    const float* upper = values + static_cast<size_t>(py) * stride;
+    const float* lower = upper + stride;
+    for (int px = 0; px + 1 < stride; ++px) {
+      // Corners clockwise from the top left, in patch coordinates.
+      const float value[4] = {upper[px], upper[px + 1], lower[px + 1], lower[px]};
+      const int inside = (value[0] > 0 ? 1 : 0) | (value[1] > 0 ? 2 : 0) | (value[2] > 0 ? 4 : 0) |
+                         (value[3] > 0 ? 8 : 0);
+      if (inside == 0 || inside == 15) continue;
+      const cv::Point2d corner[4] = {{double(px), double(py)},
+                                     {px + 1.0, double(py)},
+                                     {px + 1.0, py + 1.0},
+                                     {double(px), py + 1.0}};
+      // Where edge e (corner e to corner e+1) crosses zero, for edges whose ends differ.
+      auto crossing = [&](int e) {
+        const int a = e, b = (e + 1) & 3;
+        const double t = value[a] / (value[a] - value[b]);
+        return corner[a] + t * (corner[b] - corner[a]);
+      };
+      auto is_inside = [&](int c) { return (inside >> c & 1) != 0; };
+      if (inside == 5 || inside == 10) {
+        // Saddle: cut off the two corners that are not joined across the cell.
+        const bool cut_outside = join_diagonals;
+        for (int c = 0; c < 4; ++c) {
+          if (is_inside(c) == cut_outside) continue;
+          // Corner c lies between edges c-1 and c.
+          add_segment(crossing((c + 3) & 3), crossing(c), corner[c], is_inside(c));
+        }
+        continue;
+      }
+      // One segment between the two edges whose ends differ.
+      int edges[2], found = 0, reference = 0;
+      for (int e = 0; e < 4; ++e) {
+        if (is_inside(e) != is_inside((e + 1) & 3)) edges[found++] = e;
+        if (is_inside(e)) reference = e;
+      }
+      add_segment(crossing(edges[0]), crossing(edges[1]), corner[reference], true);
+    }
+  }
+  return {length, twice_area};
+}
+
 }  // namespace
 
 FiducialDetector::FiducialDetector(FiducialDetectorOptions options) { set_options(options); }
@@ -400,8 +459,17 @@ double FiducialDetector::circularity(const cv::Mat& roi, const Region& region, d
   }
 
   // The patch: the bounding box and a margin of one pixel, where the outline closes.
-  const int stride = box_width + 2;
-  const int patch_height = box_height + 2;
+  fill_outline_patch(roi, region, threshold);
+  const auto [length, twice_area] = outline_of_patch(patch_values_.data(), box_width + 2,
+                                                     box_height + 2, options_.connectivity == 8);
+  if (length <= 0) return 0;
+  return 4 * std::numbers::pi * (std::abs(twice_area) / 2) / (length * length);
+}
+
+void FiducialDetector::fill_outline_patch(const cv::Mat& roi, const Region& region,
+                                          double threshold) {
+  const int stride = region.x_max - region.x_min + 3;
+  const int patch_height = region.y_max - region.y_min + 3;
   const int left = region.x_min - 1, top = region.y_min - 1;
   patch_mask_.assign(static_cast<size_t>(stride) * patch_height, 0);
   for (int index = region.first_run; index >= 0; index = runs_[index].next_in_region) {
@@ -425,60 +493,6 @@ double FiducialDetector::circularity(const cv::Mat& roi, const Region& region, d
       values[px] = mask[px] != 0 ? above : std::min(above, 0.0f);
     }
   }
-
-  const bool join_diagonals = options_.connectivity == 8;
-  double length = 0, twice_area = 0;
-  // Adds the segment p-q, oriented so that `reference` lies on its right if
-  // `reference_inside`, on its left otherwise (y down: right of east is south).
-  auto add_segment = [&](cv::Point2d p, cv::Point2d q, cv::Point2d reference,
-                         bool reference_inside) {
-    const double side = (q.x - p.x) * (reference.y - p.y) - (q.y - p.y) * (reference.x - p.x);
-    if ((side > 0) != reference_inside) std::swap(p, q);
-    // sqrt, not std::hypot: hypot guards against overflow at several times the cost.
-    length += std::sqrt((q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y));
-    twice_area += p.x * q.y - q.x * p.y;
-  };
-  for (int py = 0; py + 1 < patch_height; ++py) {
-    const float* upper = patch_values_.data() + static_cast<size_t>(py) * stride;
-    const float* lower = upper + stride;
-    for (int px = 0; px + 1 < stride; ++px) {
-      // Corners clockwise from the top left, in patch coordinates.
-      const float value[4] = {upper[px], upper[px + 1], lower[px + 1], lower[px]};
-      const int inside = (value[0] > 0 ? 1 : 0) | (value[1] > 0 ? 2 : 0) | (value[2] > 0 ? 4 : 0) |
-                         (value[3] > 0 ? 8 : 0);
-      if (inside == 0 || inside == 15) continue;
-      const cv::Point2d corner[4] = {{double(px), double(py)},
-                                     {px + 1.0, double(py)},
-                                     {px + 1.0, py + 1.0},
-                                     {double(px), py + 1.0}};
-      // Where edge e (corner e to corner e+1) crosses zero, for edges whose ends differ.
-      auto crossing = [&](int e) {
-        const int a = e, b = (e + 1) & 3;
-        const double t = value[a] / (value[a] - value[b]);
-        return corner[a] + t * (corner[b] - corner[a]);
-      };
-      auto is_inside = [&](int c) { return (inside >> c & 1) != 0; };
-      if (inside == 5 || inside == 10) {
-        // Saddle: cut off the two corners that are not joined across the cell.
-        const bool cut_outside = join_diagonals;
-        for (int c = 0; c < 4; ++c) {
-          if (is_inside(c) == cut_outside) continue;
-          // Corner c lies between edges c-1 and c.
-          add_segment(crossing((c + 3) & 3), crossing(c), corner[c], is_inside(c));
-        }
-        continue;
-      }
-      // One segment between the two edges whose ends differ.
-      int edges[2], found = 0, reference = 0;
-      for (int e = 0; e < 4; ++e) {
-        if (is_inside(e) != is_inside((e + 1) & 3)) edges[found++] = e;
-        if (is_inside(e)) reference = e;
-      }
-      add_segment(crossing(edges[0]), crossing(edges[1]), corner[reference], true);
-    }
-  }
-  if (length <= 0) return 0;
-  return 4 * std::numbers::pi * (std::abs(twice_area) / 2) / (length * length);
 }
 
 std::vector<DetectedFiducial> detect_fiducials(const cv::Mat& mono8,

@@ -163,6 +163,8 @@ class FiducialDetector {
   void collect_regions();
   void mark_crowded_regions();
   double circularity(const cv::Mat& roi, const Region& region, double threshold);
+  // patch_values_ for `region`'s bounding box and a margin of one pixel (circularity says how).
+  void fill_outline_patch(const cv::Mat& roi, const Region& region, double threshold);
   Centroid region_centroid(const Region& region, double threshold) const;
   bool window_centroid(const cv::Mat& roi, const Region& region, double threshold, Centroid& out);
 

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -111,51 +112,78 @@ bool start(Child& child) {
   return true;
 }
 
-}  // namespace
-
-int supervise(const std::vector<ChildProcess>& specs,
-              std::optional<std::chrono::steady_clock::duration> timeout) {
-  ShutdownSignal::install();
-  std::vector<Child> children(specs.size());
-  int result = 0;
-  bool stopping = false, forcing = false;
-  auto now = std::chrono::steady_clock::now;
-  auto kill_deadline = std::chrono::steady_clock::time_point::max();
-  auto stop_all = [&](std::string_view why) {
-    if (stopping) return;
-    stopping = true;
-    if (!why.empty()) say(why);
-    for (Child& child : children) {
-      if (child.running) kill(child.pid, SIGTERM);
-    }
-    kill_deadline = now() + kStopGrace;
-  };
-
-  for (size_t i = 0; i < specs.size(); ++i) {
-    children[i].spec = &specs[i];
-    if (!start(children[i])) {
-      say(fmt::format("cannot start group '{}': {}", specs[i].name, std::strerror(errno)));
-      result = 1;
-      stop_all("");
-      break;
+// The supervision of one set of children: their output, their ends, the stop and its
+// escalation.
+class Supervisor {
+ public:
+  explicit Supervisor(const std::vector<ChildProcess>& specs) : children_(specs.size()) {
+    for (size_t i = 0; i < specs.size(); ++i) {
+      children_[i].spec = &specs[i];
+      if (!start(children_[i])) {
+        say(fmt::format("cannot start group '{}': {}", specs[i].name, std::strerror(errno)));
+        result_ = 1;
+        stop_all("");
+        break;
+      }
     }
   }
-  auto deadline = timeout ? now() + *timeout : std::chrono::steady_clock::time_point::max();
+  ~Supervisor() {
+    for (Child& child : children_) {
+      for (Stream* s : {&child.out, &child.err}) {
+        if (s->fd >= 0) close(s->fd);
+      }
+    }
+  }
 
-  for (;;) {
+  // Until every child has ended; the exit code (0, or the first failing child's).
+  int run(std::optional<std::chrono::steady_clock::duration> timeout) {
+    const auto deadline = timeout ? now() + *timeout : Time::max();
+    for (;;) {
+      forward_output();
+      reap();
+      if (std::none_of(children_.begin(), children_.end(),
+                       [](const Child& child) { return child.running; })) {
+        return result_;
+      }
+      if (ShutdownSignal::received()) stop_all("stopping all groups");
+      if (now() >= deadline) stop_all("time is up; stopping all groups");
+      if (now() >= kill_deadline_) escalate();
+    }
+  }
+
+ private:
+  using Time = std::chrono::steady_clock::time_point;
+  static Time now() { return std::chrono::steady_clock::now(); }
+
+  void stop_all(std::string_view why) {
+    if (stopping_) return;
+    stopping_ = true;
+    if (!why.empty()) say(why);
+    for (Child& child : children_) {
+      if (child.running) kill(child.pid, SIGTERM);
+    }
+    kill_deadline_ = now() + kStopGrace;
+  }
+
+  // Waits up to 100 ms for output, and passes on what there is.
+  void forward_output() {
     std::vector<pollfd> fds;
-    for (Child& child : children) {
+    for (Child& child : children_) {
       for (Stream* s : {&child.out, &child.err}) {
         if (s->fd >= 0) fds.push_back({s->fd, POLLIN, 0});
       }
     }
     poll(fds.data(), fds.size(), 100);
-    for (Child& child : children) {
+    for (Child& child : children_) {
       forward(child, child.out, false);
       forward(child, child.err, false);
     }
+  }
 
-    for (Child& child : children) {
+  // Children that have ended: their last output, their exit code; the first to end stops the
+  // others.
+  void reap() {
+    for (Child& child : children_) {
       if (!child.running) continue;
       int status = 0;
       if (waitpid(child.pid, &status, WNOHANG) != child.pid) continue;
@@ -164,9 +192,9 @@ int supervise(const std::vector<ChildProcess>& specs,
       forward(child, child.out, true);
       forward(child, child.err, true);
       // A group stopped on request by a signal of ours has not failed.
-      bool stopped_by_us = stopping && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM;
-      if (child.exit_code != 0 && !stopped_by_us && result == 0) result = child.exit_code;
-      if (!stopping) {
+      bool stopped_by_us = stopping_ && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM;
+      if (child.exit_code != 0 && !stopped_by_us && result_ == 0) result_ = child.exit_code;
+      if (!stopping_) {
         stop_all(child.exit_code == 0
                      ? fmt::format("group '{}' finished; stopping the others", child.spec->name)
                  : WIFSIGNALED(status)
@@ -176,39 +204,41 @@ int supervise(const std::vector<ChildProcess>& specs,
                                    child.spec->name, child.exit_code));
       }
     }
+  }
 
-    bool any_running = false;
-    for (const Child& child : children) any_running |= child.running;
-    if (!any_running) break;
-    if (ShutdownSignal::received()) stop_all("stopping all groups");
-    if (now() >= deadline) stop_all("time is up; stopping all groups");
-    // A group still running kStopGrace after the request gets a second one, which forces its
-    // exit after its ForcedExitHooks (a recorder's metadata); one that has not exited when
-    // those had their time is killed.
-    if (now() >= kill_deadline) {
-      for (Child& child : children) {
-        if (!child.running) continue;
-        if (!forcing) {
-          say(fmt::format("group '{}' did not stop within {} s; forcing its exit", child.spec->name,
-                          kStopGrace.count()));
-          kill(child.pid, SIGTERM);
-        } else {
-          say(fmt::format("group '{}' did not exit when forced; killing it", child.spec->name));
-          kill(child.pid, SIGKILL);
-        }
+  // A group still running kStopGrace after the request gets a second one, which forces its
+  // exit after its ForcedExitHooks (a recorder's metadata); one that has not exited when those
+  // had their time is killed.
+  void escalate() {
+    for (Child& child : children_) {
+      if (!child.running) continue;
+      if (!forcing_) {
+        say(fmt::format("group '{}' did not stop within {} s; forcing its exit", child.spec->name,
+                        kStopGrace.count()));
+        kill(child.pid, SIGTERM);
+      } else {
+        say(fmt::format("group '{}' did not exit when forced; killing it", child.spec->name));
+        kill(child.pid, SIGKILL);
       }
-      kill_deadline = forcing
-                          ? std::chrono::steady_clock::time_point::max()
-                          : now() + std::chrono::seconds(ShutdownSignal::kForcedExitSeconds + 1);
-      forcing = true;
     }
+    kill_deadline_ = forcing_
+                         ? Time::max()
+                         : now() + std::chrono::seconds(ShutdownSignal::kForcedExitSeconds + 1);
+    forcing_ = true;
   }
-  for (Child& child : children) {
-    for (Stream* s : {&child.out, &child.err}) {
-      if (s->fd >= 0) close(s->fd);
-    }
-  }
-  return result;
+
+  std::vector<Child> children_;
+  int result_ = 0;
+  bool stopping_ = false, forcing_ = false;
+  Time kill_deadline_ = Time::max();
+};
+
+}  // namespace
+
+int supervise(const std::vector<ChildProcess>& specs,
+              std::optional<std::chrono::steady_clock::duration> timeout) {
+  ShutdownSignal::install();
+  return Supervisor(specs).run(timeout);
 }
 
 }  // namespace mocap

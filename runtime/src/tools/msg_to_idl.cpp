@@ -636,6 +636,70 @@ void write_verbatim(std::ostringstream& out, const std::vector<std::string>& com
   out << ")\n";
 }
 
+// The lines of a .msg file, tabs as spaces.
+std::vector<std::string> split_lines(std::string_view text) {
+  std::vector<std::string> lines;
+  for (size_t start = 0; start <= text.size();) {
+    size_t end = text.find_first_of("\r\n", start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string line(text.substr(start, end - start));
+    std::replace(line.begin(), line.end(), '\t', ' ');
+    if (end == text.size() && line.empty()) break;
+    lines.push_back(line);
+    start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+  }
+  return lines;
+}
+
+// "<type> <NAME>=<value>": `rest` is what follows the type, `equals` where its '=' is.
+MsgConstant parse_constant(const MsgSpecification& msg, std::string_view type_string,
+                           std::string_view rest, size_t equals, int line_number,
+                           const Failure& fail) {
+  const std::string_view package = msg.package;
+  MsgConstant constant;
+  constant.line = line_number;
+  constant.name = rtrim(rest.substr(0, equals));
+  if (!kIdlPrimitive.count(type_string))
+    fail("constant " + constant.name + " has type '" + std::string(type_string) +
+         "': constants are unbounded primitives (bool, int32, float64, string, ...)");
+  if (!valid_constant_name(constant.name))
+    fail("'" + constant.name +
+         "' is not a constant name: upper case, digits and single underscores");
+  for (const auto& other : msg.constants)
+    if (other.name == constant.name) fail("constant " + constant.name + " is defined twice");
+  constant.type = parse_type(type_string, package, fail);
+  constant.value_idl =
+      idl_literal(parse_primitive(constant.type, ltrim(rest.substr(equals + 1)), fail), fail);
+  return constant;
+}
+
+// "<type> <name> [default]": `rest` is what follows the type.
+MsgField parse_field(const MsgSpecification& msg, std::string_view type_string,
+                     std::string_view rest, int line_number, const Failure& fail) {
+  const std::string_view package = msg.package;
+  MsgField field;
+  field.line = line_number;
+  const size_t name_end = rest.find(' ');
+  field.name = rest.substr(0, name_end);
+  field.type = parse_type(type_string, package, fail);
+  if (field.type.is_fixed_array() && field.type.is_primitive() &&
+      (field.type.name == "string" || field.type.name == "wstring"))
+    fail("fixed array of strings '" + std::string(type_string) +
+         "': fastddsgen 2.3 writes them but does not read them back; use " +
+         type_text(MsgType{field.type.package, field.type.name, field.type.string_bound, true,
+                           field.type.array_size, true}) +
+         " (at most N) instead");
+  if (!valid_package_or_field_name(field.name))
+    fail("'" + field.name + "' is not a field name: lower case, digits and single underscores");
+  for (const auto& other : msg.fields)
+    if (other.name == field.name) fail("field " + field.name + " is defined twice");
+  if (name_end != std::string_view::npos) {
+    const std::string_view default_text = ltrim(rest.substr(name_end + 1));
+    if (!default_text.empty()) field.default_idl = parse_default(field.type, default_text, fail);
+  }
+  return field;
+}
+
 }  // namespace
 
 MsgSpecification parse_msg(std::string_view package, std::string_view name, std::string_view text,
@@ -649,16 +713,7 @@ MsgSpecification parse_msg(std::string_view package, std::string_view name, std:
   msg.package = package;
   msg.name = name;
 
-  std::vector<std::string> lines;
-  for (size_t start = 0; start <= text.size();) {
-    size_t end = text.find_first_of("\r\n", start);
-    if (end == std::string_view::npos) end = text.size();
-    std::string line(text.substr(start, end - start));
-    std::replace(line.begin(), line.end(), '\t', ' ');
-    if (end == text.size() && line.empty()) break;
-    lines.push_back(line);
-    start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
-  }
+  const std::vector<std::string> lines = split_lines(text);
 
   size_t first = 0;  // the comment block at the top documents the message
   while (first < lines.size() && starts_with(lines[first], "#"))
@@ -692,45 +747,10 @@ MsgSpecification parse_msg(std::string_view package, std::string_view name, std:
 
     const size_t equals = rest.find('=');
     if (equals != std::string_view::npos) {
-      MsgConstant constant;
-      constant.line = line_number;
-      constant.name = rtrim(rest.substr(0, equals));
-      if (!kIdlPrimitive.count(type_string))
-        fail("constant " + constant.name + " has type '" + std::string(type_string) +
-             "': constants are unbounded primitives (bool, int32, float64, string, ...)");
-      if (!valid_constant_name(constant.name))
-        fail("'" + constant.name +
-             "' is not a constant name: upper case, digits and single underscores");
-      for (const auto& other : msg.constants)
-        if (other.name == constant.name) fail("constant " + constant.name + " is defined twice");
-      constant.type = parse_type(type_string, package, fail);
-      constant.value_idl =
-          idl_literal(parse_primitive(constant.type, ltrim(rest.substr(equals + 1)), fail), fail);
-      msg.constants.push_back(std::move(constant));
+      msg.constants.push_back(parse_constant(msg, type_string, rest, equals, line_number, fail));
       last_comment = &msg.constants.back().comment;
     } else {
-      MsgField field;
-      field.line = line_number;
-      const size_t name_end = rest.find(' ');
-      field.name = rest.substr(0, name_end);
-      field.type = parse_type(type_string, package, fail);
-      if (field.type.is_fixed_array() && field.type.is_primitive() &&
-          (field.type.name == "string" || field.type.name == "wstring"))
-        fail("fixed array of strings '" + std::string(type_string) +
-             "': fastddsgen 2.3 writes them but does not read them back; use " +
-             type_text(MsgType{field.type.package, field.type.name, field.type.string_bound, true,
-                               field.type.array_size, true}) +
-             " (at most N) instead");
-      if (!valid_package_or_field_name(field.name))
-        fail("'" + field.name + "' is not a field name: lower case, digits and single underscores");
-      for (const auto& other : msg.fields)
-        if (other.name == field.name) fail("field " + field.name + " is defined twice");
-      if (name_end != std::string_view::npos) {
-        const std::string_view default_text = ltrim(rest.substr(name_end + 1));
-        if (!default_text.empty())
-          field.default_idl = parse_default(field.type, default_text, fail);
-      }
-      msg.fields.push_back(std::move(field));
+      msg.fields.push_back(parse_field(msg, type_string, rest, line_number, fail));
       last_comment = &msg.fields.back().comment;
     }
     last_comment->insert(last_comment->end(), pending_comment.begin(), pending_comment.end());
