@@ -280,6 +280,8 @@ int info(const std::string& path) {
 
 }  // namespace
 
+// Kept whole (about 85 lines): one option parser for the three commands, whose options
+// overlap.
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) usage_error("no command given");

@@ -27,6 +27,8 @@ int root_of(std::vector<int>& parent, int node) {
 
 }  // namespace
 
+// Kept whole (about 85 lines): gating, the tangles and their assignments are three passes
+// over the same pair list, in the order the comments give.
 std::vector<int> associate_markers(const std::vector<PredictedMarker>& predictions,
                                    const std::vector<Eigen::Vector2d>& fiducials, double gate) {
   const int prediction_count = static_cast<int>(predictions.size());
