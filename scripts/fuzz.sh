@@ -94,7 +94,7 @@ for name in "${names[@]}"; do
   rate=$([ -z "$executions" ] || echo $((executions / seconds)))
   # The last status line ("#N DONE cov: C ft: F corp: K/...") or, after a crash, the last one
   # printed before it.
-  last=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1)
+  last=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1 || true)  # none: it failed at once
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<< "$last")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<< "$last")
   corpus=$(sed -n 's/.* corp: \([0-9]*\)\/.*/\1/p' <<< "$last")
