@@ -1,6 +1,6 @@
 // The graph's default topic names, one place for every component, each with the type it
 // carries. They are part of the interface (README "Messages"); a launch file may remap any of
-// them. A {placeholder} names a family: one topic per board or camera.
+// them. A name with {board} or {camera} in it is a family: one topic per board or camera.
 #pragma once
 
 #include <string>

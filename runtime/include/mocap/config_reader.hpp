@@ -5,9 +5,8 @@
 //
 // A problem stops the reading: fail() throws the format's own Error (constructed from the
 // one-line message), so callers keep catching the format's exception type. A format that
-// reports every problem at once reads each independent part (a group, a component, a topic)
-// inside collect(), which records that part's problem and goes on; problems() then lists them
-// in file order.
+// reports every problem at once records them instead (record(), report_keys()) and goes on;
+// problems() then lists them in file order.
 //
 //   mocap::ConfigReader<SceneError> reader(path);
 //   YAML::Node root = reader.load();
@@ -79,17 +78,6 @@ class ConfigReader {
     throw Error(fmt::format("{}{}: {}", source_, where(node), what));
   }
 
-  // Runs `read`; a problem it fails with is recorded, and false returned, instead of thrown.
-  template <class Read>
-  bool collect(Read&& read) {
-    try {
-      read();
-      return true;
-    } catch (const Error& e) {
-      problems_.emplace_back(line_of_message(e.what()), e.what());
-      return false;
-    }
-  }
   // Records a problem at `node` (or at 1-based `line`) without stopping.
   void record(const YAML::Node& node, const std::string& what) { record(line_of(node), what); }
   void record(int line, const std::string& what) {
@@ -277,17 +265,6 @@ class ConfigReader {
     int line = line_of(node);
     return line > 0 ? fmt::format(":{}", line) : "";
   }
-  // The line in "file:12: ...", for ordering collected problems.
-  int line_of_message(std::string_view message) const {
-    if (!message.starts_with(source_ + ":")) return std::numeric_limits<int>::max();
-    int line = 0;
-    for (char c : message.substr(source_.size() + 1)) {
-      if (c < '0' || c > '9') break;
-      line = line * 10 + (c - '0');
-    }
-    return line > 0 ? line : std::numeric_limits<int>::max();
-  }
-
   std::string source_;
   std::vector<std::pair<int, std::string>> problems_;
 };

@@ -176,9 +176,9 @@ struct ComponentHost::Impl {
       : options(std::move(host_options)), executor(options.threads), logger(options.name) {
     transports.push_back(std::make_unique<IntraProcessTransport>());
     if (options.dds.enabled) {
-      auto dds = make_dds_transport(options.dds, options.name);
-      dds_domain = dds->domain_id();
       dds_implementation = &resolve_dds_implementation(options.dds.implementation);
+      auto dds = dds_implementation->make(options.dds, options.name);
+      dds_domain = dds->domain_id();
       transports.push_back(std::move(dds));
     }
   }
