@@ -37,7 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const CalibrationConfigError& error) {
     // The configuration's own errors name it; a data file's errors name that file.
     const std::string_view what = error.what();
-    if (!what.starts_with("calib.json: ") && !what.starts_with((folder / "").string())) {
+    if (!what.starts_with("calib.json:") && !what.starts_with((folder / "").string())) {
       std::abort();
     }
     return 0;

@@ -63,7 +63,7 @@ std::optional<CalibrationConfig> read(const std::filesystem::path& folder, const
     return parse_calibration_config(config_for(a, b, file), "calib.json", folder.string());
   } catch (const CalibrationConfigError& error) {
     const std::string_view what = error.what();
-    if (!what.starts_with("calib.json: ") && !what.starts_with((folder / file).string() + ": ")) {
+    if (!what.starts_with("calib.json:") && !what.starts_with((folder / file).string() + ":")) {
       std::abort();
     }
     return std::nullopt;

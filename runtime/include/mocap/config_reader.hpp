@@ -1,7 +1,8 @@
 // Reading YAML configuration files with one-line errors that name the file and the line of the
 // node at fault: "scene.yaml:12: 'period_s' must be a number, not 'fast'". Every configuration
 // format of the project reads through it: launch files, bag metadata, camera files,
-// constellation databases, synthetic and PixArt scenes, rigs and turrets.
+// constellation databases, synthetic and PixArt scenes, rigs, turrets, and (through
+// calibration/src/json_reader.hpp) the calibration's JSON configuration and data files.
 //
 // A problem stops the reading: fail() throws the format's own Error (constructed from the
 // one-line message), so callers keep catching the format's exception type. A format that
@@ -50,7 +51,10 @@ template <class Error = ConfigError>
 class ConfigReader {
  public:
   // `source` names the file in messages: its path, or "launch.yaml" for text given directly.
-  explicit ConfigReader(std::string source) : source_(std::move(source)) {}
+  // `syntax` names the file's syntax in parse errors: a JSON file (yaml-cpp reads JSON too)
+  // says "JSON error".
+  explicit ConfigReader(std::string source, std::string syntax = "YAML")
+      : source_(std::move(source)), syntax_(std::move(syntax)) {}
 
   const std::string& source() const { return source_; }
 
@@ -60,8 +64,8 @@ class ConfigReader {
     try {
       return YAML::Load(text);
     } catch (const YAML::Exception& e) {
-      throw Error(fmt::format("{}:{}:{}: YAML error: {}", source_, e.mark.line + 1,
-                              e.mark.column + 1, e.msg));
+      throw Error(fmt::format("{}:{}:{}: {} error: {}", source_, e.mark.line + 1, e.mark.column + 1,
+                              syntax_, e.msg));
     }
   }
 
@@ -266,6 +270,7 @@ class ConfigReader {
     return line > 0 ? fmt::format(":{}", line) : "";
   }
   std::string source_;
+  std::string syntax_;
   std::vector<std::pair<int, std::string>> problems_;
 };
 

@@ -140,20 +140,21 @@ struct CalibrationConfig {
   std::vector<std::string> ignored_flags;
 };
 
-// A configuration or data file that cannot be used. One line: the file, the key path and what
-// is wrong, e.g. "calib.json: transformations[1].value: 3, 6, 7 or 12 numbers, not 5".
+// A configuration or data file that cannot be used. One line: the file, the line, the key path
+// and what is wrong, e.g. "calib.json:14: transformations[1].value: 3, 6, 7 or 12 numbers, not 5".
 class CalibrationConfigError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
 // Reads the config and every data file it references. Errors (CalibrationConfigError) name the
-// file and the key path: unknown keys (with the nearest known one), wrong types, duplicate
-// names, a chain naming an undeclared transformation or camera, a chain without exactly one
-// per-shot transformation, camera value counts, image sizes that are not positive, malformed
-// JSON (with its line, column and byte), and a data file's own errors with that file's name and
-// its key path ("ir.json: [3][0].points: ..."). A data entry whose camera has no complete frame
-// in its data file is an error too: it would calibrate nothing.
+// file, the line and the key path: unknown or repeated keys (with the nearest known one), wrong
+// types, duplicate names, a chain naming an undeclared transformation or camera, a chain without
+// exactly one per-shot transformation, camera value counts, image sizes that are not positive,
+// malformed JSON (with its line and column), and a data file's own errors with that file's name
+// ("ir.json:4: [3][0].points: ..."). A data entry whose camera has no complete frame in its data
+// file is an error too: it would calibrate nothing. The files are read by yaml-cpp, which takes
+// a little more than JSON (a trailing comma in a list; YAML of the same shape).
 CalibrationConfig load_calibration_config(const std::string& path);
 // `source` names the text in messages; data files are looked up relative to `base_directory`
 // (unless absolute).
