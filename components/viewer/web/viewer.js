@@ -122,6 +122,9 @@ function data(bytes) {
   const view = new DataView(bytes.buffer, bytes.byteOffset);
   const channel = bySubscription.get(view.getUint32(1, true));
   if (!channel) return;
+  // When the bridge received the message, on the graph's clock (the page's clock may be
+  // another machine's).
+  const receivedMs = Number(view.getBigUint64(5, true)) / 1e6;
   const payload = bytes.subarray(13);
   const topic = topics.get(channel.topic);
   if (topic) {
@@ -136,7 +139,7 @@ function data(bytes) {
     return;
   }
   const handler = handlers[channel.topic];
-  if (handler) handler(message);
+  if (handler) handler(message, receivedMs);
 }
 
 // --- what arrives -------------------------------------------------------------------------
@@ -186,11 +189,13 @@ const handlers = {
   [CAMERA_INFO](info) {
     cameraInfo = info;
   },
-  [POSES](message) {
+  [POSES](message, receivedMs) {
     latestPoses = message;
     remember(recentPoses, stampKey(message.header), message.poses);
     dirty.camera = true;
-    state.latencyMs = Date.now() - stampSeconds(message.header) * 1000;
+    // Capture to bridge, both on the graph's clocks: the page's Date.now() would add the
+    // difference between this machine's clock and the graph's.
+    state.latencyMs = receivedMs - stampSeconds(message.header) * 1000;
     posesAt = Date.now();
     for (const pose of message.poses) addToTrail(pose.name, pose.pose.pose.position);
     dirty.side = true;
@@ -550,7 +555,7 @@ setInterval(() => {
   renderTopics();
   const images = topics.get(IMAGE)?.rate;
   $("rates").textContent = state.connected
-    ? `camera ${images ?? 0} Hz shown · poses ${topics.get(POSES)?.rate ?? 0} Hz · latency ${state.latencyMs === null ? "—" : state.latencyMs.toFixed(1) + " ms"}`
+    ? `camera ${images ?? 0} Hz shown · poses ${topics.get(POSES)?.rate ?? 0} Hz · latency to bridge ${state.latencyMs === null ? "—" : state.latencyMs.toFixed(1) + " ms"}`
     : "";
 }, 1000);
 
