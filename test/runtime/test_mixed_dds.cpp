@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <random>
+#include <regex>
+#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -88,6 +92,57 @@ TEST(MixedDds, EveryMessageTypeCrossesFromFastDdsToCycloneDds) {
 
 TEST(MixedDds, EveryMessageTypeCrossesFromCycloneDdsToFastDds) {
   expect_every_type_crosses("cyclonedds", "fastdds", 71);
+}
+
+// The receive buffers (ss's "rb", which the kernel doubles) of this process's UDP sockets, as
+// ss lists them.
+std::vector<uint64_t> udp_receive_buffers() {
+  auto [code, listing] = test::run_command({"ss", "-u", "-a", "-n", "-m", "-p"});
+  EXPECT_EQ(code, 0) << listing;
+  std::vector<uint64_t> buffers;
+  const std::string ours = fmt::format("pid={},", getpid());
+  std::istringstream lines(listing);
+  std::string line;
+  bool socket_is_ours = false;
+  static const std::regex receive_buffer(R"(skmem:\(r\d+,rb(\d+),)");
+  while (std::getline(lines, line)) {
+    std::smatch match;
+    if (std::regex_search(line, match, receive_buffer)) {
+      if (socket_is_ours) buffers.push_back(std::stoull(match[1]));
+      socket_is_ours = false;
+    } else if (!line.empty() && line[0] != ' ' && line[0] != '\t') {
+      socket_is_ours = line.find(ours) != std::string::npos;
+    }
+  }
+  return buffers;
+}
+
+// Both implementations' sockets ask for kUdpSocketBufferBytes (as much as net.core.rmem_max
+// lets them have): a camera image arrives whole, without repairs (dds_transport.hpp).
+TEST(MixedDds, BothImplementationsReceiveUdpIntoLargeBuffers) {
+  uint64_t rmem_max = 0;
+  std::istringstream(test::read_file("/proc/sys/net/core/rmem_max")) >> rmem_max;
+  const uint64_t expected = std::min<uint64_t>(kUdpSocketBufferBytes, rmem_max);
+  for (const std::string implementation : {"fastdds", "cyclonedds"}) {
+    const std::vector<uint64_t> before = udp_receive_buffers();
+    auto transport = participant(implementation, 79);
+    const std::vector<uint64_t> after = udp_receive_buffers();
+    ASSERT_GT(after.size(), before.size()) << implementation << ": no UDP socket seen";
+    EXPECT_GE(*std::max_element(after.begin(), after.end()), expected) << implementation;
+  }
+}
+
+TEST(MixedDds, ASocketBufferCapIsSaidWithTheCommandThatLiftsIt) {
+  test::TempDir dir;
+  test::write_file(dir / "rmem_max", "212992\n");
+  test::write_file(dir / "wmem_max", "4194304\n");
+  EXPECT_EQ(udp_buffer_problem(dir.path()),
+            "net.core.rmem_max is 212992 bytes: UDP socket buffers are capped there, and large "
+            "samples (camera images) between hosts wait for repairs; to lift the cap: sysctl -w "
+            "net.core.rmem_max=4194304 net.core.wmem_max=4194304");
+  test::write_file(dir / "rmem_max", "8388608\n");
+  EXPECT_EQ(udp_buffer_problem(dir.path()), std::nullopt);
+  EXPECT_EQ(udp_buffer_problem(dir / "absent"), std::nullopt);  // no /proc: nothing to say
 }
 
 // Discovery across implementations: each lists the other's endpoints with their QoS and names.

@@ -595,6 +595,9 @@ int ComponentHost::run(std::optional<std::chrono::duration<double>> duration) {
                     ? ""
                     : ", UDP only")
           : std::string("DDS off"));
+  if (dds.enabled) {
+    if (auto problem = udp_buffer_problem()) impl_->logger.warn("{}", *problem);
+  }
   auto deadline =
       duration ? std::chrono::steady_clock::now() +
                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(*duration)

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -54,6 +55,23 @@ const DdsImplementation& resolve_dds_implementation(std::string_view configured)
   }
   throw std::runtime_error(fmt::format("{} '{}' is not a DDS implementation here (available: {})",
                                        source, name, dds_implementation_names()));
+}
+
+std::optional<std::string> udp_buffer_problem(const std::filesystem::path& sysctl_directory) {
+  std::vector<std::string> capped;
+  for (const char* name : {"rmem_max", "wmem_max"}) {
+    std::ifstream file(sysctl_directory / name);
+    uint64_t bytes = 0;
+    if (file >> bytes && bytes < kUdpSocketBufferBytes) {
+      capped.push_back(fmt::format("net.core.{} is {} bytes", name, bytes));
+    }
+  }
+  if (capped.empty()) return std::nullopt;
+  return fmt::format(
+      "{}: UDP socket buffers are capped there, and large samples (camera images) between "
+      "hosts wait for repairs; to lift the cap: sysctl -w net.core.rmem_max={} "
+      "net.core.wmem_max={}",
+      fmt::join(capped, " and "), kUdpSocketBufferBytes, kUdpSocketBufferBytes);
 }
 
 int resolve_domain_id(int configured) {

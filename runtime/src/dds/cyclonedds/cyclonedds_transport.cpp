@@ -164,13 +164,13 @@ std::string domain_configuration(const DdsOptions& options) {
   // A crashed peer is forgotten after 5 s, as with Fast DDS (fastdds_qos.cpp says why).
   // A Fast DDS writer sends a large sample's fragments in one burst, without Cyclone's own
   // pacing: with Cyclone's 1 MB socket buffer a 1280x720 image overflowed it, and the repairs
-  // cut the rate from Fast DDS to Cyclone eightfold (transport_bench). The kernel caps the
-  // request at net.core.rmem_max.
+  // cut the rate from Fast DDS to Cyclone eightfold (transport_bench). Both implementations ask
+  // for kUdpSocketBufferBytes; the kernel caps the request at net.core.rmem_max.
   return fmt::format(
       "<CycloneDDS><Domain Id=\"any\"><Discovery><LeaseDuration>5 s</LeaseDuration></Discovery>"
-      "<Internal><SocketReceiveBufferSize min=\"default\" max=\"8MB\"/></Internal>"
+      "<Internal><SocketReceiveBufferSize min=\"default\" max=\"{}B\"/></Internal>"
       "{}</Domain></CycloneDDS>",
-      security);
+      kUdpSocketBufferBytes, security);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include <fastrtps/utils/IPLocator.h>
 #include <fmt/format.h>
 
+#include "dds/dds_transport.hpp"
 #include "dds/writer_backpressure.hpp"
 
 namespace mocap {
@@ -222,8 +223,12 @@ dds::DomainParticipantQos to_participant_qos(const DdsOptions& given, const std:
     shared_memory->segment_size(kSharedMemorySegmentBytes);
     out.transport().user_transports.push_back(shared_memory);
   }
-  out.transport().user_transports.push_back(
-      std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+  // Fast DDS otherwise keeps the system's default socket buffers (dds_transport.hpp says why
+  // that is too small).
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->receiveBufferSize = kUdpSocketBufferBytes;
+  udp->sendBufferSize = kUdpSocketBufferBytes;
+  out.transport().user_transports.push_back(udp);
   return out;
 }
 
