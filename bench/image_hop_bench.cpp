@@ -1,0 +1,242 @@
+// Camera images between hosts: one 1280x720 mono8 hop over UDP at 100 Hz through the runtime,
+// for each pair of DDS implementations (publisher -> subscriber), between two processes of this
+// machine (loopback) and between two network-namespace hosts joined by a veth link (as two
+// machines on a switch; needs root) with Ethernet's MTU and with jumbo frames. Shared memory is off
+// for Fast DDS, so every image crosses UDP as it does between machines. All measured in this run,
+// the paths interleaved.
+//
+//   build/bin/image_hop_bench [--quick]
+//
+// One-way latency: the publisher stamps each image with CLOCK_MONOTONIC just before
+// publishing, the subscriber subtracts it from its own reading on arrival (network namespaces
+// share the kernel's clock). Target: median <= 1 ms on every path (issue: a tracking volume).
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <mocap/component_host.hpp>
+#include <sensor_msgs/msg/image.hpp>
+
+#include "one_hop.hpp"
+
+namespace {
+
+using namespace mocap::one_hop;
+using Image = sensor_msgs::msg::Image;
+
+constexpr int kRateHz = 100;
+const Size kImage{"Image 1280x720 mono8", true, 1280, 720, kRateHz, 0, 0};
+
+mocap::HostOptions udp_host(const std::string& name, const std::string& implementation) {
+  return {.name = name,
+          .threads = 2,
+          .dds = {.implementation = implementation, .fastdds = {.shared_memory = false}}};
+}
+
+// --- the two processes ------------------------------------------------------------------
+
+int run_subscriber(const std::string& implementation, int total, const std::string& out) {
+  mocap::ComponentHost host(udp_host("image_subscriber", implementation));
+  host.add(kSubscriberFactory<Image>, {.name = "subscriber"});
+  host.start();
+  // Tells the publisher, through a file beside `out`, that the path is open.
+  if (received.wait_primed(std::chrono::seconds(60))) std::ofstream(out + ".ready");
+  received.wait_for(total, std::chrono::seconds(120));
+  host.stop();
+  std::lock_guard lock(received.mutex);
+  std::ofstream file(out);
+  file << received.count << "\n";
+  for (double latency : received.latencies_us) file << latency << "\n";
+  return 0;
+}
+
+int run_publisher(const std::string& implementation, int count, const std::string& out) {
+  mocap::ComponentHost host(udp_host("image_publisher", implementation));
+  auto& publisher =
+      static_cast<BenchPublisher<Image>&>(host.add(kPublisherFactory<Image>, {.name = "pub"}));
+  host.start();
+  for (int i = 0; i < 1000 && publisher.publisher.matched_subscribers() == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  // Priming images until the subscriber has one: each side may see the other first.
+  Image priming = prototype<Image>(kImage);
+  priming.header().frame_id(kPrimingFrame);
+  for (int i = 0; i < 1000 && !std::filesystem::exists(out + ".ready"); ++i) {
+    publisher.publisher.publish(std::make_shared<Image>(priming));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  auto image = std::make_shared<Image>(prototype<Image>(kImage));
+  publish_all(count, kRateHz, [&] {
+    stamp(*image);
+    publisher.publisher.publish(image);
+    return stamp_ns(*image);
+  });
+  // Until the subscriber has everything (reliable): stopping now would drop the last ones.
+  for (int i = 0; i < 3000 && !std::filesystem::exists(out); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  host.stop();
+  return 0;
+}
+
+// --- two hosts --------------------------------------------------------------------------
+
+// Two network namespaces joined by a veth pair, each end eth0 with an address of its own and
+// a multicast route (DDS discovers by multicast). Removed when destroyed.
+class NamespaceHosts {
+ public:
+  NamespaceHosts() {
+    const std::string a = names_[0], b = names_[1];
+    ok_ = run("ip netns add " + a) && run("ip netns add " + b) &&
+          run(fmt::format("ip link add eth0 netns {} type veth peer name eth0 netns {}", a, b));
+    for (int i = 0; ok_ && i < 2; ++i) {
+      const std::string& n = names_[i];
+      ok_ = run(fmt::format("ip -n {} addr add 10.213.0.{}/24 dev eth0", n, i + 1)) &&
+            run(fmt::format("ip -n {} link set eth0 up", n)) &&
+            run(fmt::format("ip -n {} link set lo up", n)) &&
+            run(fmt::format("ip -n {} route add 224.0.0.0/4 dev eth0", n));
+    }
+  }
+  ~NamespaceHosts() {
+    for (const std::string& n : names_) run("ip netns del " + n + " 2>/dev/null");
+  }
+  bool ok() const { return ok_; }
+  const std::string& name(int i) const { return names_[i]; }
+  // The link's MTU, both ends.
+  void set_mtu(int mtu) const {
+    for (const std::string& n : names_) run(fmt::format("ip -n {} link set eth0 mtu {}", n, mtu));
+  }
+
+ private:
+  static bool run(const std::string& command) {
+    return std::system((command + " 2>/dev/null").c_str()) == 0;
+  }
+  std::string names_[2] = {fmt::format("imghopA{}", getpid()), fmt::format("imghopB{}", getpid())};
+  bool ok_ = false;
+};
+
+// --- the orchestrating process ----------------------------------------------------------
+
+struct Path {
+  std::string publisher, subscriber;  // implementations
+  int mtu;                            // of the link between two namespace hosts; 0: loopback
+  std::string label() const {
+    return fmt::format("{} -> {}, {}", publisher, subscriber,
+                       mtu > 0 ? fmt::format("hosts, MTU {}", mtu) : "loopback");
+  }
+};
+
+struct Result {
+  std::vector<double> latencies_us;
+  int delivered = 0, expected = 0;
+};
+
+pid_t spawn(const std::vector<std::string>& argv) {
+  pid_t child = fork();
+  if (child == 0) {
+    std::vector<char*> args;
+    for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+    args.push_back(nullptr);
+    execvp(args[0], args.data());
+    _exit(127);
+  }
+  return child;
+}
+
+void measure(const std::string& self, const Path& path, const NamespaceHosts* hosts, int count,
+             Result& result) {
+  const std::string out = fmt::format("/tmp/image_hop_bench_{}.txt", getpid());
+  auto on = [&](int host, std::vector<std::string> argv) {
+    if (hosts == nullptr) return argv;
+    argv.insert(argv.begin(), {"ip", "netns", "exec", hosts->name(host)});
+    return argv;
+  };
+  const int total = kWarmup + count;
+  pid_t subscriber =
+      spawn(on(1, {self, "--subscriber", path.subscriber, std::to_string(total), out}));
+  pid_t publisher = spawn(on(0, {self, "--publisher", path.publisher, std::to_string(count), out}));
+  waitpid(subscriber, nullptr, 0);
+  waitpid(publisher, nullptr, 0);
+  std::ifstream in(out);
+  int delivered = 0;
+  in >> delivered;
+  for (double latency; in >> latency;) result.latencies_us.push_back(latency);
+  result.delivered += delivered;
+  result.expected += total;
+  std::remove(out.c_str());
+  std::remove((out + ".ready").c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.size() == 4 && args[0] == "--subscriber") {
+    return run_subscriber(args[1], std::stoi(args[2]), args[3]);
+  }
+  if (args.size() == 4 && args[0] == "--publisher") {
+    return run_publisher(args[1], std::stoi(args[2]), args[3]);
+  }
+  const bool quick = !args.empty() && args[0] == "--quick";
+  if (getenv("MOCAP_DOMAIN_ID") == nullptr) {
+    setenv("MOCAP_DOMAIN_ID", std::to_string(200 + getpid() % 30).c_str(), 1);
+  }
+  const int rounds = quick ? 1 : 3;
+  const int count = quick ? 300 : 500;
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  NamespaceHosts hosts;
+  std::vector<Path> paths;
+  // Ethernet's 1500 bytes, and the jumbo frames of a camera network (GigE Vision's 9000).
+  for (int mtu : {0, 1500, 9000}) {
+    if (mtu > 0 && !hosts.ok()) continue;
+    for (const char* publisher : {"fastdds", "cyclonedds"}) {
+      for (const char* subscriber : {"fastdds", "cyclonedds"}) {
+        paths.push_back({publisher, subscriber, mtu});
+      }
+    }
+  }
+  std::map<std::string, Result> results;
+  for (int round = 0; round < rounds; ++round) {
+    for (size_t turn = 0; turn < paths.size(); ++turn) {
+      const Path& path = paths[(turn + size_t(round)) % paths.size()];
+      if (path.mtu > 0) hosts.set_mtu(path.mtu);
+      measure(self, path, path.mtu > 0 ? &hosts : nullptr, count, results[path.label()]);
+    }
+  }
+  fmt::print(
+      "image_hop_bench: {} at {} Hz over UDP through the runtime (Fast DDS's shared memory "
+      "off), {} cores, {} round(s) of {} images a path, the paths interleaved.{}\n\n",
+      kImage.label, kRateHz, std::thread::hardware_concurrency(), rounds, count,
+      hosts.ok() ? "" : " No namespace hosts (needs root and ip): loopback only.");
+  fmt::print("| {:<42} | {:>9} | {:>9} | {:>12} |\n", "publisher -> subscriber, where", "median us",
+             "p99 us", "delivered");
+  fmt::print("|{:-<44}|{:-<11}|{:-<11}|{:-<14}|\n", "", "", "", "");
+  // Per place: the fastest and slowest median.
+  std::map<int, std::pair<double, double>> spread;
+  for (const Path& path : paths) {
+    const Result& r = results[path.label()];
+    const double median = quantile(r.latencies_us, 0.5);
+    auto [it, fresh] = spread.try_emplace(path.mtu, median, median);
+    it->second = {std::min(it->second.first, median), std::max(it->second.second, median)};
+    fmt::print("| {:<42} | {:>9.1f} | {:>9.1f} | {:>12} |\n", path.label(), median,
+               quantile(r.latencies_us, 0.99), fmt::format("{} of {}", r.delivered, r.expected));
+  }
+  fmt::print(
+      "\ntargets: median <= 1000 us on every path; per place, the slowest pair of "
+      "implementations within 1.5 x the fastest:");
+  for (const auto& [mtu, fastest_slowest] : spread) {
+    fmt::print(" {} {:.2f} x;", mtu > 0 ? fmt::format("MTU {}", mtu) : "loopback",
+               fastest_slowest.second / fastest_slowest.first);
+  }
+  fmt::print("\n");
+  return 0;
+}
