@@ -2,117 +2,45 @@
 
 #include <algorithm>
 #include <cmath>
-
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
-#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <opencv2/calib3d.hpp>
+
+#include "pose_refinement.hpp"
 
 namespace mocap::pose {
 namespace {
 
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
-
-// Applies a small motion (translation, rotation vector in the camera frame) to a pose.
-Eigen::Isometry3d perturbed(const Eigen::Isometry3d& pose, const Vector6d& delta) {
-  Eigen::Isometry3d result = pose;
-  double angle = delta.tail<3>().norm();
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  if (angle > 0) rotation = Eigen::AngleAxisd(angle, delta.tail<3>() / angle).toRotationMatrix();
-  result.linear() = rotation * pose.linear();
-  result.translation() = pose.translation() + delta.head<3>();
-  return result;
-}
-
-struct Residuals {
-  Eigen::VectorXd values;
-  bool valid = true;
-};
-
-Residuals residuals(const calibration::CameraModel& camera, const Eigen::Isometry3d& pose,
-                    const std::vector<Eigen::Vector3d>& object,
-                    const std::vector<Eigen::Vector2d>& pixels) {
-  Residuals r;
-  r.values.resize(2 * static_cast<Eigen::Index>(object.size()));
+// The pixel residuals of `object` seen through `camera` at `pose`.
+std::optional<Eigen::VectorXd> residuals(const calibration::CameraModel& camera,
+                                         const Eigen::Isometry3d& pose,
+                                         const std::vector<Eigen::Vector3d>& object,
+                                         const std::vector<Eigen::Vector2d>& pixels) {
+  Eigen::VectorXd values(2 * static_cast<Eigen::Index>(object.size()));
   for (size_t i = 0; i < object.size(); ++i) {
     auto projected = camera.project(pose * object[i]);
-    if (!projected) {
-      r.valid = false;
-      return r;
-    }
-    r.values.segment<2>(2 * static_cast<Eigen::Index>(i)) = *projected - pixels[i];
+    if (!projected) return std::nullopt;
+    values.segment<2>(2 * static_cast<Eigen::Index>(i)) = *projected - pixels[i];
   }
-  return r;
+  return values;
 }
 
 struct Refined {
-  Eigen::Isometry3d pose;
+  RefinedPose refined;
   double rms = 0;
-  Matrix6d information = Matrix6d::Zero();  // J^T J at the solution
-  bool valid = false;
 };
 
-// Levenberg–Marquardt on the pixel residuals, numeric Jacobian (the camera model is opaque).
-Refined refine(const calibration::CameraModel& camera, Eigen::Isometry3d pose,
+Refined refine(const calibration::CameraModel& camera, const Eigen::Isometry3d& start,
                const std::vector<Eigen::Vector3d>& object,
                const std::vector<Eigen::Vector2d>& pixels, int max_iterations) {
   Refined out;
-  Residuals current = residuals(camera, pose, object, pixels);
-  if (!current.valid) return out;
-  double cost = current.values.squaredNorm();
-  double lambda = 1e-3;
-  Eigen::MatrixXd jacobian(current.values.size(), 6);
-  for (int iteration = 0; iteration < max_iterations; ++iteration) {
-    // Forward differences while iterating (half the projections); the covariance below
-    // uses central ones.
-    for (int k = 0; k < 6; ++k) {
-      double h = k < 3 ? 1e-7 * std::max(1.0, pose.translation().norm()) : 1e-7;
-      Vector6d step = Vector6d::Zero();
-      step(k) = h;
-      Residuals plus = residuals(camera, perturbed(pose, step), object, pixels);
-      if (!plus.valid) return out;
-      jacobian.col(k) = (plus.values - current.values) / h;
-    }
-    Matrix6d jtj = jacobian.transpose() * jacobian;
-    Vector6d jtr = jacobian.transpose() * current.values;
-    bool improved = false;
-    for (int attempt = 0; attempt < 8 && !improved; ++attempt) {
-      Matrix6d damped = jtj;
-      damped.diagonal() *= 1 + lambda;
-      Vector6d delta = -damped.ldlt().solve(jtr);
-      Eigen::Isometry3d candidate = perturbed(pose, delta);
-      Residuals next = residuals(camera, candidate, object, pixels);
-      if (next.valid && next.values.squaredNorm() < cost) {
-        bool converged = cost - next.values.squaredNorm() < 1e-8 * (1 + cost);
-        pose = candidate;
-        current = next;
-        cost = next.values.squaredNorm();
-        lambda = std::max(lambda / 10, 1e-9);
-        improved = true;
-        if (converged) iteration = max_iterations;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!improved) break;
-  }
-  // The information matrix at the final pose, for the covariance.
-  for (int k = 0; k < 6; ++k) {
-    double h = k < 3 ? 1e-6 * std::max(1.0, pose.translation().norm()) : 1e-6;
-    Vector6d step = Vector6d::Zero();
-    step(k) = h;
-    Residuals plus = residuals(camera, perturbed(pose, step), object, pixels);
-    Residuals minus = residuals(camera, perturbed(pose, -step), object, pixels);
-    if (!plus.valid || !minus.valid) return out;
-    jacobian.col(k) = (plus.values - minus.values) / (2 * h);
-  }
-  out.information = jacobian.transpose() * jacobian;
-  out.pose = pose;
-  out.rms = std::sqrt(cost / static_cast<double>(object.size()));
-  out.valid = true;
+  out.refined = refine_pose(
+      [&](const Eigen::Isometry3d& pose) { return residuals(camera, pose, object, pixels); }, start,
+      max_iterations);
+  out.rms = std::sqrt(out.refined.squared_error / static_cast<double>(object.size()));
   return out;
 }
 
@@ -152,14 +80,10 @@ bool enough_points(const PlanarPoseOptions& options, PlanarPose& result) {
 
 // The refined pose as the result: its covariance and the checks that reject it.
 void accept_if_valid(const Refined& best, const PlanarPoseOptions& options, PlanarPose& result) {
-  result.camera_from_object = best.pose;
+  result.camera_from_object = best.refined.pose;
   result.reprojection_rms_px = best.rms;
-  // Residual variance per coordinate, with the 6 pose parameters taken out.
-  int dof = 2 * result.points_used - 6;
-  double sigma2 = dof > 0 ? best.rms * best.rms * result.points_used / dof : 0;
-  Eigen::FullPivLU<Matrix6d> lu(best.information);
-  if (lu.isInvertible()) result.covariance = sigma2 * lu.inverse();
-  if (best.pose.translation().z() <= 0) {
+  result.covariance = pose_covariance(best.refined, 2 * result.points_used);
+  if (best.refined.pose.translation().z() <= 0) {
     result.rejection = "the pose puts the object behind the camera";
   } else if (best.rms > options.max_reprojection_rms_px) {
     result.rejection = fmt::format("reprojection RMS {:.2f} px exceeds {:.2f} px", best.rms,
@@ -225,8 +149,7 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
       camera_from_plane.translation()(i) = translations[s].at<double>(i);
     }
     Eigen::Isometry3d start = camera_from_plane * plane_from_object;
-    Residuals r0 = residuals(camera, start, object, image);
-    if (r0.valid) starts.emplace_back(r0.values.norm(), start);
+    if (auto r0 = residuals(camera, start, object, image)) starts.emplace_back(r0->norm(), start);
   }
   std::sort(starts.begin(), starts.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -234,9 +157,11 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
   for (size_t s = 0; s < starts.size(); ++s) {
     if (s > 0 && starts[s].first > 3 * starts[0].first + 1.0) break;
     Refined refined = refine(camera, starts[s].second, object, image, options.max_iterations);
-    if (refined.valid && (!best.valid || refined.rms < best.rms)) best = refined;
+    if (refined.refined.valid && (!best.refined.valid || refined.rms < best.rms)) {
+      best = refined;
+    }
   }
-  if (!best.valid) {
+  if (!best.refined.valid) {
     result.rejection = "no pose puts every point in front of the camera";
     return result;
   }
@@ -254,7 +179,7 @@ PlanarPose refine_planar_pose(const calibration::CameraModel& camera,
   result.points_used = static_cast<int>(usable.object.size());
   if (!enough_points(options, result)) return result;
   Refined refined = refine(camera, start, usable.object, usable.image, options.max_iterations);
-  if (!refined.valid) {
+  if (!refined.refined.valid) {
     result.rejection = "no pose near the start puts every point in front of the camera";
     return result;
   }

@@ -1,0 +1,230 @@
+// The pose of a body seen by a volume of fixed cameras (multi_camera_pose.hpp): on the same
+// frames, against each camera's own pose of it (planar_pose.hpp), with pixel noise; a body that
+// only one camera sees; a camera whose extrinsics have moved.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include <mocap/calibration/camera_factory.hpp>
+
+#include "multi_camera_pose.hpp"
+#include "planar_pose.hpp"
+
+namespace mocap::volume {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A camera at `position` looking at `target`, image x roughly along the world's horizontal.
+Eigen::Isometry3d camera_from_world_looking(const Eigen::Vector3d& position,
+                                            const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - position).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Isometry3d world_from_camera = Eigen::Isometry3d::Identity();
+  world_from_camera.linear() << x, y, z;
+  world_from_camera.translation() = position;
+  return world_from_camera.inverse();
+}
+
+// Four cameras 2.5 m up at the corners of a 4 x 4 m floor, looking at its centre 1 m up.
+struct Volume {
+  Volume() {
+    const std::vector<double> intrinsics = {900, 900, 639.5, 359.5};  // fx, fy, cx, cy
+    camera = calibration::make_camera_model("pinhole", 1280, 720, intrinsics);
+    for (double x : {-2.0, 2.0}) {
+      for (double y : {-2.0, 2.0}) {
+        extrinsics.push_back(camera_from_world_looking({x, y, 2.5}, Eigen::Vector3d(0, 0, 1)));
+      }
+    }
+  }
+  std::shared_ptr<const calibration::CameraModel> camera;
+  std::vector<Eigen::Isometry3d> extrinsics;
+};
+
+// A planar board of eight markers, 30 x 20 cm, none symmetric to another.
+const std::vector<Eigen::Vector3d> kBoard = {{0, 0, 0},       {0.10, 0, 0},    {0.30, 0, 0},
+                                             {0.30, 0.08, 0}, {0.30, 0.20, 0}, {0.12, 0.20, 0},
+                                             {0, 0.20, 0},    {0, 0.13, 0}};
+
+// Each camera's view of the board at `world_from_body`, with Gaussian pixel noise; a camera
+// that does not see every marker in its image sees nothing.
+std::vector<CameraView> views_of(const Volume& volume, const Eigen::Isometry3d& world_from_body,
+                                 double noise_px, std::mt19937& random) {
+  std::normal_distribution<double> noise(0, noise_px);
+  std::vector<CameraView> views;
+  for (const Eigen::Isometry3d& extrinsic : volume.extrinsics) {
+    CameraView view{volume.camera.get(), extrinsic, {}, {}};
+    for (const Eigen::Vector3d& point : kBoard) {
+      auto pixel = volume.camera->project(extrinsic * world_from_body * point);
+      if (!pixel || !volume.camera->in_image(*pixel)) {
+        view.body_points.clear();
+        view.pixels.clear();
+        break;
+      }
+      view.body_points.push_back(point);
+      view.pixels.push_back(*pixel + Eigen::Vector2d(noise(random), noise(random)));
+    }
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
+// A board pose in the volume, facing up within 40 degrees, any yaw.
+Eigen::Isometry3d random_pose(std::mt19937& random) {
+  std::uniform_real_distribution<double> across(-1.0, 1.0), height(0.3, 1.5), tilt(-0.7, 0.7),
+      yaw(-kPi, kPi);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(yaw(random), Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
+                   Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(across(random), across(random), height(random));
+  return pose;
+}
+
+double quantile(std::vector<double> values, double q) {
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, static_cast<size_t>(q * values.size()))];
+}
+
+double position_error(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return (a.translation() - b.translation()).norm();
+}
+double rotation_error(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return pose::rotation_angle_between(Eigen::Quaterniond(a.rotation()),
+                                      Eigen::Quaterniond(b.rotation()));
+}
+
+// The accuracy target, on frames every camera sees: the fused pose's position and
+// orientation errors at least twice lower than the best single camera's, median and p95.
+TEST(MultiCameraPose, FusedIsTwiceAsAccurateAsTheBestSingleCamera) {
+  const Volume volume;
+  std::mt19937 random(7);
+  const size_t cameras = volume.extrinsics.size();
+  std::vector<double> fused_position, fused_rotation;
+  std::vector<std::vector<double>> single_position(cameras), single_rotation(cameras);
+  int frames = 0;
+  while (frames < 300) {
+    const Eigen::Isometry3d truth = random_pose(random);
+    const std::vector<CameraView> views = views_of(volume, truth, 0.3, random);
+    if (std::any_of(views.begin(), views.end(),
+                    [](const CameraView& v) { return v.body_points.empty(); })) {
+      continue;  // the same frames for every estimate
+    }
+    std::vector<Eigen::Isometry3d> singles;
+    for (const CameraView& view : views) {
+      const pose::PlanarPose single =
+          pose::estimate_planar_pose(*view.camera, view.body_points, view.pixels);
+      ASSERT_TRUE(single.valid) << single.rejection;
+      singles.push_back(view.camera_from_world.inverse() * single.camera_from_object);
+    }
+    const MultiCameraPose fused = estimate_multi_camera_pose(views, singles.front());
+    ASSERT_TRUE(fused.valid) << fused.rejection;
+    EXPECT_EQ(fused.cameras_used, 4);
+    EXPECT_EQ(fused.points_used, 32);
+    fused_position.push_back(position_error(fused.world_from_body, truth));
+    fused_rotation.push_back(rotation_error(fused.world_from_body, truth));
+    for (size_t c = 0; c < cameras; ++c) {
+      single_position[c].push_back(position_error(singles[c], truth));
+      single_rotation[c].push_back(rotation_error(singles[c], truth));
+    }
+    ++frames;
+  }
+  for (double q : {0.5, 0.95}) {
+    double best_position = 1e9, best_rotation = 1e9;
+    for (size_t c = 0; c < cameras; ++c) {
+      best_position = std::min(best_position, quantile(single_position[c], q));
+      best_rotation = std::min(best_rotation, quantile(single_rotation[c], q));
+    }
+    const double position = quantile(fused_position, q), rotation = quantile(fused_rotation, q);
+    EXPECT_LE(2 * position, best_position) << "quantile " << q << ": fused " << position * 1e3
+                                           << " mm, best camera " << best_position * 1e3 << " mm";
+    EXPECT_LE(2 * rotation, best_rotation)
+        << "quantile " << q << ": fused " << rotation * 180 / kPi << " deg, best camera "
+        << best_rotation * 180 / kPi << " deg";
+    std::printf("quantile %.2f: fused %.3f mm %.4f deg; best single camera %.3f mm %.4f deg\n", q,
+                position * 1e3, rotation * 180 / kPi, best_position * 1e3,
+                best_rotation * 180 / kPi);
+  }
+}
+
+// A body only one camera sees still gets a pose, said to be that camera's alone.
+TEST(MultiCameraPose, OneCameraAloneGivesItsPoseFlaggedAsSuch) {
+  const Volume volume;
+  std::mt19937 random(3);
+  const Eigen::Isometry3d truth = random_pose(random);
+  std::vector<CameraView> views = views_of(volume, truth, 0.0, random);
+  for (size_t c = 1; c < views.size(); ++c) {
+    views[c].body_points.clear();
+    views[c].pixels.clear();
+  }
+  ASSERT_FALSE(views[0].body_points.empty());
+  Eigen::Isometry3d start = truth;
+  start.translation() += Eigen::Vector3d(0.02, -0.01, 0.03);
+  const MultiCameraPose fused = estimate_multi_camera_pose(views, start);
+  ASSERT_TRUE(fused.valid) << fused.rejection;
+  EXPECT_EQ(fused.cameras_used, 1);
+  EXPECT_LT(position_error(fused.world_from_body, truth), 1e-6);
+  EXPECT_EQ(fused.view_rms_px.size(), views.size());
+  EXPECT_EQ(fused.view_rms_px[1], 0.0);
+}
+
+// A camera bumped by half a degree after calibration: its residuals stand out (by its index),
+// and the covariance is that of a 6-DoF pose.
+TEST(MultiCameraPose, ABumpedCameraStandsOutInItsResiduals) {
+  Volume volume;
+  std::mt19937 random(11);
+  Eigen::Isometry3d truth;
+  std::vector<CameraView> views;
+  do {
+    truth = random_pose(random);
+    views = views_of(volume, truth, 0.1, random);
+  } while (std::any_of(views.begin(), views.end(),
+                       [](const CameraView& v) { return v.body_points.empty(); }));
+  // The images were taken by the moved camera 2; the fusion still believes the old extrinsics.
+  const Eigen::Isometry3d bump(Eigen::AngleAxisd(0.5 * kPi / 180, Eigen::Vector3d::UnitY()));
+  views[2].camera_from_world = bump * views[2].camera_from_world;
+  MultiCameraPoseOptions options;
+  options.max_reprojection_rms_px = 100;  // keep the pose, to look at the residuals
+  const MultiCameraPose fused = estimate_multi_camera_pose(views, truth, options);
+  ASSERT_TRUE(fused.valid) << fused.rejection;
+  // The fused pose spreads the moved camera's error over every view; without it, the others
+  // agree to the noise, and without any other camera they do not.
+  const std::vector<double> without = rms_without_each_view_px(views, truth);
+  ASSERT_EQ(without.size(), views.size());
+  EXPECT_LT(without[2], 0.3);
+  for (size_t c = 0; c < views.size(); ++c) {
+    if (c != 2) {
+      EXPECT_GT(without[c], 10 * without[2]) << "without camera " << c;
+    }
+  }
+  for (int k = 0; k < 6; ++k) EXPECT_GT(fused.covariance(k, k), 0) << k;
+  // With the default bound, the bumped camera's disagreement rejects the pose.
+  const MultiCameraPose strict = estimate_multi_camera_pose(views, truth);
+  EXPECT_FALSE(strict.valid);
+  EXPECT_NE(strict.rejection.find("reprojection RMS"), std::string::npos) << strict.rejection;
+}
+
+TEST(MultiCameraPose, TooFewPointsAreSaidAndBadOptionsThrow) {
+  const Volume volume;
+  CameraView view{volume.camera.get(), volume.extrinsics[0], {kBoard[0], kBoard[1]}, {}};
+  view.pixels = {{600, 300}, {620, 300}};
+  const MultiCameraPose result = estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity());
+  EXPECT_FALSE(result.valid);
+  EXPECT_EQ(result.rejection, "2 points in all views, 4 needed");
+  MultiCameraPoseOptions options;
+  options.min_points = 2;
+  EXPECT_THROW(estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity(), options),
+               std::invalid_argument);
+  view.pixels.pop_back();
+  EXPECT_THROW(estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity()),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mocap::volume
