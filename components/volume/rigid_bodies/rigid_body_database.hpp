@@ -1,0 +1,51 @@
+// Rigid bodies of any shape: each is three or more markers at fixed positions in its own frame,
+// identified among a volume's triangulated markers by the distances between its markers (no
+// cross-ratio, no plane). A YAML file lists them:
+//
+//   bodies:
+//     - name: wand
+//       markers: [[0, 0, 0], [0.10, 0, 0], [0.25, 0.03, 0]]   # metres, the body's frame
+//     - name: drone
+//       markers: [[0.1, 0, 0], [0, 0.12, 0], [-0.1, 0, 0.02], [0, -0.07, 0.04]]
+//
+// Two bodies that the distances cannot tell apart within the identification's tolerance (the
+// same shape, or one the shape of part of the other) are an error when the file is read, with
+// both names: in a volume they would be taken for each other.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace mocap::volume {
+
+struct RigidBody {
+  std::string name;
+  std::vector<Eigen::Vector3d> markers;  // metres, in the body's frame
+};
+
+class RigidBodyError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct RigidBodyDatabase {
+  std::vector<RigidBody> bodies;
+};
+
+// Markers closer than this within a body cannot be told apart once triangulated.
+inline constexpr double kMinMarkerSeparation = 0.01;  // metres
+
+// The bodies of `text` (`source` names it in messages: "bodies.yaml:7: ..."). Throws
+// RigidBodyError for a malformed file, a body of fewer than three markers or with markers
+// closer than kMinMarkerSeparation, a name given twice, and two bodies that identification
+// with `tolerance` (metres) and `min_markers` (rigid_body_identification.hpp) cannot tell
+// apart: one whose markers, measured with errors up to the tolerance, could be taken for
+// `min_markers` or more of the other's.
+RigidBodyDatabase parse_rigid_bodies(const std::string& text, const std::string& source,
+                                     double tolerance, int min_markers);
+RigidBodyDatabase load_rigid_bodies(const std::string& path, double tolerance, int min_markers);
+
+}  // namespace mocap::volume
