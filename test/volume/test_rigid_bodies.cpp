@@ -30,10 +30,10 @@ const char* kBodies = R"(bodies:
   - name: wand
     markers: [[0, 0, 0], [0.10, 0, 0], [0.22, 0.12, 0]]
   - name: drone
-    markers: [[0.1, 0, 0], [0, 0.12, 0], [-0.1, 0, 0.02], [0, -0.07, 0.04]]
+    markers: [[-0.07, 0.11, 0.03], [0.08, -0.02, 0.04], [0.11, -0.11, 0.03], [0.02, 0.11, 0.04]]
   - name: helmet
-    markers: [[0, 0, 0.1], [0.08, 0.02, 0.05], [-0.07, 0.05, 0.06], [0.02, -0.09, 0.03],
-              [-0.03, -0.02, 0.15]]
+    markers: [[0, 0, 0.1], [0.04, 0.09, 0.04], [-0.06, 0.01, 0.12], [0.05, -0.11, 0.19],
+              [0.11, 0.11, 0.04]]
 )";
 
 TEST(RigidBodies, BestFitRecoversATransform) {
@@ -118,6 +118,11 @@ TEST(RigidBodies, DatabaseErrorsNameTheLine) {
        "  - name: b\n    markers: [[1, 1, 0], [1.1, 1, 0], [1, 1.2, 0]]\n",
        "b.yaml:4: body 'b' cannot be told apart from 'a' (line 2): 3 or more markers of one "
        "match the other's distances within 0.008 m; move a marker"},
+      // Two of its triangles alike: seen by three markers, which way round would be a guess.
+      {"bodies:\n  - name: a\n    markers: [[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0]]\n",
+       "b.yaml:2: body 'a': its markers 0, 1, 2 could be taken for its markers 0, 2, 1 "
+       "(distances within 0.008 m), so its pose is ambiguous when only 3 are seen; move a "
+       "marker, or identify bodies from more markers (min_markers)"},
       // Three of a four-marker body's, within the tolerance: seeing those three would be both.
       {"bodies:\n  - name: a\n    markers: [[0, 0, 0], [0.1, 0, 0], [0, 0.2, 0], [0.3, 0.3, 0.1]]\n"
        "  - name: b\n    markers: [[0, 0, 0], [0.103, 0, 0], [0, 0.2, 0]]\n",

@@ -31,6 +31,45 @@ std::optional<Eigen::VectorXd> residuals(const std::vector<CameraView>& views, i
 
 }  // namespace
 
+std::vector<CameraView> views_near(const std::vector<CameraDetections>& cameras,
+                                   const std::vector<Eigen::Vector3d>& body_points,
+                                   const Eigen::Isometry3d& world_from_body, double radius_px) {
+  std::vector<CameraView> views;
+  for (const CameraDetections& camera : cameras) {
+    CameraView view{camera.camera, camera.camera_from_world, {}, {}};
+    std::vector<std::optional<Eigen::Vector2d>> projected;
+    for (const Eigen::Vector3d& point : body_points) {
+      const Eigen::Vector3d in_camera = camera.camera_from_world * world_from_body * point;
+      projected.push_back(in_camera.z() > 0 ? camera.camera->project(in_camera) : std::nullopt);
+    }
+    auto distance = [&](size_t m, size_t d) {
+      return projected[m] ? (camera.pixels[d] - *projected[m]).norm()
+                          : std::numeric_limits<double>::infinity();
+    };
+    // Pairs that are each other's nearest: a hidden marker that projects near another's
+    // detection does not take it, as the other projects nearer.
+    for (size_t m = 0; m < body_points.size(); ++m) {
+      size_t nearest = camera.pixels.size();
+      for (size_t d = 0; d < camera.pixels.size(); ++d) {
+        if (distance(m, d) <= radius_px &&
+            (nearest == camera.pixels.size() || distance(m, d) < distance(m, nearest))) {
+          nearest = d;
+        }
+      }
+      if (nearest == camera.pixels.size()) continue;
+      bool mutual = true;
+      for (size_t other = 0; other < body_points.size() && mutual; ++other) {
+        mutual = other == m || distance(other, nearest) > distance(m, nearest);
+      }
+      if (!mutual) continue;
+      view.body_points.push_back(body_points[m]);
+      view.pixels.push_back(camera.pixels[nearest]);
+    }
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
 MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
                                            const Eigen::Isometry3d& start,
                                            const MultiCameraPoseOptions& options) {

@@ -19,6 +19,8 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
+#include "marker_triangulation.hpp"
+
 namespace mocap::volume {
 
 // What one camera saw of the body: its points in the body's frame and the pixels they were
@@ -53,6 +55,13 @@ struct MultiCameraPose {
   // view without points): a camera far above the others has moved or misidentified.
   std::vector<double> view_rms_px;
 };
+
+// Each camera's view of a body at about `world_from_body`: each of `body_points` paired with
+// the camera's detection within `radius_px` of where the pose projects it, when each is the
+// other's nearest. Markers that only one camera sees count here, where triangulation needs two.
+std::vector<CameraView> views_near(const std::vector<CameraDetections>& cameras,
+                                   const std::vector<Eigen::Vector3d>& body_points,
+                                   const Eigen::Isometry3d& world_from_body, double radius_px);
 
 MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
                                            const Eigen::Isometry3d& start,

@@ -1,6 +1,12 @@
 #include "rigid_body_database.hpp"
 
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <utility>
+
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "rigid_body_identification.hpp"
 #include "yaml_reader.hpp"
@@ -38,14 +44,54 @@ RigidBody read_body(const Reader& reader, const YAML::Node& node,
   return body;
 }
 
-// Whether `seen`'s markers, measured with errors up to the tolerance, could be taken for
-// `min_markers` or more of `taken_for`'s: their distances differ by up to twice the tolerance.
-bool could_be_taken_for(const RigidBody& seen, const RigidBody& taken_for, double tolerance,
-                        int min_markers) {
-  RigidBodyIdentificationOptions options;
-  options.tolerance = 2 * tolerance;
-  options.min_markers = min_markers;
-  return !identify_rigid_bodies({{taken_for}}, seen.markers, options).empty();
+// A way `count` markers of `seen` could be taken for `count` of `taken_for`'s: their distances
+// differ by up to twice the tolerance and a rotation maps one set onto the other (a mirror
+// image does not confuse). With `same` (one body against itself), the markers taken for
+// themselves do not count. The markers of each side, or nothing.
+std::optional<std::pair<std::vector<int>, std::vector<int>>> confusion(
+    const RigidBody& seen, const RigidBody& taken_for, size_t count, double tolerance, bool same) {
+  const double within = 2 * tolerance;
+  std::vector<int> from(count), to(count);
+  std::vector<bool> used(taken_for.markers.size());
+  // Ordered choices on `taken_for`'s side against increasing index sets on `seen`'s.
+  std::function<std::optional<std::pair<std::vector<int>, std::vector<int>>>(size_t)> place =
+      [&](size_t k) -> std::optional<std::pair<std::vector<int>, std::vector<int>>> {
+    if (k == count) {
+      if (same && from == to) return std::nullopt;
+      std::vector<Eigen::Vector3d> a, b;
+      for (size_t i = 0; i < count; ++i) {
+        a.push_back(seen.markers[from[i]]);
+        b.push_back(taken_for.markers[to[i]]);
+      }
+      if (best_fit_rms(a, b) > within) return std::nullopt;
+      return std::make_pair(from, to);
+    }
+    for (int f = k == 0 ? 0 : from[k - 1] + 1; f < static_cast<int>(seen.markers.size()); ++f) {
+      from[k] = f;
+      for (int t = 0; t < static_cast<int>(taken_for.markers.size()); ++t) {
+        if (used[t]) continue;
+        bool matches = true;
+        for (size_t j = 0; j < k && matches; ++j) {
+          const double a = (seen.markers[f] - seen.markers[from[j]]).norm();
+          const double b = (taken_for.markers[t] - taken_for.markers[to[j]]).norm();
+          matches = std::abs(a - b) <= within;
+        }
+        if (!matches) continue;
+        to[k] = t;
+        used[t] = true;
+        auto found = place(k + 1);
+        used[t] = false;
+        if (found) return found;
+      }
+    }
+    return std::nullopt;
+  };
+  if (seen.markers.size() < count || taken_for.markers.size() < count) return std::nullopt;
+  return place(0);
+}
+
+std::string listed(const std::vector<int>& markers) {
+  return fmt::format("{}", fmt::join(markers, ", "));
 }
 
 RigidBodyDatabase read_bodies(const Reader& reader, const YAML::Node& root, double tolerance,
@@ -56,12 +102,21 @@ RigidBodyDatabase read_bodies(const Reader& reader, const YAML::Node& root, doub
     database.bodies.push_back(read_body(reader, node, database.bodies));
   }
   const YAML::Node nodes = root["bodies"];
-  for (size_t later = 1; later < database.bodies.size(); ++later) {
+  const size_t count = static_cast<size_t>(min_markers);
+  for (size_t later = 0; later < database.bodies.size(); ++later) {
+    const RigidBody& b = database.bodies[later];
+    if (auto self = confusion(b, b, count, tolerance, true)) {
+      reader.fail(nodes[later],
+                  fmt::format("body '{}': its markers {} could be taken for its markers {} "
+                              "(distances within {} m), so its pose is ambiguous when only {} "
+                              "are seen; move a marker, or identify bodies from more markers "
+                              "(min_markers)",
+                              b.name, listed(self->first), listed(self->second), 2 * tolerance,
+                              min_markers));
+    }
     for (size_t earlier = 0; earlier < later; ++earlier) {
       const RigidBody& a = database.bodies[earlier];
-      const RigidBody& b = database.bodies[later];
-      if (could_be_taken_for(a, b, tolerance, min_markers) ||
-          could_be_taken_for(b, a, tolerance, min_markers)) {
+      if (confusion(a, b, count, tolerance, false)) {
         reader.fail(nodes[later],
                     fmt::format("body '{}' cannot be told apart from '{}' (line {}): {} or more "
                                 "markers of one match the other's distances within {} m; move "

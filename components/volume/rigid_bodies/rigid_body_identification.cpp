@@ -11,14 +11,6 @@
 namespace mocap::volume {
 namespace {
 
-double rms_after_fit(const std::vector<Eigen::Vector3d>& from,
-                     const std::vector<Eigen::Vector3d>& to, Eigen::Isometry3d& fit) {
-  fit = best_fit_transform(from, to);
-  double sum = 0;
-  for (size_t i = 0; i < from.size(); ++i) sum += (fit * from[i] - to[i]).squaredNorm();
-  return std::sqrt(sum / static_cast<double>(from.size()));
-}
-
 // Depth-first over the body's markers: each one placed on a free measured marker whose
 // distances to those placed before match, or left missing.
 class AssignmentSearch {
@@ -80,7 +72,7 @@ class AssignmentSearch {
       to.push_back(markers_[assignment_[k]]);
     }
     Eigen::Isometry3d fit;
-    const double rms = rms_after_fit(from, to, fit);
+    const double rms = best_fit_rms(from, to, &fit);
     if (rms > options_.tolerance) return;
     if (found > best_found_ || rms < best_rms_) {
       best_found_ = found;
@@ -126,6 +118,15 @@ Eigen::Isometry3d best_fit_transform(const std::vector<Eigen::Vector3d>& from,
   transform.linear() = svd.matrixU() * correction * svd.matrixV().transpose();
   transform.translation() = to_centre - transform.linear() * from_centre;
   return transform;
+}
+
+double best_fit_rms(const std::vector<Eigen::Vector3d>& from,
+                    const std::vector<Eigen::Vector3d>& to, Eigen::Isometry3d* fit) {
+  const Eigen::Isometry3d transform = best_fit_transform(from, to);
+  double sum = 0;
+  for (size_t i = 0; i < from.size(); ++i) sum += (transform * from[i] - to[i]).squaredNorm();
+  if (fit != nullptr) *fit = transform;
+  return std::sqrt(sum / static_cast<double>(from.size()));
 }
 
 std::vector<IdentifiedBody> identify_rigid_bodies(const RigidBodyDatabase& database,

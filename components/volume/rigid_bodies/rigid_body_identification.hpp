@@ -45,5 +45,9 @@ std::vector<IdentifiedBody> identify_rigid_bodies(
 // squares sense (Kabsch): to ≈ T * from. At least three points not on one line.
 Eigen::Isometry3d best_fit_transform(const std::vector<Eigen::Vector3d>& from,
                                      const std::vector<Eigen::Vector3d>& to);
+// The RMS distance (metres) between `to` and `from` moved by best_fit_transform, which it
+// stores in `fit` when given.
+double best_fit_rms(const std::vector<Eigen::Vector3d>& from,
+                    const std::vector<Eigen::Vector3d>& to, Eigen::Isometry3d* fit = nullptr);
 
 }  // namespace mocap::volume
