@@ -1,0 +1,118 @@
+// The cameras' messages of one capture time, gathered for the fusion: a volume's cameras are
+// stamped at capture, and their messages arrive in any order, some late, some never (a camera
+// that stopped). A frame is complete when every live camera has given its message for that
+// capture time, or when the wait for the late ones has run out; a camera silent for longer than
+// `silent_after` (or not heard yet) is left out of the frames that follow, which then wait for
+// it no more (said by the frame, so coverage can be reported), until its next message, which
+// takes it back.
+//
+//   FrameAssembler<FiducialArray> frames(camera_count, options);
+//   frames.add(camera, stamp, message, now);        // as each arrives
+//   for (auto& frame : frames.take_ready(now)) fuse(frame);
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <map>
+#include <optional>
+#include <vector>
+
+namespace mocap::volume {
+
+struct FrameAssemblerOptions {
+  // Messages whose stamps differ by no more than this are one capture time (cameras triggered
+  // together still stamp a little apart).
+  std::chrono::nanoseconds same_capture{std::chrono::milliseconds(2)};
+  // How long a frame waits for its late cameras after its first message arrived.
+  std::chrono::nanoseconds wait{std::chrono::milliseconds(5)};
+  // A camera with no message for this long is left out of the frames that follow.
+  std::chrono::nanoseconds silent_after{std::chrono::milliseconds(500)};
+};
+
+template <class Message>
+struct AssembledFrame {
+  int64_t stamp_ns = 0;  // the capture time: the earliest stamp of its messages
+  // One slot per camera: its message, or nothing (late past the wait, silent, or none).
+  std::vector<std::optional<Message>> messages;
+  std::vector<bool> silent;  // per camera: left out as silent when the frame was made
+  bool complete = false;     // every camera that was not silent gave its message
+};
+
+template <class Message>
+class FrameAssembler {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  FrameAssembler(int cameras, FrameAssemblerOptions options = {})
+      : options_(options), last_heard_(static_cast<size_t>(cameras)) {}
+
+  // A camera's message for the capture time `stamp_ns`, arriving at `now`. A message for a
+  // capture time already handed out is dropped (counted in late_drops()).
+  void add(int camera, int64_t stamp_ns, Message message, Clock::time_point now) {
+    last_heard_[static_cast<size_t>(camera)] = now;
+    if (handed_out_ && stamp_ns <= *handed_out_ + options_.same_capture.count()) {
+      ++late_drops_;
+      return;
+    }
+    Pending& pending = pending_for(stamp_ns, now);
+    pending.frame.messages[static_cast<size_t>(camera)] = std::move(message);
+  }
+
+  // The frames that are complete or whose wait has run out, oldest first; a frame never comes
+  // out before an older one.
+  std::vector<AssembledFrame<Message>> take_ready(Clock::time_point now) {
+    std::vector<AssembledFrame<Message>> ready;
+    while (!pending_.empty()) {
+      auto oldest = pending_.begin();
+      Pending& pending = oldest->second;
+      const std::vector<bool> silent = silent_cameras(now);
+      bool complete = true;
+      for (size_t c = 0; c < silent.size(); ++c) {
+        complete = complete && (silent[c] || pending.frame.messages[c].has_value());
+      }
+      if (!complete && now - pending.first_arrival < options_.wait) break;
+      pending.frame.silent = silent;
+      pending.frame.complete = complete;
+      handed_out_ = oldest->first;
+      ready.push_back(std::move(pending.frame));
+      pending_.erase(oldest);
+    }
+    return ready;
+  }
+
+  int64_t late_drops() const { return late_drops_; }
+
+ private:
+  struct Pending {
+    AssembledFrame<Message> frame;
+    Clock::time_point first_arrival;
+  };
+
+  Pending& pending_for(int64_t stamp_ns, Clock::time_point now) {
+    for (auto& [stamp, pending] : pending_) {
+      if (std::abs(stamp - stamp_ns) <= options_.same_capture.count()) return pending;
+    }
+    Pending& pending = pending_[stamp_ns];
+    pending.frame.stamp_ns = stamp_ns;
+    pending.frame.messages.resize(last_heard_.size());
+    pending.first_arrival = now;
+    return pending;
+  }
+
+  std::vector<bool> silent_cameras(Clock::time_point now) const {
+    std::vector<bool> silent(last_heard_.size());
+    for (size_t c = 0; c < silent.size(); ++c) {
+      silent[c] = !last_heard_[c] || now - *last_heard_[c] > options_.silent_after;
+    }
+    return silent;
+  }
+
+  FrameAssemblerOptions options_;
+  std::vector<std::optional<Clock::time_point>> last_heard_;
+  std::map<int64_t, Pending> pending_;  // by capture time
+  std::optional<int64_t> handed_out_;   // the latest capture time handed out
+  int64_t late_drops_ = 0;
+};
+
+}  // namespace mocap::volume
