@@ -42,7 +42,7 @@ std::vector<Frame> make_frames(const test::Volume& volume, int count, std::mt199
       for (const CameraView& view : views) all = all && !view.body_points.empty();
       if (!all) continue;
       Eigen::Isometry3d start = truth;
-      start.translation() += Eigen::Vector3d(offset(random), offset(random), offset(random));
+      start.translation() += test::draws<3>(offset, random);
       start.linear() =
           Eigen::AngleAxisd(test::kPi / 180, Eigen::Vector3d::UnitX()) * start.linear();
       frame.bodies.push_back(std::move(views));

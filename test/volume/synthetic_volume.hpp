@@ -14,6 +14,15 @@
 
 namespace mocap::volume::test {
 
+// N draws of `distribution`, in order: draws written as the arguments of one call happen in an
+// order the compiler chooses, which would make a test's numbers depend on the build.
+template <int N, class Distribution>
+Eigen::Matrix<double, N, 1> draws(Distribution& distribution, std::mt19937& random) {
+  Eigen::Matrix<double, N, 1> values;
+  for (int i = 0; i < N; ++i) values[i] = distribution(random);
+  return values;
+}
+
 inline constexpr double kPi = 3.14159265358979323846;
 
 // A camera at `position` looking at `target`, image x roughly along the world's horizontal.
@@ -65,7 +74,7 @@ inline std::vector<CameraView> views_of(const Volume& volume,
         break;
       }
       view.body_points.push_back(point);
-      view.pixels.push_back(*pixel + Eigen::Vector2d(noise(random), noise(random)));
+      view.pixels.push_back(*pixel + draws<2>(noise, random));
     }
     views.push_back(std::move(view));
   }
@@ -76,12 +85,14 @@ inline std::vector<CameraView> views_of(const Volume& volume,
 inline Eigen::Isometry3d random_pose(std::mt19937& random) {
   std::uniform_real_distribution<double> across(-1.0, 1.0), height(0.3, 1.5), tilt(-0.7, 0.7),
       yaw(-kPi, kPi);
+  const double heading = yaw(random), roll = tilt(random), pitch = tilt(random);
+  const double x = across(random), y = across(random), z = height(random);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = (Eigen::AngleAxisd(yaw(random), Eigen::Vector3d::UnitZ()) *
-                   Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitX()) *
-                   Eigen::AngleAxisd(tilt(random), Eigen::Vector3d::UnitY()))
+  pose.linear() = (Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()) *
+                   Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()))
                       .toRotationMatrix();
-  pose.translation() = Eigen::Vector3d(across(random), across(random), height(random));
+  pose.translation() = Eigen::Vector3d(x, y, z);
   return pose;
 }
 

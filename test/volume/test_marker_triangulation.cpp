@@ -39,7 +39,7 @@ std::vector<CameraDetections> detections_of(const test::Volume& volume,
     std::shuffle(order.begin(), order.end(), random);
     for (int p : order) {
       camera.pixels.push_back(*volume.camera->project(volume.extrinsics[c] * points[p]) +
-                              Eigen::Vector2d(noise(random), noise(random)));
+                              test::draws<2>(noise, random));
       truth[c].push_back(p);
     }
     cameras.push_back(std::move(camera));
@@ -56,8 +56,10 @@ TEST(MarkerTriangulation, FindsEveryMarkerAndNoGhost) {
   std::vector<double> errors;
   for (int trial = 0; trial < 10; ++trial) {
     std::vector<Eigen::Vector3d> points;
-    for (int i = 0; i < 20; ++i)
-      points.emplace_back(across(random), across(random), height(random));
+    for (int i = 0; i < 20; ++i) {
+      const Eigen::Vector2d xy = test::draws<2>(across, random);
+      points.emplace_back(xy.x(), xy.y(), height(random));
+    }
     std::vector<std::vector<int>> truth;
     const auto cameras = detections_of(volume, points, 0.3, random, truth, nullptr);
     const std::vector<TriangulatedMarker> markers = triangulate_markers(cameras);

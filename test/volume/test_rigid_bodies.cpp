@@ -9,6 +9,7 @@
 
 #include "planar_pose.hpp"
 #include "rigid_body_identification.hpp"
+#include "synthetic_volume.hpp"
 
 namespace mocap::volume {
 namespace {
@@ -17,18 +18,17 @@ constexpr double kTolerance = 0.004;
 
 Eigen::Isometry3d random_transform(std::mt19937& random) {
   std::uniform_real_distribution<double> unit(-1, 1);
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() =
-      Eigen::Quaterniond(
-          Eigen::Vector4d(unit(random), unit(random), unit(random), unit(random)).normalized())
-          .toRotationMatrix();
-  t.translation() = Eigen::Vector3d(2 * unit(random), 2 * unit(random), 1 + unit(random));
-  return t;
+  const Eigen::Vector4d q = test::draws<4>(unit, random);
+  const Eigen::Vector3d t = test::draws<3>(unit, random);
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  transform.linear() = Eigen::Quaterniond(q.normalized()).toRotationMatrix();
+  transform.translation() = Eigen::Vector3d(2 * t.x(), 2 * t.y(), 1 + t.z());
+  return transform;
 }
 
 const char* kBodies = R"(bodies:
   - name: wand
-    markers: [[0, 0, 0], [0.10, 0, 0], [0.22, 0.12, 0]]
+    markers: [[0, 0, 0], [0.10, -0.04, 0], [0.22, 0.12, 0]]
   - name: drone
     markers: [[-0.07, 0.11, 0.03], [0.08, -0.02, 0.04], [0.11, -0.11, 0.03], [0.02, 0.11, 0.04]]
   - name: helmet
@@ -66,11 +66,12 @@ TEST(RigidBodies, FoundAmongDistractorsWithAMarkerMissing) {
         }
         indices[b].push_back(static_cast<int>(markers.size()));
         markers.push_back(truths[b] * database.bodies[b].markers[k] +
-                          Eigen::Vector3d(noise(random), noise(random), noise(random)));
+                          test::draws<3>(noise, random));
       }
     }
     for (int d = 0; d < 10; ++d) {
-      markers.emplace_back(anywhere(random), anywhere(random), 1 + anywhere(random) / 2);
+      const Eigen::Vector3d at = test::draws<3>(anywhere, random);
+      markers.emplace_back(at.x(), at.y(), 1 + at.z() / 2);
     }
     const std::vector<IdentifiedBody> found = identify_rigid_bodies(database, markers);
     ASSERT_EQ(found.size(), database.bodies.size()) << "trial " << trial;
