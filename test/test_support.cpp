@@ -53,6 +53,11 @@ std::string dds_implementation() {
 
 int test_domain(int slot) { return (dds_implementation() == "cyclonedds" ? 0 : 100) + slot; }
 
+int mixed_domain(int index) {
+  if (index < 0 || index > 12) throw std::invalid_argument("mixed_domain takes 0..12");
+  return 87 + index;
+}
+
 int unshared_domain() {
   // 232: the highest domain whose ports (7400 + 250 x domain + offsets) fit in 16 bits.
   static const int domain = [] {

@@ -41,6 +41,13 @@ std::string dds_implementation();
 // 0..99 under Cyclone DDS (MOCAP_DDS_IMPLEMENTATION), so the two runs of a test do not meet.
 int test_domain(int slot);
 
+// The DDS domain of a test that puts Fast DDS and Cyclone DDS participants side by side (such
+// tests run once, not once per implementation): 87 + `index` (0..12), domains no other test
+// takes. Their ports (7400 + 250 x domain + offsets) lie below Linux's ephemeral ports (32768
+// and up), which other processes' sockets hold for as long as they live: Fast DDS moves on to
+// another port, but Cyclone DDS cannot create its participant ("address in use").
+int mixed_domain(int index);
+
 // A DDS domain (200..232, beyond every slot's) that no other test process holds while this one
 // runs: for the tests of one fixture that may run at the same time, which share a set-up and
 // so cannot each name a slot. Held through a lock file in the temporary directory until the

@@ -644,7 +644,9 @@ class SecurityAcrossImplementations : public Security,
 
 TEST_P(SecurityAcrossImplementations, OneCaAcrossImplementations) {
   const CrossSecurityCase& param = GetParam();
-  const int slot = 78;
+  // Both implementations in one run: a domain of test::mixed_domain's.
+  std::map<std::string, std::string> environment_of_both = environment(0);
+  environment_of_both["MOCAP_DOMAIN_ID"] = std::to_string(test::mixed_domain(9));
   const int window_s = 5;
   // The `dds:` map for "identity@implementation" of `folder`.
   auto dds = [](const std::string& who, const fs::path& folder = credentials()) {
@@ -673,8 +675,8 @@ TEST_P(SecurityAcrossImplementations, OneCaAcrossImplementations) {
                     dds("outsider@" + sink_side, outsiders())));
   auto start = [&](const std::string& name) {
     return std::make_unique<test::ChildProcess>(
-        std::vector<std::string>{launcher(), (dir / (name + ".yaml")).string()}, environment(slot),
-        dir / (name + ".log"));
+        std::vector<std::string>{launcher(), (dir / (name + ".yaml")).string()},
+        environment_of_both, dir / (name + ".log"));
   };
   auto source = start("source");
   auto sink = start("sink");

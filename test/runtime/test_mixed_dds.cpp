@@ -36,7 +36,7 @@ std::vector<uint8_t> serialize(const MessageType& type, const void* message) {
 std::unique_ptr<DdsTransport> participant(const std::string& implementation, int slot) {
   DdsOptions options;
   options.implementation = implementation;
-  options.domain_id = test::test_domain(slot);
+  options.domain_id = test::mixed_domain(slot);
   return make_dds_transport(options, implementation + "_participant");
 }
 
@@ -87,11 +87,11 @@ void expect_every_type_crosses(const std::string& from, const std::string& to, i
 }
 
 TEST(MixedDds, EveryMessageTypeCrossesFromFastDdsToCycloneDds) {
-  expect_every_type_crosses("fastdds", "cyclonedds", 70);
+  expect_every_type_crosses("fastdds", "cyclonedds", 0);
 }
 
 TEST(MixedDds, EveryMessageTypeCrossesFromCycloneDdsToFastDds) {
-  expect_every_type_crosses("cyclonedds", "fastdds", 71);
+  expect_every_type_crosses("cyclonedds", "fastdds", 1);
 }
 
 // The receive buffers (ss's "rb", which the kernel doubles) of this process's UDP sockets, as
@@ -125,7 +125,7 @@ TEST(MixedDds, BothImplementationsReceiveUdpIntoLargeBuffers) {
   const uint64_t expected = std::min<uint64_t>(kUdpSocketBufferBytes, rmem_max);
   for (const std::string implementation : {"fastdds", "cyclonedds"}) {
     const std::vector<uint64_t> before = udp_receive_buffers();
-    auto transport = participant(implementation, 79);
+    auto transport = participant(implementation, 7);
     const std::vector<uint64_t> after = udp_receive_buffers();
     ASSERT_GT(after.size(), before.size()) << implementation << ": no UDP socket seen";
     EXPECT_GE(*std::max_element(after.begin(), after.end()), expected) << implementation;
@@ -147,8 +147,8 @@ TEST(MixedDds, ASocketBufferCapIsSaidWithTheCommandThatLiftsIt) {
 
 // Discovery across implementations: each lists the other's endpoints with their QoS and names.
 TEST(MixedDds, EachImplementationDiscoversTheOthersEndpoints) {
-  auto fast = participant("fastdds", 72);
-  auto cyclone = participant("cyclonedds", 72);
+  auto fast = participant("fastdds", 2);
+  auto cyclone = participant("cyclonedds", 2);
   const MessageType& type = *find_message_type("mocap_msgs/msg/FiducialArray");
   auto fast_writer = fast->advertise({"/mixed/fast", &type, Qos::latched(), "test"});
   auto cyclone_writer = cyclone->advertise({"/mixed/cyclone", &type, Qos::reliable(), "test"});
@@ -184,8 +184,8 @@ std::string launcher() { return (test::bin_dir() / "mocap_launch").string(); }
 // A peer of the other implementation whose QoS cannot match: nothing connects, and
 // `mocap_topic list`, on either implementation, names the pair and why.
 TEST(MixedDds, TopicListNamesPairsThatCannotConnect) {
-  auto fast = participant("fastdds", 84);
-  auto cyclone = participant("cyclonedds", 84);
+  auto fast = participant("fastdds", 8);
+  auto cyclone = participant("cyclonedds", 8);
   const MessageType& type = *find_message_type("mocap_msgs/msg/FiducialArray");
   auto best_effort = fast->advertise({"/mixed/best_effort", &type, Qos::sensor_data(), "test"});
   auto wants_reliable =
@@ -200,7 +200,7 @@ TEST(MixedDds, TopicListNamesPairsThatCannotConnect) {
     SCOPED_TRACE(implementation);
     auto [code, output] =
         test::run_command({(test::bin_dir() / "mocap_topic").string(), "list", "--wait", "3"},
-                          {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(84))},
+                          {{"MOCAP_DOMAIN_ID", std::to_string(test::mixed_domain(8))},
                            {"MOCAP_DDS_IMPLEMENTATION", implementation}});
     ASSERT_EQ(code, 0) << output;
     EXPECT_NE(output.find("/mixed/best_effort [mocap_msgs/msg/FiducialArray] 1 publisher(s), 1 "
@@ -230,7 +230,7 @@ TEST(MixedDds, TopicListNamesPairsThatCannotConnect) {
 }
 
 std::map<std::string, std::string> environment(int slot, const std::string& implementation) {
-  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))},
+  return {{"MOCAP_DOMAIN_ID", std::to_string(test::mixed_domain(slot))},
           {"MOCAP_BIN_DIR", test::bin_dir().string()},
           {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()},
           {"MOCAP_DDS_IMPLEMENTATION", implementation}};
@@ -245,7 +245,7 @@ TEST_P(MixedTracking, PosesCrossImplementationsBothWays) {
   bool sensor_on_fastdds = GetParam();
   std::string sensor_side = sensor_on_fastdds ? "fastdds" : "cyclonedds";
   std::string compute_side = sensor_on_fastdds ? "cyclonedds" : "fastdds";
-  int slot = sensor_on_fastdds ? 73 : 74;
+  int slot = sensor_on_fastdds ? 3 : 4;
   test::TempDir dir;
   std::string file = (test::source_dir() / "launch_yaml/distributed/tracking.yaml").string();
   std::string servos = (dir / "servos").string();
@@ -310,7 +310,7 @@ groups:
                                                      source_on_fastdds ? "cyclonedds" : "fastdds",
                                                      (dir / "summary.yaml").string()));
     std::string file = (dir / "graph.yaml").string();
-    int slot = source_on_fastdds ? 75 : 76;
+    int slot = source_on_fastdds ? 5 : 6;
     test::ChildProcess sink(hosts.on_a({launcher(), file, "--group", "sink"}),
                             environment(slot, ""), dir / "sink.log");
     test::ChildProcess source(hosts.on_b({launcher(), file, "--group", "source"}),
