@@ -10,10 +10,9 @@
 // One-way latency: the publisher stamps each image with CLOCK_MONOTONIC just before
 // publishing, the subscriber subtracts it from its own reading on arrival (network namespaces
 // share the kernel's clock). Target: median <= 1 ms on every path (issue: a tracking volume).
-#include <sys/wait.h>
+
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +26,7 @@
 #include <sensor_msgs/msg/image.hpp>
 
 #include "one_hop.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -88,42 +88,6 @@ int run_publisher(const std::string& implementation, int count, const std::strin
   return 0;
 }
 
-// --- two hosts --------------------------------------------------------------------------
-
-// Two network namespaces joined by a veth pair, each end eth0 with an address of its own and
-// a multicast route (DDS discovers by multicast). Removed when destroyed.
-class NamespaceHosts {
- public:
-  NamespaceHosts() {
-    const std::string a = names_[0], b = names_[1];
-    ok_ = run("ip netns add " + a) && run("ip netns add " + b) &&
-          run(fmt::format("ip link add eth0 netns {} type veth peer name eth0 netns {}", a, b));
-    for (int i = 0; ok_ && i < 2; ++i) {
-      const std::string& n = names_[i];
-      ok_ = run(fmt::format("ip -n {} addr add 10.213.0.{}/24 dev eth0", n, i + 1)) &&
-            run(fmt::format("ip -n {} link set eth0 up", n)) &&
-            run(fmt::format("ip -n {} link set lo up", n)) &&
-            run(fmt::format("ip -n {} route add 224.0.0.0/4 dev eth0", n));
-    }
-  }
-  ~NamespaceHosts() {
-    for (const std::string& n : names_) run("ip netns del " + n + " 2>/dev/null");
-  }
-  bool ok() const { return ok_; }
-  const std::string& name(int i) const { return names_[i]; }
-  // The link's MTU, both ends.
-  void set_mtu(int mtu) const {
-    for (const std::string& n : names_) run(fmt::format("ip -n {} link set eth0 mtu {}", n, mtu));
-  }
-
- private:
-  static bool run(const std::string& command) {
-    return std::system((command + " 2>/dev/null").c_str()) == 0;
-  }
-  std::string names_[2] = {fmt::format("imghopA{}", getpid()), fmt::format("imghopB{}", getpid())};
-  bool ok_ = false;
-};
-
 // --- the orchestrating process ----------------------------------------------------------
 
 struct Path {
@@ -140,40 +104,29 @@ struct Result {
   int delivered = 0, expected = 0;
 };
 
-pid_t spawn(const std::vector<std::string>& argv) {
-  pid_t child = fork();
-  if (child == 0) {
-    std::vector<char*> args;
-    for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    _exit(127);
-  }
-  return child;
-}
-
-void measure(const std::string& self, const Path& path, const NamespaceHosts* hosts, int count,
-             Result& result) {
-  const std::string out = fmt::format("/tmp/image_hop_bench_{}.txt", getpid());
-  auto on = [&](int host, std::vector<std::string> argv) {
+void measure(const std::string& self, const Path& path, const mocap::test::TwoHosts* hosts,
+             int count, Result& result) {
+  const mocap::test::TempDir dir;
+  const std::string out = (dir / "received.txt").string();
+  auto on = [&](bool host_b, std::vector<std::string> argv) {
     if (hosts == nullptr) return argv;
-    argv.insert(argv.begin(), {"ip", "netns", "exec", hosts->name(host)});
-    return argv;
+    return host_b ? hosts->on_b(std::move(argv)) : hosts->on_a(std::move(argv));
   };
   const int total = kWarmup + count;
-  pid_t subscriber =
-      spawn(on(1, {self, "--subscriber", path.subscriber, std::to_string(total), out}));
-  pid_t publisher = spawn(on(0, {self, "--publisher", path.publisher, std::to_string(count), out}));
-  waitpid(subscriber, nullptr, 0);
-  waitpid(publisher, nullptr, 0);
+  mocap::test::ChildProcess subscriber(
+      on(true, {self, "--subscriber", path.subscriber, std::to_string(total), out}), {},
+      dir / "subscriber.log");
+  mocap::test::ChildProcess publisher(
+      on(false, {self, "--publisher", path.publisher, std::to_string(count), out}), {},
+      dir / "publisher.log");
+  subscriber.wait(std::chrono::seconds(300));
+  publisher.wait(std::chrono::seconds(60));
   std::ifstream in(out);
   int delivered = 0;
   in >> delivered;
   for (double latency; in >> latency;) result.latencies_us.push_back(latency);
   result.delivered += delivered;
   result.expected += total;
-  std::remove(out.c_str());
-  std::remove((out + ".ready").c_str());
 }
 
 }  // namespace
@@ -193,11 +146,11 @@ int main(int argc, char** argv) {
   const int rounds = quick ? 1 : 3;
   const int count = quick ? 300 : 500;
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  NamespaceHosts hosts;
+  const mocap::test::TwoHosts hosts;
   std::vector<Path> paths;
   // Ethernet's 1500 bytes, and the jumbo frames of a camera network (GigE Vision's 9000).
   for (int mtu : {0, 1500, 9000}) {
-    if (mtu > 0 && !hosts.ok()) continue;
+    if (mtu > 0 && !hosts.error().empty()) continue;
     for (const char* publisher : {"fastdds", "cyclonedds"}) {
       for (const char* subscriber : {"fastdds", "cyclonedds"}) {
         paths.push_back({publisher, subscriber, mtu});
@@ -216,7 +169,8 @@ int main(int argc, char** argv) {
       "image_hop_bench: {} at {} Hz over UDP through the runtime (Fast DDS's shared memory "
       "off), {} cores, {} round(s) of {} images a path, the paths interleaved.{}\n\n",
       kImage.label, kRateHz, std::thread::hardware_concurrency(), rounds, count,
-      hosts.ok() ? "" : " No namespace hosts (needs root and ip): loopback only.");
+      hosts.error().empty() ? std::string()
+                            : " No namespace hosts (" + hosts.error() + "): loopback only.");
   fmt::print("| {:<42} | {:>9} | {:>9} | {:>12} |\n", "publisher -> subscriber, where", "median us",
              "p99 us", "delivered");
   fmt::print("|{:-<44}|{:-<11}|{:-<11}|{:-<14}|\n", "", "", "", "");

@@ -172,6 +172,7 @@ TwoHosts::TwoHosts(bool multicast) {
   host_b_ = "mocap_b_" + id;
   std::string link_a = "mva" + id, link_b = "mvb" + id;
   link_a_ = link_a;
+  link_b_ = link_b;
   std::string subnet = "10.77." + std::to_string((getpid() + serial) % 250);
   address_a_ = subnet + ".1";
   address_b_ = subnet + ".2";
@@ -234,6 +235,11 @@ long long TwoHosts::bytes_received_by_a() const {
   auto [code, output] =
       run_command(on_a({"cat", "/sys/class/net/" + link_a_ + "/statistics/rx_bytes"}));
   return code == 0 ? std::stoll(output) : -1;
+}
+
+void TwoHosts::set_mtu(int mtu) const {
+  run_command({"ip", "-n", host_a_, "link", "set", link_a_, "mtu", std::to_string(mtu)});
+  run_command({"ip", "-n", host_b_, "link", "set", link_b_, "mtu", std::to_string(mtu)});
 }
 
 std::map<std::string, long long> read_summary(const fs::path& path) {

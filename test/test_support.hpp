@@ -119,9 +119,11 @@ class TwoHosts {
   std::vector<std::string> on_a(std::vector<std::string> command) const;
   std::vector<std::string> on_b(std::vector<std::string> command) const;
   long long bytes_received_by_a() const;  // over the link; -1 if unknown
+  // The link's MTU at both ends (Ethernet's 1500 until set).
+  void set_mtu(int mtu) const;
 
  private:
-  std::string host_a_, host_b_, link_a_, address_a_, address_b_, error_;
+  std::string host_a_, host_b_, link_a_, link_b_, address_a_, address_b_, error_;
 };
 
 // "key: integer" lines, as sequence_sink writes them.

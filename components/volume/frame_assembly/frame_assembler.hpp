@@ -63,10 +63,10 @@ class FrameAssembler {
   // out before an older one.
   std::vector<AssembledFrame<Message>> take_ready(Clock::time_point now) {
     std::vector<AssembledFrame<Message>> ready;
+    const std::vector<bool> silent = silent_cameras(now);
     while (!pending_.empty()) {
       auto oldest = pending_.begin();
       Pending& pending = oldest->second;
-      const std::vector<bool> silent = silent_cameras(now);
       bool complete = true;
       for (size_t c = 0; c < silent.size(); ++c) {
         complete = complete && (silent[c] || pending.frame.messages[c].has_value());

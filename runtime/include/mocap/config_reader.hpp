@@ -30,6 +30,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -150,14 +151,7 @@ class ConfigReader {
   double to_number(const YAML::Node& node, std::string_view key,
                    double min = std::numeric_limits<double>::lowest(),
                    double max = std::numeric_limits<double>::max()) const {
-    double value = 0;
-    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
-      fail(node, fmt::format("'{}' must be a number, not {}", key, describe(node)));
-    }
-    if (value < min || value > max) {
-      fail(node, fmt::format("'{}' is {}, must be in [{}, {}]", key, value, min, max));
-    }
-    return value;
+    return in_range<double>(node, key, "a number", min, max);
   }
 
   double number(const YAML::Node& map, const char* key, double fallback, double min,
@@ -190,14 +184,7 @@ class ConfigReader {
   }
 
   int64_t to_integer(const YAML::Node& node, std::string_view key, int64_t min, int64_t max) const {
-    int64_t value = 0;
-    if (!node.IsScalar() || !YAML::convert<int64_t>::decode(node, value)) {
-      fail(node, fmt::format("'{}' must be an integer, not {}", key, describe(node)));
-    }
-    if (value < min || value > max) {
-      fail(node, fmt::format("'{}' is {}, must be in [{}, {}]", key, value, min, max));
-    }
-    return value;
+    return in_range<int64_t>(node, key, "an integer", min, max);
   }
 
   int64_t integer(const YAML::Node& map, const char* key, int64_t fallback, int64_t min,
@@ -245,6 +232,20 @@ class ConfigReader {
   }
 
  private:
+  // `node` read as a T (`kind` names it in the message: "a number"), finite, in [min, max].
+  template <class T>
+  T in_range(const YAML::Node& node, std::string_view key, std::string_view kind, T min,
+             T max) const {
+    T value{};
+    bool read = node.IsScalar() && YAML::convert<T>::decode(node, value);
+    if constexpr (std::is_floating_point_v<T>) read = read && std::isfinite(value);
+    if (!read) fail(node, fmt::format("'{}' must be {}, not {}", key, kind, describe(node)));
+    if (value < min || value > max) {
+      fail(node, fmt::format("'{}' is {}, must be in [{}, {}]", key, value, min, max));
+    }
+    return value;
+  }
+
   // Repeated keys, keys that are not names, and (with `allowed`) keys outside it.
   std::vector<std::pair<YAML::Node, std::string>> key_problems(
       const YAML::Node& map, const std::vector<std::string>* allowed, std::string_view what) const {
