@@ -21,6 +21,9 @@ inline constexpr const char* kPoses = "/mocap/poses";      // mocap_msgs/Constel
 inline constexpr const char* kOverlay = "/mocap/overlay";  // sensor_msgs/Image, bgr8
 inline constexpr const char* kDemoFiducials = "/demo/fiducials";  // FiducialArray, a stand-in
 
+// A volume of fixed cameras.
+inline constexpr const char* kVolumeFiducials = "/volume/{camera}/fiducials";  // FiducialArray
+
 // The poses as other tools read them.
 inline constexpr const char* kBoardPose = "/mocap/{board}/pose";      // PoseStamped
 inline constexpr const char* kBoardOdometry = "/mocap/{board}/odom";  // nav_msgs/Odometry

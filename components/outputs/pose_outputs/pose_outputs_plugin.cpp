@@ -94,7 +94,8 @@ const ParameterList<Settings> kParameters =
              &Settings::camera_frame)
         .add("optical_frame",
              "name of the camera's optical frame (z forward, x right, y down), the frame "
-             "of /mocap/poses; poses whose header names another are counted and skipped",
+             "of /mocap/poses; poses in world_frame (a volume's) pass as they are, poses "
+             "in any other frame are counted and skipped",
              &Settings::optical_frame)
         .add("camera_in_world", "camera_frame in world_frame: x, y, z (m), roll, pitch, yaw (rad)",
              &Settings::camera_in_world)
@@ -198,7 +199,9 @@ class PoseOutputs final : public Component {
       std_msgs::msg::Header header = pose.pose().header();
       if (header.frame_id().empty()) header.frame_id(poses.header().frame_id());
       if (header.frame_id().empty()) header.frame_id(settings_.optical_frame);
-      if (header.frame_id() != settings_.optical_frame) {
+      // A volume's poses (volume_fusion) are in the world frame already.
+      const bool already_in_world = header.frame_id() == settings_.world_frame;
+      if (header.frame_id() != settings_.optical_frame && !already_in_world) {
         if (wrong_frame_++ == 0) {
           log().warn("a pose in frame '{}', not optical_frame '{}': skipped (and counted)",
                      header.frame_id(), settings_.optical_frame);
@@ -211,7 +214,7 @@ class PoseOutputs final : public Component {
         continue;
       }
       BodyState board = *measured;
-      if (in_world_) {
+      if (in_world_ && !already_in_world) {
         board = seen_from(world_from_optical_, board);
         header.frame_id(settings_.world_frame);
       }

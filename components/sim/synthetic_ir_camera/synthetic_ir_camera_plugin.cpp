@@ -12,10 +12,21 @@
 // then describes the world as a camera at the world's origin looking along its x axis would
 // see it (scene x = world −y, y = world −z, z = world x), so a scene reads the same for a
 // fixed camera and for one that starts at the origin.
+//
+// A camera file with a `pose` places the camera in a volume: it stands there, the scene is in
+// the world's frame (z up) and the ground truth too (frame 'world'). With `synchronized`, the
+// cameras of a volume capture together: frames are taken at multiples of the period on the
+// system clock, stamped with that time, and each shows the scene at that time (seconds since
+// midnight UTC), so cameras in different processes, on hosts with synchronized clocks, show
+// the same instant in frames of the same stamp. A frame whose time passed while the previous
+// one rendered is skipped, as a real camera drops it. The frames are then taken on a thread of
+// their own, sleeping until each capture time, where a timer would fire at any phase.
 #include <chrono>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <thread>
 
 #include <geometry_msgs/msg/pose_stamped.hpp>
 #include <mocap/calibration/camera_file.hpp>
@@ -61,6 +72,7 @@ struct Settings {
   int max_frames = 0;
   bool wait_for_subscriber = true;
   bool moving_camera = false;
+  bool synchronized = false;
 };
 
 const ParameterList<Settings> kParameters =
@@ -91,7 +103,11 @@ const ParameterList<Settings> kParameters =
              "in the world comes on " +
                  std::string(topics::kSimCameraPose) +
                  " and the scene is as seen from the world's origin looking along x",
-             &Settings::moving_camera);
+             &Settings::moving_camera)
+        .add("synchronized",
+             "frames at multiples of the period on the system clock, stamped with that time "
+             "and showing the scene at it: the cameras of a volume capture together",
+             &Settings::synchronized);
 
 class SyntheticIrCamera final : public Component {
   // Before the other members, which may start from it.
@@ -115,8 +131,8 @@ class SyntheticIrCamera final : public Component {
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
         topics::kGroundTruth, Qos::reliable(),
         "per frame, the true pose and velocity of every constellation in front of the camera "
-        "(camera frame, mid-exposure; the velocity of a fixed camera's view); points_used = its "
-        "visible markers; same header as the image");
+        "(camera frame, or 'world' for a camera placed by its file; mid-exposure); points_used = its "
+        "visible markers; same stamp as the image");
   }
 
   explicit SyntheticIrCamera(Context& context) : Component(context) {
@@ -134,6 +150,9 @@ class SyntheticIrCamera final : public Component {
     time_step_s_ = settings_.time_step_s;
     if (time_step_s_ == 0) time_step_s_ = rate_hz > 0 ? 1 / rate_hz : kDefaultTimeStep_s;
 
+    if (settings_.synchronized && (rate_hz <= 0 || settings_.moving_camera)) {
+      throw std::invalid_argument("synchronized: needs a rate_hz above 0 and a fixed camera");
+    }
     if (settings_.moving_camera) {
       create_subscription<geometry_msgs::msg::PoseStamped>(
           topics::kSimCameraPose, [this](const geometry_msgs::msg::PoseStamped& pose) {
@@ -141,6 +160,9 @@ class SyntheticIrCamera final : public Component {
               camera_from_world_ = world_from_camera->inverse() * world_from_scene();
             }
           });
+    } else if (camera.world_from_camera) {
+      world_from_camera_ = *camera.world_from_camera;
+      camera_from_world_ = camera.world_from_camera->inverse();
     } else {
       camera_from_world_ = Eigen::Isometry3d::Identity();
     }
@@ -154,7 +176,11 @@ class SyntheticIrCamera final : public Component {
                                           ? std::chrono::duration_cast<std::chrono::nanoseconds>(
                                                 std::chrono::duration<double>(1 / rate_hz))
                                           : std::chrono::nanoseconds(kBackToBackPeriod);
-    create_timer(period, [this] { tick(); });
+    if (settings_.synchronized) {
+      create_worker("capture", [this, period](std::stop_token stop) { capture_on_the_clock(period, stop); });
+    } else {
+      create_timer(period, [this] { tick(); });
+    }
     log().info("{}x{} frames of {} ({} objects) at {} on {}, scene time step {:.6g} s",
                camera.model->width(), camera.model->height(), settings_.scene, object_count,
                rate_hz > 0 ? fmt::format("{} Hz", rate_hz) : "full speed", images_.topic(),
@@ -162,7 +188,24 @@ class SyntheticIrCamera final : public Component {
   }
 
  private:
-  void tick() {
+  // Synchronized: a frame at every multiple of `period` on the system clock, stamped with it.
+  // The only caller of tick() then (no timer, no pose subscription), so it needs no lock.
+  void capture_on_the_clock(std::chrono::nanoseconds period, const std::stop_token& stop) {
+    constexpr auto kStopCheck = std::chrono::milliseconds(100);
+    while (!stop.stop_requested()) {
+      const auto since_epoch = std::chrono::system_clock::now().time_since_epoch();
+      const Clock::time_point next(since_epoch / period * period + period);
+      if (next - std::chrono::system_clock::now() > kStopCheck) {
+        std::this_thread::sleep_for(kStopCheck);
+        continue;
+      }
+      std::this_thread::sleep_until(next);
+      tick(next);
+    }
+  }
+
+  // `capture`: the synchronized capture time; none: now, and scene time by the frame count.
+  void tick(std::optional<Clock::time_point> capture = std::nullopt) {
     if (wait_for_subscriber_) {
       if (images_.matched_subscribers() == 0) {
         if (!reported_waiting_) log().info("waiting for a subscriber on {}", images_.topic());
@@ -184,34 +227,45 @@ class SyntheticIrCamera final : public Component {
       reported_no_pose_ = true;
       return;
     }
-    RenderedFrame frame = renderer_->render(static_cast<double>(frames_) * time_step_s_, frames_,
-                                            *camera_from_world_);
+    const Clock::time_point stamp = capture.value_or(now());
+    double scene_time_s = static_cast<double>(frames_) * time_step_s_;
+    if (capture) {
+      const int64_t day_ns = int64_t{86400} * 1'000'000'000;
+      scene_time_s = static_cast<double>(stamp.time_since_epoch().count() % day_ns) * 1e-9;
+    }
+    RenderedFrame frame = renderer_->render(scene_time_s, frames_, *camera_from_world_);
     ++frames_;
 
     std_msgs::msg::Header header;
-    header.stamp(to_time_msg(now()));
+    header.stamp(to_time_msg(stamp));
     header.frame_id(frame_id_);
+    std_msgs::msg::Header truth_header = header;
+    if (world_from_camera_) truth_header.frame_id("world");
 
     auto image = std::make_shared<sensor_msgs::msg::Image>();
     image->header(header);
     fill_image_message(frame.image, *image);
 
     auto truth = std::make_shared<mocap_msgs::msg::ConstellationPoseArray>();
-    truth->header(header);
+    truth->header(truth_header);
+    // Into the world's frame for a placed camera: its rotation turns the velocities too.
+    const Eigen::Isometry3d to_truth_frame = world_from_camera_.value_or(Eigen::Isometry3d::Identity());
     for (const ObjectTruth& object : frame.objects) {
       if (!object.in_front) continue;
+      const Eigen::Vector3d linear = to_truth_frame.linear() * object.linear_velocity;
+      const Eigen::Vector3d angular = to_truth_frame.linear() * object.angular_velocity;
       mocap_msgs::msg::ConstellationPose pose;
       pose.name(object.constellation);
-      pose.pose().header(header);
-      pose.pose().pose(to_pose_message(object.pose));
+      pose.pose().header(truth_header);
+      pose.pose().pose(to_pose_message(to_truth_frame * object.pose));
       pose.reprojection_rms_px(0);
       pose.points_used(static_cast<uint32_t>(object.visible_markers()));
-      pose.velocity().linear().x(object.linear_velocity.x());
-      pose.velocity().linear().y(object.linear_velocity.y());
-      pose.velocity().linear().z(object.linear_velocity.z());
-      pose.velocity().angular().x(object.angular_velocity.x());
-      pose.velocity().angular().y(object.angular_velocity.y());
-      pose.velocity().angular().z(object.angular_velocity.z());
+      pose.velocity().linear().x(linear.x());
+      pose.velocity().linear().y(linear.y());
+      pose.velocity().linear().z(linear.z());
+      pose.velocity().angular().x(angular.x());
+      pose.velocity().angular().y(angular.y());
+      pose.velocity().angular().z(angular.z());
       truth->poses().push_back(std::move(pose));
     }
     images_.publish(std::move(image));
@@ -235,6 +289,7 @@ class SyntheticIrCamera final : public Component {
   // The camera's place; none until the first pose arrives (moving_camera). Callbacks of one
   // component never overlap, so the pose callback and tick() share it without a lock.
   std::optional<Eigen::Isometry3d> camera_from_world_;
+  std::optional<Eigen::Isometry3d> world_from_camera_;  // a camera placed by its file's pose
   Publisher<sensor_msgs::msg::Image> images_;
   Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
   Publisher<sensor_msgs::msg::CameraInfo> infos_;  // none for a lens camera_info cannot describe

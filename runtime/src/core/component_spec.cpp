@@ -26,9 +26,10 @@ void ComponentSpec::parameter(ParameterSpec declared) {
   if (find_parameter(declared.name) != nullptr) {
     throw std::logic_error(fmt::format("parameter '{}' is declared twice", declared.name));
   }
-  if (declared.is_path && declared.type() != ParameterType::String) {
-    throw std::logic_error(
-        fmt::format("parameter '{}': only a string parameter can be a path", declared.name));
+  if (declared.is_path && declared.type() != ParameterType::String &&
+      declared.type() != ParameterType::StringList) {
+    throw std::logic_error(fmt::format(
+        "parameter '{}': only a string or a list of strings can be a path", declared.name));
   }
   parameters_.push_back(std::move(declared));
 }

@@ -549,13 +549,18 @@ class Reader {
     namespace fs = std::filesystem;
     for (auto& [name, value] : component.config.parameters) {
       const ParameterSpec* spec = component.plugin->spec.find_parameter(name);
-      auto* text = std::get_if<std::string>(&value);
-      if (spec == nullptr || !spec->is_path || text == nullptr || text->empty()) continue;
-      fs::path path(*text);
-      if (path.is_absolute()) continue;
+      if (spec == nullptr || !spec->is_path) continue;
       bool from_set = set_texts_.count({&component, name}) > 0;
       fs::path base = from_set ? fs::current_path() : fs::absolute(result_.path).parent_path();
-      *text = (base / path).lexically_normal().string();
+      auto resolve = [&base](std::string& text) {
+        if (!text.empty() && !fs::path(text).is_absolute()) {
+          text = (base / fs::path(text)).lexically_normal().string();
+        }
+      };
+      if (auto* text = std::get_if<std::string>(&value)) resolve(*text);
+      if (auto* texts = std::get_if<std::vector<std::string>>(&value)) {
+        for (std::string& text : *texts) resolve(text);
+      }
     }
   }
 

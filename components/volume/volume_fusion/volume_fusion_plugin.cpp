@@ -1,0 +1,328 @@
+// volume_fusion: a volume's fixed cameras' fiducials -> one world pose per rigid body
+// (volume_tracker.hpp), published on /mocap/poses in frame 'world' for each capture time.
+//
+// Each camera's fiducials come on its own topic (/volume/{camera}/fiducials, the name in its
+// camera file), stamped at capture. The messages of one capture time are gathered
+// (frame_assembler.hpp): a frame is fused when every live camera has given its message, or
+// `wait_s` after its first one. A camera silent for `silent_after_s` is left out and reported
+// on /alerts, and taken back, also reported, at its next message; so is a camera found drifted
+// (its extrinsics moved: its residuals against the others' poses), and a body seen by one
+// camera only (its pose then rests on that camera alone).
+#include <chrono>
+#include <map>
+#include <optional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <mocap/calibration/camera_file.hpp>
+#include <mocap/component.hpp>
+#include <mocap/config_files.hpp>
+#include <mocap/message_time.hpp>
+#include <mocap_msgs/msg/alert.hpp>
+#include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <mocap_msgs/msg/fiducial_array.hpp>
+
+#include "frame_assembler.hpp"
+#include "graph_topics.hpp"
+#include "pose_message.hpp"
+#include "rigid_body_database.hpp"
+#include "volume_tracker.hpp"
+
+namespace mocap::volume {
+namespace {
+
+using mocap_msgs::msg::Alert;
+using mocap_msgs::msg::ConstellationPoseArray;
+using mocap_msgs::msg::FiducialArray;
+
+constexpr std::chrono::milliseconds kSingleCameraAlert{500};
+
+std::chrono::nanoseconds seconds(double s) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
+}
+
+// The tracker's options with what only the plugin reads.
+struct Settings : VolumeTrackerOptions {
+  std::vector<std::string> cameras = {
+      mocap::config_file("volume/cameras/cam_0.yaml"), mocap::config_file("volume/cameras/cam_1.yaml"),
+      mocap::config_file("volume/cameras/cam_2.yaml"), mocap::config_file("volume/cameras/cam_3.yaml")};
+  std::string bodies = mocap::config_file("volume/bodies.yaml");
+  double same_capture_s = 0.002;
+  double wait_s = 0.005;
+  double silent_after_s = 0.5;
+
+  // The shipped bodies are told apart by 5 markers (config/volume/bodies.yaml).
+  Settings() { identification.min_markers = 5; }
+};
+
+const ParameterList<Settings> kParameters =
+    ParameterList<Settings>()
+        .add("cameras",
+             "the volume's camera files, each with its `pose` in the world; the file's "
+             "camera_name names the camera's topic",
+             &Settings::cameras)
+        .path()
+        .add("bodies", "the rigid bodies: markers in 3D (rigid_body_database.hpp)",
+             &Settings::bodies)
+        .path()
+        .add("body_tolerance_m",
+             "how far a triangulated inter-marker distance may be from the body's",
+             &Settings::identification, &RigidBodyIdentificationOptions::tolerance)
+        .range(1e-4, 0.1)
+        .add("min_markers", "fewest of a body's markers that identify it",
+             &Settings::identification, &RigidBodyIdentificationOptions::min_markers)
+        .range(3, 1000)
+        .add("triangulation_tolerance_px",
+             "how far a triangulated marker may reproject from a detection it explains",
+             &Settings::triangulation, &MarkerTriangulationOptions::tolerance_px)
+        .range(0.01, 100)
+        .add("match_radius_px",
+             "how far a detection may be from where a track predicts one of its markers",
+             &Settings::match_radius_px)
+        .range(0.1, 1000)
+        .add("max_reprojection_rms_px", "a fused pose with a larger RMS is rejected",
+             &Settings::fusion, &MultiCameraPoseOptions::max_reprojection_rms_px)
+        .range(0.01, 100)
+        .add("lost_after_s", "a track not fused for this long is dropped",
+             &Settings::lost_after_s)
+        .range(0, 3600)
+        .add("drift_rms_px",
+             "a camera whose average residual against the fused poses exceeds this has "
+             "moved: reported and left out",
+             &Settings::drift_rms_px)
+        .range(0.01, 100)
+        .add("same_capture_s", "stamps this close are one capture time",
+             &Settings::same_capture_s)
+        .range(0, 1)
+        .add("wait_s", "how long a frame waits for late cameras after its first message",
+             &Settings::wait_s)
+        .range(0, 1)
+        .add("silent_after_s", "a camera silent this long is left out until it returns",
+             &Settings::silent_after_s)
+        .range(0.001, 3600);
+
+std::vector<VolumeCamera> load_cameras(const std::vector<std::string>& files) {
+  if (files.empty()) throw std::invalid_argument("cameras: no camera files");
+  std::vector<VolumeCamera> cameras;
+  for (const std::string& file : files) {
+    calibration::CameraFile camera = calibration::load_camera_file(file);
+    if (!camera.world_from_camera) {
+      throw std::invalid_argument(file + ": no `pose`: a volume camera needs its place in the world");
+    }
+    if (camera.name.empty()) throw std::invalid_argument(file + ": no camera_name");
+    for (const VolumeCamera& other : cameras) {
+      if (other.name == camera.name) {
+        throw std::invalid_argument(file + ": camera_name '" + camera.name + "' is taken");
+      }
+    }
+    cameras.push_back({camera.name, camera.model, camera.world_from_camera->inverse()});
+  }
+  return cameras;
+}
+
+class VolumeFusion final : public Component {
+  // Before the other members, which may start from it.
+  const Settings settings_ = read_settings(kParameters);
+
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.description(
+        "Fuses a volume of fixed, calibrated cameras: each camera's fiducials of one capture "
+        "time gathered, markers triangulated, rigid bodies identified by their markers' "
+        "distances and tracked, each body's world pose fitted over every camera that sees it "
+        "(with covariance and velocity). Silent, returning and drifted cameras and bodies seen "
+        "by one camera only go to /alerts.");
+    kParameters.declare(spec);
+    spec.subscribes<FiducialArray>(topics::kVolumeFiducials, Qos::sensor_data(),
+                                   "one topic per camera: its fiducials in pixels, stamped at "
+                                   "capture");
+    spec.publishes<ConstellationPoseArray>(
+        topics::kPoses, Qos::reliable(),
+        "each body posed in a frame: frame 'world', stamped with the capture time; "
+        "points_used counts pixels over every camera");
+    spec.publishes<Alert>(topics::kAlerts, Qos::reliable(),
+                          "cameras silent, back or drifted; bodies seen by one camera only");
+  }
+
+  explicit VolumeFusion(Context& context)
+      : Component(context),
+        tracker_(load_cameras(settings_.cameras),
+                 load_rigid_bodies(settings_.bodies, settings_.identification.tolerance,
+                                   settings_.identification.min_markers),
+                 settings_),
+        frames_(static_cast<int>(tracker_.cameras().size()),
+                {seconds(settings_.same_capture_s), seconds(settings_.wait_s),
+                 seconds(settings_.silent_after_s)}),
+        heard_(tracker_.cameras().size(), false),
+        silent_(tracker_.cameras().size(), false),
+        drifted_(tracker_.cameras().size(), false) {
+    poses_ = create_publisher<ConstellationPoseArray>(topics::kPoses);
+    alerts_ = create_publisher<Alert>(topics::kAlerts);
+    for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
+      create_subscription<FiducialArray>(
+          topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name),
+          [this, c](const FiducialArray& array) {
+            frames_.add(static_cast<int>(c), to_nanoseconds(array.header().stamp()), array,
+                        std::chrono::steady_clock::now());
+            fuse_ready();
+          });
+    }
+    // Frames whose wait runs out while no message arrives: a camera that stopped.
+    create_timer(std::chrono::milliseconds(1), [this] { fuse_ready(); });
+    std::string names;
+    for (const VolumeCamera& camera : tracker_.cameras()) names += " " + camera.name;
+    log().info("{} bodies ({}), {} cameras:{}", tracker_.bodies().bodies.size(), settings_.bodies,
+               tracker_.cameras().size(), names);
+  }
+
+  ~VolumeFusion() override {
+    std::string health;
+    for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
+      const CameraHealth& h = tracker_.camera_health()[c];
+      health += fmt::format("; {}: residual {:.2f} px over {} views, left out {}{}",
+                            tracker_.cameras()[c].name, h.average_rms_px, h.views, h.left_out,
+                            h.drifted ? ", DRIFTED" : "");
+    }
+    log().info("{} frames fused ({} incomplete), {} body poses ({} from one camera), {} "
+               "identifications, {} late messages dropped{}",
+               fused_frames_, incomplete_frames_, body_poses_, single_camera_poses_,
+               tracker_.identifications(), frames_.late_drops(), health);
+  }
+
+ private:
+  void fuse_ready() {
+    for (AssembledFrame<FiducialArray>& frame : frames_.take_ready(std::chrono::steady_clock::now())) {
+      fuse(frame);
+    }
+  }
+
+  void fuse(const AssembledFrame<FiducialArray>& assembled) {
+    report_coverage(assembled);
+    std::vector<CameraFrame> frame(assembled.messages.size());
+    for (size_t c = 0; c < frame.size(); ++c) {
+      const std::optional<FiducialArray>& message = assembled.messages[c];
+      if (!message) continue;
+      frame[c].received = true;
+      frame[c].stamp_ns = to_nanoseconds(message->header().stamp());
+      for (const auto& fiducial : message->fiducials()) {
+        frame[c].pixels.emplace_back(fiducial.x(), fiducial.y());
+      }
+    }
+    const std::vector<TrackedBodyPose> poses = tracker_.track(assembled.stamp_ns, frame);
+    ++fused_frames_;
+    if (!assembled.complete) ++incomplete_frames_;
+
+    auto message = std::make_shared<ConstellationPoseArray>();
+    message->header().stamp(to_time_msg(Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns))));
+    message->header().frame_id("world");
+    for (const TrackedBodyPose& body : poses) {
+      mocap_msgs::msg::ConstellationPose pose;
+      pose.name(body.name);
+      pose.pose().header(message->header());
+      pose.pose().pose(to_pose_message(body.world_from_body));
+      for (int i = 0; i < 36; ++i) pose.covariance()[static_cast<size_t>(i)] = body.covariance(i / 6, i % 6);
+      pose.reprojection_rms_px(static_cast<float>(body.reprojection_rms_px));
+      pose.points_used(static_cast<uint32_t>(body.points_used));
+      if (body.velocity_known) {
+        for (int i = 0; i < 36; ++i) {
+          pose.velocity_covariance()[static_cast<size_t>(i)] = body.velocity_covariance(i / 6, i % 6);
+        }
+        pose.velocity().linear().x(body.linear_velocity.x());
+        pose.velocity().linear().y(body.linear_velocity.y());
+        pose.velocity().linear().z(body.linear_velocity.z());
+        pose.velocity().angular().x(body.angular_velocity.x());
+        pose.velocity().angular().y(body.angular_velocity.y());
+        pose.velocity().angular().z(body.angular_velocity.z());
+      }
+      message->poses().push_back(std::move(pose));
+      report_single_camera(body, assembled.stamp_ns);
+    }
+    body_poses_ += poses.size();
+    poses_.publish(std::move(message));
+    report_drift();
+  }
+
+  // A camera not heard yet is left out as a silent one, but is not news until it was heard.
+  void report_coverage(const AssembledFrame<FiducialArray>& frame) {
+    for (size_t c = 0; c < silent_.size(); ++c) {
+      const std::string& name = tracker_.cameras()[c].name;
+      if (!frame.silent[c] && !heard_[c]) {
+        heard_[c] = true;
+        log().info("camera {}: first fiducials", name);
+      }
+      if (frame.silent[c] == silent_[c] || !heard_[c]) continue;
+      silent_[c] = frame.silent[c];
+      if (silent_[c]) {
+        alert(1, fmt::format("camera {} is silent: no fiducials for {} s; fusing without it", name,
+                             settings_.silent_after_s));
+      } else {
+        alert(1, fmt::format("camera {} is back", name));
+      }
+    }
+  }
+
+  // Said once a body has rested on one camera for kSingleCameraAlert: a body passing out of
+  // the others' views for a frame or two is no news.
+  void report_single_camera(const TrackedBodyPose& body, int64_t stamp_ns) {
+    std::optional<SingleCamera>& single = single_camera_[body.name];
+    if (body.cameras_used != 1) {
+      single.reset();
+      return;
+    }
+    ++single_camera_poses_;
+    if (!single) single = SingleCamera{stamp_ns, false};
+    if (!single->reported && stamp_ns - single->since_ns >= kSingleCameraAlert.count()) {
+      single->reported = true;
+      alert(1, fmt::format("{} is seen by one camera only for {} s: its depth is poor", body.name,
+                           std::chrono::duration<double>(kSingleCameraAlert).count()));
+    }
+  }
+
+  void report_drift() {
+    for (size_t c = 0; c < drifted_.size(); ++c) {
+      const CameraHealth& health = tracker_.camera_health()[c];
+      if (!health.drifted || drifted_[c]) continue;
+      drifted_[c] = true;
+      alert(2, fmt::format("camera {} has moved since calibration: residual {:.1f} px against "
+                           "the other cameras' poses; left out, calibrate it again",
+                           tracker_.cameras()[c].name, health.average_rms_px));
+    }
+  }
+
+  void alert(uint8_t level, const std::string& text) {
+    if (level >= 2) {
+      log().error("{}", text);
+    } else {
+      log().warn("{}", text);
+    }
+    auto message = std::make_shared<Alert>();
+    message->header().stamp(to_time_msg(now()));
+    message->source(name());
+    message->level(level);
+    message->text(text);
+    alerts_.publish(std::move(message));
+  }
+
+  VolumeTracker tracker_;
+  FrameAssembler<FiducialArray> frames_;
+  std::vector<bool> heard_;          // per camera
+  std::vector<bool> silent_;         // per camera, as last reported
+  std::vector<bool> drifted_;        // per camera, as last reported
+  struct SingleCamera {
+    int64_t since_ns = 0;
+    bool reported = false;
+  };
+  std::map<std::string, std::optional<SingleCamera>> single_camera_;  // by body
+  uint64_t single_camera_poses_ = 0;
+  Publisher<ConstellationPoseArray> poses_;
+  Publisher<Alert> alerts_;
+  uint64_t fused_frames_ = 0;
+  uint64_t incomplete_frames_ = 0;
+  uint64_t body_poses_ = 0;
+};
+
+}  // namespace
+}  // namespace mocap::volume
+
+MOCAP_REGISTER_COMPONENT(mocap::volume::VolumeFusion, "volume_fusion")

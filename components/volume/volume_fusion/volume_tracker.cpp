@@ -1,0 +1,289 @@
+#include "volume_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+namespace mocap::volume {
+namespace {
+
+// How quickly a camera's average residual follows its latest views, and how many views it
+// takes before the average can call the camera drifted.
+constexpr double kResidualSmoothing = 0.05;
+constexpr int64_t kViewsBeforeDriftCall = 20;
+// The residual of a camera is measured with detections up to this many times the matching
+// radius away: a bumped camera's markers land beyond the radius that pairs them for fusion.
+constexpr double kResidualRadiusFactor = 3;
+// A track's velocity is measured over its poses of this long (seconds).
+constexpr double kVelocityWindow_s = 0.05;
+
+int cameras_seeing(const std::vector<CameraView>& views) {
+  return static_cast<int>(
+      std::count_if(views.begin(), views.end(), [](const CameraView& v) { return !v.pixels.empty(); }));
+}
+
+int points_in(const std::vector<CameraView>& views) {
+  int points = 0;
+  for (const CameraView& view : views) points += static_cast<int>(view.pixels.size());
+  return points;
+}
+
+// The RMS distance (pixels) between the view's pixels and where the pose projects its points;
+// NaN for a view without points or a point that does not project.
+double view_rms_px(const CameraView& view, const Eigen::Isometry3d& world_from_body) {
+  if (view.pixels.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0;
+  for (size_t i = 0; i < view.pixels.size(); ++i) {
+    const Eigen::Vector3d in_camera = view.camera_from_world * world_from_body * view.body_points[i];
+    const auto pixel = in_camera.z() > 0 ? view.camera->project(in_camera) : std::nullopt;
+    if (!pixel) return std::numeric_limits<double>::quiet_NaN();
+    sum += (*pixel - view.pixels[i]).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(view.pixels.size()));
+}
+
+// `world_from_body` moved on by the velocities for `dt_s`.
+Eigen::Isometry3d predicted(const Eigen::Isometry3d& world_from_body, const Eigen::Vector3d& v,
+                            const Eigen::Vector3d& w, double dt_s) {
+  Eigen::Isometry3d pose = world_from_body;
+  pose.translation() += v * dt_s;
+  const double angle = w.norm() * dt_s;
+  if (angle > 0) {
+    pose.linear() = Eigen::AngleAxisd(angle, w.normalized()).toRotationMatrix() * pose.linear();
+  }
+  return pose;
+}
+
+}  // namespace
+
+VolumeTracker::VolumeTracker(std::vector<VolumeCamera> cameras, RigidBodyDatabase bodies,
+                             VolumeTrackerOptions options)
+    : cameras_(std::move(cameras)),
+      bodies_(std::move(bodies)),
+      options_(options),
+      tracks_(bodies_.bodies.size()),
+      health_(cameras_.size()) {
+  if (cameras_.empty()) throw std::invalid_argument("a volume needs at least one camera");
+  for (const VolumeCamera& camera : cameras_) {
+    if (!camera.model) throw std::invalid_argument("camera '" + camera.name + "' has no model");
+  }
+  if (!(options_.match_radius_px > 0) || !(options_.lost_after_s >= 0) ||
+      !(options_.drift_rms_px > 0)) {
+    throw std::invalid_argument(
+        "match_radius_px and drift_rms_px must be above 0, lost_after_s not below 0");
+  }
+}
+
+std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
+                                                  const std::vector<CameraFrame>& frame) {
+  if (frame.size() != cameras_.size()) {
+    throw std::invalid_argument("a frame needs one entry per camera");
+  }
+  std::vector<CameraDetections> detections;
+  for (size_t c = 0; c < cameras_.size(); ++c) {
+    CameraDetections camera{cameras_[c].model.get(), cameras_[c].camera_from_world, {}};
+    if (frame[c].received && !health_[c].drifted) camera.pixels = frame[c].pixels;
+    detections.push_back(std::move(camera));
+  }
+  // A camera stamped a little off the frame's time saw each body moved on by its velocity:
+  // its extrinsics take the shift, per body.
+  auto for_body = [&](const Track* track) {
+    std::vector<CameraDetections> shifted = detections;
+    if (track == nullptr || !track->velocity_known) return shifted;
+    for (size_t c = 0; c < shifted.size(); ++c) {
+      const double dt_s = static_cast<double>(frame[c].stamp_ns - stamp_ns) * 1e-9;
+      if (frame[c].received && dt_s != 0) {
+        shifted[c].camera_from_world =
+            shifted[c].camera_from_world * Eigen::Translation3d(track->linear_velocity * dt_s);
+      }
+    }
+    return shifted;
+  };
+
+  std::vector<std::optional<TrackedBodyPose>> posed(bodies_.bodies.size());
+  std::vector<std::optional<Fused>> single_camera(bodies_.bodies.size());
+  // Tracked bodies first, where their tracks predict them.
+  for (size_t b = 0; b < bodies_.bodies.size(); ++b) {
+    std::optional<Track>& track = tracks_[b];
+    if (!track) continue;
+    const double dt_s = static_cast<double>(stamp_ns - track->stamp_ns) * 1e-9;
+    if (dt_s > options_.lost_after_s) {
+      track.reset();
+      continue;
+    }
+    const Eigen::Isometry3d start =
+        track->velocity_known
+            ? predicted(track->world_from_body, track->linear_velocity, track->angular_velocity, dt_s)
+            : track->world_from_body;
+    if (std::optional<Fused> fused = fuse(b, start, for_body(&*track))) {
+      if (fused->pose.cameras_used >= 2) {
+        take(fused->used, detections);  // what this body used is nobody else's
+        posed[b] = update_track(b, stamp_ns, fused->pose);
+      } else {
+        single_camera[b] = std::move(*fused);
+      }
+    }
+  }
+
+  // The others, identified among the markers triangulated from what is left. A track that one
+  // camera alone found may be found again from several: its depth from one camera is poor, and
+  // a prediction off in depth misses the other cameras' detections, which would keep it at one.
+  RigidBodyDatabase untracked;
+  std::vector<size_t> untracked_index;
+  for (size_t b = 0; b < bodies_.bodies.size(); ++b) {
+    if (posed[b]) continue;
+    untracked.bodies.push_back(bodies_.bodies[b]);
+    untracked_index.push_back(b);
+  }
+  if (!untracked.bodies.empty()) {
+    std::vector<Eigen::Vector3d> markers;
+    for (const TriangulatedMarker& marker : triangulate_markers(detections, options_.triangulation)) {
+      markers.push_back(marker.position);
+    }
+    for (const IdentifiedBody& found :
+         identify_rigid_bodies(untracked, markers, options_.identification)) {
+      const size_t b = untracked_index[static_cast<size_t>(
+          std::find_if(untracked.bodies.begin(), untracked.bodies.end(),
+                       [&](const RigidBody& body) { return body.name == found.name; }) -
+          untracked.bodies.begin())];
+      if (std::optional<Fused> fused = fuse(b, found.world_from_body, detections)) {
+        ++identifications_;
+        take(fused->used, detections);
+        posed[b] = update_track(b, stamp_ns, fused->pose);
+      }
+    }
+  }
+  for (size_t b = 0; b < bodies_.bodies.size(); ++b) {
+    if (posed[b] || !single_camera[b]) continue;
+    take(single_camera[b]->used, detections);
+    posed[b] = update_track(b, stamp_ns, single_camera[b]->pose);
+  }
+
+  std::vector<TrackedBodyPose> poses;
+  for (auto& pose : posed) {
+    if (pose) poses.push_back(std::move(*pose));
+  }
+  return poses;
+}
+
+std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
+    size_t body, const Eigen::Isometry3d& start,
+    const std::vector<CameraDetections>& detections) {
+  const std::vector<Eigen::Vector3d>& markers = bodies_.bodies[body].markers;
+  std::vector<CameraView> views = views_near(detections, markers, start, options_.match_radius_px);
+  if (points_in(views) < options_.fusion.min_points) return std::nullopt;
+  MultiCameraPose fused = estimate_multi_camera_pose(views, start, options_.fusion);
+  std::optional<size_t> left_out;
+  if (!fused.valid && cameras_seeing(views) >= 3) {
+    // One camera that disagrees with the rest: the one whose removal lets them agree.
+    const std::vector<double> without = rms_without_each_view_px(views, start, options_.fusion);
+    size_t best = views.size();
+    for (size_t c = 0; c < without.size(); ++c) {
+      if (!std::isnan(without[c]) && (best == views.size() || without[c] < without[best])) best = c;
+    }
+    if (best < views.size() && without[best] <= options_.fusion.max_reprojection_rms_px) {
+      std::vector<CameraView> others = views;
+      others[best].body_points.clear();
+      others[best].pixels.clear();
+      fused = estimate_multi_camera_pose(others, start, options_.fusion);
+      if (fused.valid) {
+        left_out = best;
+        ++health_[best].left_out;
+        views[best].pixels.clear();  // its detections stay for others
+        views[best].body_points.clear();
+      }
+    }
+  }
+  if (!fused.valid) return std::nullopt;
+
+  // Each camera's residual against the pose the others fix: a camera in the fusion by its own
+  // points, one left out by the detections nearest to where the pose puts the markers.
+  if (fused.cameras_used >= 2) {
+    for (size_t c = 0; c < views.size(); ++c) {
+      const bool in_fusion = !views[c].pixels.empty();
+      if (fused.cameras_used - (in_fusion ? 1 : 0) < 2) continue;
+      double residual = std::numeric_limits<double>::quiet_NaN();
+      if (in_fusion) {
+        residual = view_rms_px(views[c], fused.world_from_body);
+      } else if (left_out == c) {
+        const std::vector<CameraView> wide =
+            views_near({detections[c]}, markers, fused.world_from_body,
+                       kResidualRadiusFactor * options_.match_radius_px);
+        residual = view_rms_px(wide[0], fused.world_from_body);
+      }
+      if (!std::isnan(residual)) record_residual(c, residual);
+    }
+  }
+
+  Fused result{fused, std::vector<std::vector<Eigen::Vector2d>>(views.size())};
+  for (size_t c = 0; c < views.size(); ++c) result.used[c] = views[c].pixels;
+  return result;
+}
+
+void VolumeTracker::take(const std::vector<std::vector<Eigen::Vector2d>>& used,
+                         std::vector<CameraDetections>& detections) {
+  for (size_t c = 0; c < used.size(); ++c) {
+    std::vector<Eigen::Vector2d>& pixels = detections[c].pixels;
+    for (const Eigen::Vector2d& pixel : used[c]) {
+      auto it = std::find(pixels.begin(), pixels.end(), pixel);
+      if (it != pixels.end()) pixels.erase(it);
+    }
+  }
+}
+
+void VolumeTracker::record_residual(size_t camera, double rms_px) {
+  // Clipped, so that one wild view (a marker taken for another) does not make a camera drifted:
+  // it takes several views in a row well above the threshold.
+  rms_px = std::min(rms_px, 2 * options_.drift_rms_px);
+  CameraHealth& health = health_[camera];
+  health.average_rms_px =
+      health.views == 0
+          ? rms_px
+          : (1 - kResidualSmoothing) * health.average_rms_px + kResidualSmoothing * rms_px;
+  ++health.views;
+  if (health.views >= kViewsBeforeDriftCall && health.average_rms_px > options_.drift_rms_px) {
+    health.drifted = true;
+  }
+}
+
+TrackedBodyPose VolumeTracker::update_track(size_t body, int64_t stamp_ns,
+                                            const MultiCameraPose& fused) {
+  std::optional<Track>& track = tracks_[body];
+  if (!track) track.emplace();
+  Track& next = *track;
+  next.world_from_body = fused.world_from_body;
+  next.stamp_ns = stamp_ns;
+  next.history.emplace_back(stamp_ns, fused.world_from_body);
+  while (next.history.size() > 2 &&
+         static_cast<double>(stamp_ns - next.history[1].first) * 1e-9 >= kVelocityWindow_s) {
+    next.history.pop_front();
+  }
+  // The velocity over the window's poses, oldest to newest: steadier than one frame's step.
+  const auto& [oldest_ns, oldest] = next.history.front();
+  if (stamp_ns > oldest_ns) {
+    const double dt_s = static_cast<double>(stamp_ns - oldest_ns) * 1e-9;
+    next.linear_velocity = (fused.world_from_body.translation() - oldest.translation()) / dt_s;
+    const Eigen::AngleAxisd turn(fused.world_from_body.linear() * oldest.linear().transpose());
+    next.angular_velocity = turn.axis() * turn.angle() / dt_s;
+    next.velocity_known = true;
+    // A difference of two poses over dt: twice a pose's variance over dt squared.
+    next.velocity_covariance = 2 * fused.covariance / (dt_s * dt_s);
+  }
+
+  TrackedBodyPose pose;
+  pose.name = bodies_.bodies[body].name;
+  pose.world_from_body = fused.world_from_body;
+  pose.covariance = fused.covariance;
+  pose.linear_velocity = next.linear_velocity;
+  pose.angular_velocity = next.angular_velocity;
+  pose.velocity_known = next.velocity_known;
+  pose.velocity_covariance = next.velocity_covariance;
+  pose.reprojection_rms_px = fused.reprojection_rms_px;
+  pose.cameras_used = fused.cameras_used;
+  pose.points_used = fused.points_used;
+  return pose;
+}
+
+}  // namespace mocap::volume

@@ -1,0 +1,134 @@
+// A volume's cameras, frame by frame, to one pose per rigid body: what the fusion component
+// runs, without middleware (the libraries of this folder's siblings, tied together).
+//
+// Each frame, every tracked body is looked for first where its track predicts it: each camera's
+// detections near the predicted markers (views_near), the pose fused over them. Bodies not
+// tracked are then identified among the markers triangulated from the detections left over,
+// and fused the same way, which starts their tracks. A track the cameras lose is kept for
+// `lost_after_s` and looked for at its prediction, then dropped. A body that only one camera
+// sees keeps its track (the single-camera pose, `cameras_used` 1) but cannot start one:
+// identification needs markers in 3D.
+//
+// The cameras' residuals are watched: a camera whose views disagree with the others' fused
+// pose (its extrinsics have moved: bumped) is left out of fusion when the others agree without
+// it, and reported as drifted when its average residual stays above `drift_rms_px`.
+//
+//   VolumeTracker tracker(cameras, bodies);
+//   std::vector<TrackedBodyPose> poses = tracker.track(stamp_ns, detections);
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <mocap/calibration/camera_model.hpp>
+
+#include "marker_triangulation.hpp"
+#include "multi_camera_pose.hpp"
+#include "rigid_body_database.hpp"
+#include "rigid_body_identification.hpp"
+
+namespace mocap::volume {
+
+struct VolumeCamera {
+  std::string name;
+  std::shared_ptr<const calibration::CameraModel> model;
+  Eigen::Isometry3d camera_from_world = Eigen::Isometry3d::Identity();
+};
+
+struct VolumeTrackerOptions {
+  MarkerTriangulationOptions triangulation;
+  RigidBodyIdentificationOptions identification;
+  MultiCameraPoseOptions fusion;
+  // How far a camera's detection may be from where the predicted pose puts a marker (pixels).
+  double match_radius_px = 8;
+  // A track not fused for this long is dropped; the body must then be identified again.
+  double lost_after_s = 0.5;
+  // A camera whose average residual against the fused poses exceeds this (pixels) has moved.
+  double drift_rms_px = 1.0;
+};
+
+// One frame's detections of one camera.
+struct CameraFrame {
+  bool received = false;  // false: no message from this camera for this capture time
+  int64_t stamp_ns = 0;   // its capture time (may differ a little from the frame's)
+  std::vector<Eigen::Vector2d> pixels;
+};
+
+struct TrackedBodyPose {
+  std::string name;
+  Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  // From the track's last two poses; known from a track's second frame on.
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   // world frame, m/s
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame, rad/s
+  bool velocity_known = false;
+  // Over (vx, vy, vz, wx, wy, wz), from the poses' covariance over the velocity's time span.
+  Eigen::Matrix<double, 6, 6> velocity_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  double reprojection_rms_px = 0;
+  int cameras_used = 0;  // 1: the single-camera pose
+  int points_used = 0;
+};
+
+struct CameraHealth {
+  double average_rms_px = 0;  // of its views against the fused poses (exponential average)
+  int64_t views = 0;          // views that went into the average
+  int64_t left_out = 0;       // fusions that left it out because the others disagreed with it
+  bool drifted = false;       // average above drift_rms_px: left out of fusion
+};
+
+class VolumeTracker {
+ public:
+  // Throws std::invalid_argument for no cameras, a camera without a model, or bad options.
+  VolumeTracker(std::vector<VolumeCamera> cameras, RigidBodyDatabase bodies,
+                VolumeTrackerOptions options = {});
+
+  // One capture time's detections, one entry per camera in the constructor's order. Returns
+  // the bodies posed in this frame, in database order.
+  std::vector<TrackedBodyPose> track(int64_t stamp_ns, const std::vector<CameraFrame>& frame);
+
+  const std::vector<VolumeCamera>& cameras() const { return cameras_; }
+  const RigidBodyDatabase& bodies() const { return bodies_; }
+  const std::vector<CameraHealth>& camera_health() const { return health_; }
+  // Bodies identified from triangulated markers (tracks started), over the tracker's life.
+  int64_t identifications() const { return identifications_; }
+
+ private:
+  struct Track {
+    Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+    int64_t stamp_ns = 0;
+    Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+    bool velocity_known = false;
+    Eigen::Matrix<double, 6, 6> velocity_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+    std::deque<std::pair<int64_t, Eigen::Isometry3d>> history;  // recent poses by stamp
+  };
+
+  struct Fused {
+    MultiCameraPose pose;
+    std::vector<std::vector<Eigen::Vector2d>> used;  // per camera, the detections it rests on
+  };
+  // The body's pose fused over the cameras' detections near `start`, with a disagreeing camera
+  // left out when the others agree without it.
+  std::optional<Fused> fuse(size_t body, const Eigen::Isometry3d& start,
+                            const std::vector<CameraDetections>& detections);
+  // Removes the detections `used` from `detections`: one detection belongs to one body.
+  static void take(const std::vector<std::vector<Eigen::Vector2d>>& used,
+                   std::vector<CameraDetections>& detections);
+  void record_residual(size_t camera, double rms_px);
+  TrackedBodyPose update_track(size_t body, int64_t stamp_ns, const MultiCameraPose& fused);
+
+  std::vector<VolumeCamera> cameras_;
+  RigidBodyDatabase bodies_;
+  VolumeTrackerOptions options_;
+  std::vector<std::optional<Track>> tracks_;  // per body
+  std::vector<CameraHealth> health_;
+  int64_t identifications_ = 0;
+};
+
+}  // namespace mocap::volume
