@@ -153,7 +153,7 @@ TEST(VolumeTracker, ABumpedCameraIsFoundAndLeftOut) {
     }
   }
   std::printf("camera 1 found drifted at frame %d (bumped at 120); residual %.2f px\n", found_at,
-              tracker.camera_health()[1].average_rms_px);
+              tracker.camera_health()[1].average_error_px);
   EXPECT_GE(found_at, 120);
   EXPECT_LT(found_at, 360);
   for (size_t c = 0; c < 4; ++c) EXPECT_EQ(tracker.camera_health()[c].drifted, c == 1) << c;

@@ -87,10 +87,10 @@ const ParameterList<Settings> kParameters =
         .add("lost_after_s", "a track not fused for this long is dropped",
              &Settings::lost_after_s)
         .range(0, 3600)
-        .add("drift_rms_px",
+        .add("drift_px",
              "a camera whose average residual against the fused poses exceeds this has "
              "moved: reported and left out",
-             &Settings::drift_rms_px)
+             &Settings::drift_px)
         .range(0.01, 100)
         .add("same_capture_s", "stamps this close are one capture time",
              &Settings::same_capture_s)
@@ -181,7 +181,7 @@ class VolumeFusion final : public Component {
     for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
       const CameraHealth& h = tracker_.camera_health()[c];
       health += fmt::format("; {}: residual {:.2f} px over {} views, left out {}{}",
-                            tracker_.cameras()[c].name, h.average_rms_px, h.views, h.left_out,
+                            tracker_.cameras()[c].name, h.average_error_px, h.views, h.left_out,
                             h.drifted ? ", DRIFTED" : "");
     }
     log().info("{} frames fused ({} incomplete), {} body poses ({} from one camera), {} "
@@ -286,7 +286,7 @@ class VolumeFusion final : public Component {
       drifted_[c] = true;
       alert(2, fmt::format("camera {} has moved since calibration: residual {:.1f} px against "
                            "the other cameras' poses; left out, calibrate it again",
-                           tracker_.cameras()[c].name, health.average_rms_px));
+                           tracker_.cameras()[c].name, health.average_error_px));
     }
   }
 

@@ -30,18 +30,20 @@ int points_in(const std::vector<CameraView>& views) {
   return points;
 }
 
-// The RMS distance (pixels) between the view's pixels and where the pose projects its points;
-// NaN for a view without points or a point that does not project.
-double view_rms_px(const CameraView& view, const Eigen::Isometry3d& world_from_body) {
+// The median distance (pixels) between the view's pixels and where the pose projects its
+// points: a moved camera has all of them off, where a marker merged with a neighbour's, or taken
+// for it, is one; NaN for a view without points or a point that does not project.
+double view_median_error_px(const CameraView& view, const Eigen::Isometry3d& world_from_body) {
   if (view.pixels.empty()) return std::numeric_limits<double>::quiet_NaN();
-  double sum = 0;
+  std::vector<double> errors;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
     const Eigen::Vector3d in_camera = view.camera_from_world * world_from_body * view.body_points[i];
     const auto pixel = in_camera.z() > 0 ? view.camera->project(in_camera) : std::nullopt;
     if (!pixel) return std::numeric_limits<double>::quiet_NaN();
-    sum += (*pixel - view.pixels[i]).squaredNorm();
+    errors.push_back((*pixel - view.pixels[i]).norm());
   }
-  return std::sqrt(sum / static_cast<double>(view.pixels.size()));
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  return errors[errors.size() / 2];
 }
 
 // `world_from_body` moved on by the velocities for `dt_s`.
@@ -70,9 +72,9 @@ VolumeTracker::VolumeTracker(std::vector<VolumeCamera> cameras, RigidBodyDatabas
     if (!camera.model) throw std::invalid_argument("camera '" + camera.name + "' has no model");
   }
   if (!(options_.match_radius_px > 0) || !(options_.lost_after_s >= 0) ||
-      !(options_.drift_rms_px > 0)) {
+      !(options_.drift_px > 0)) {
     throw std::invalid_argument(
-        "match_radius_px and drift_rms_px must be above 0, lost_after_s not below 0");
+        "match_radius_px and drift_px must be above 0, lost_after_s not below 0");
   }
 }
 
@@ -206,12 +208,12 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
       if (fused.cameras_used - (in_fusion ? 1 : 0) < 2) continue;
       double residual = std::numeric_limits<double>::quiet_NaN();
       if (in_fusion) {
-        residual = view_rms_px(views[c], fused.world_from_body);
+        residual = view_median_error_px(views[c], fused.world_from_body);
       } else if (left_out == c) {
         const std::vector<CameraView> wide =
             views_near({detections[c]}, markers, fused.world_from_body,
                        kResidualRadiusFactor * options_.match_radius_px);
-        residual = view_rms_px(wide[0], fused.world_from_body);
+        residual = view_median_error_px(wide[0], fused.world_from_body);
       }
       if (!std::isnan(residual)) record_residual(c, residual);
     }
@@ -233,17 +235,17 @@ void VolumeTracker::take(const std::vector<std::vector<Eigen::Vector2d>>& used,
   }
 }
 
-void VolumeTracker::record_residual(size_t camera, double rms_px) {
+void VolumeTracker::record_residual(size_t camera, double error_px) {
   // Clipped, so that one wild view (a marker taken for another) does not make a camera drifted:
   // it takes several views in a row well above the threshold.
-  rms_px = std::min(rms_px, 2 * options_.drift_rms_px);
+  error_px = std::min(error_px, 2 * options_.drift_px);
   CameraHealth& health = health_[camera];
-  health.average_rms_px =
+  health.average_error_px =
       health.views == 0
-          ? rms_px
-          : (1 - kResidualSmoothing) * health.average_rms_px + kResidualSmoothing * rms_px;
+          ? error_px
+          : (1 - kResidualSmoothing) * health.average_error_px + kResidualSmoothing * error_px;
   ++health.views;
-  if (health.views >= kViewsBeforeDriftCall && health.average_rms_px > options_.drift_rms_px) {
+  if (health.views >= kViewsBeforeDriftCall && health.average_error_px > options_.drift_px) {
     health.drifted = true;
   }
 }

@@ -11,7 +11,7 @@
 //
 // The cameras' residuals are watched: a camera whose views disagree with the others' fused
 // pose (its extrinsics have moved: bumped) is left out of fusion when the others agree without
-// it, and reported as drifted when its average residual stays above `drift_rms_px`.
+// it, and reported as drifted when its average residual stays above `drift_px`.
 //
 //   VolumeTracker tracker(cameras, bodies);
 //   std::vector<TrackedBodyPose> poses = tracker.track(stamp_ns, detections);
@@ -49,8 +49,9 @@ struct VolumeTrackerOptions {
   double match_radius_px = 8;
   // A track not fused for this long is dropped; the body must then be identified again.
   double lost_after_s = 0.5;
-  // A camera whose average residual against the fused poses exceeds this (pixels) has moved.
-  double drift_rms_px = 1.0;
+  // A camera whose average residual (each view's median pixel error) against the others' fused
+  // poses exceeds this (pixels) has moved.
+  double drift_px = 2.0;
 };
 
 // One frame's detections of one camera.
@@ -76,10 +77,10 @@ struct TrackedBodyPose {
 };
 
 struct CameraHealth {
-  double average_rms_px = 0;  // of its views against the fused poses (exponential average)
+  double average_error_px = 0;  // its views' median errors against the fused poses, averaged
   int64_t views = 0;          // views that went into the average
   int64_t left_out = 0;       // fusions that left it out because the others disagreed with it
-  bool drifted = false;       // average above drift_rms_px: left out of fusion
+  bool drifted = false;       // average above drift_px: left out of fusion
 };
 
 class VolumeTracker {
@@ -120,7 +121,7 @@ class VolumeTracker {
   // Removes the detections `used` from `detections`: one detection belongs to one body.
   static void take(const std::vector<std::vector<Eigen::Vector2d>>& used,
                    std::vector<CameraDetections>& detections);
-  void record_residual(size_t camera, double rms_px);
+  void record_residual(size_t camera, double error_px);
   TrackedBodyPose update_track(size_t body, int64_t stamp_ns, const MultiCameraPose& fused);
 
   std::vector<VolumeCamera> cameras_;

@@ -1,0 +1,148 @@
+// The tracking volume as launch_yaml/volume_demo.yaml ships it: four camera processes (synthetic
+// camera and fiducial tracker each, capturing together) and the compute process fusing them,
+// evaluated against the simulator's truth; then the faults: a camera process killed and
+// started again, and a camera bumped after calibration. Real time on a shared machine: the
+// bounds leave room for a frame or two late.
+#include <gtest/gtest.h>
+
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <csignal>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <mocap/calibration/camera_file.hpp>
+
+#include "test_support.hpp"
+
+namespace mocap {
+namespace {
+
+std::string launch_file() { return (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string(); }
+
+std::map<std::string, std::string> environment(int slot) {
+  return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))}};
+}
+
+// The evaluator's summary: tracked share, position error, frames without poses.
+struct Figures {
+  YAML::Node node;
+  double tracked_share() const {
+    return node["tracked"].as<double>() / std::max(1.0, node["expected"].as<double>());
+  }
+};
+
+Figures read_figures(const std::filesystem::path& summary) {
+  SCOPED_TRACE(test::read_file(summary));
+  return {YAML::LoadFile(summary.string())};
+}
+
+// 20 s of the demo: the four boards posed in the world within a millimetre (median) in nearly
+// every frame, no false identification, the cameras' residuals at the noise.
+TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
+  test::TempDir dir;
+  const auto summary = dir / "summary.yaml";
+  auto [code, output] = test::run_command(
+      {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "20", "--set",
+       "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+      environment(96), std::chrono::seconds(90));
+  ASSERT_EQ(code, 0) << output;
+  const Figures figures = read_figures(summary);
+  std::printf("%s", test::read_file(summary).c_str());
+  EXPECT_GT(figures.node["frames"].as<int>(), 450) << output;  // 30 Hz, less the start
+  EXPECT_GE(figures.tracked_share(), 0.98) << test::read_file(summary);
+  EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
+  EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
+  EXPECT_LE(figures.node["false_identifications"].as<int>(), 5) << output;
+  EXPECT_GT(figures.node["velocity_errors"].as<int>(), 1000);
+  EXPECT_LT(figures.node["velocity_error_median_mps"].as<double>(), 0.05);
+  EXPECT_EQ(output.find("DRIFTED"), std::string::npos) << output;
+  EXPECT_EQ(output.find("has moved"), std::string::npos) << output;
+}
+
+// Camera cam_1's process is killed: the compute process says so and goes on fusing the other
+// three, a pose array for every frame; started again, the camera is taken back.
+TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
+  test::TempDir dir;
+  const auto summary = dir / "summary.yaml";
+  auto group = [&](const std::string& name, const std::string& log,
+                   std::vector<std::string> more = {}) {
+    std::vector<std::string> argv = {(test::bin_dir() / "mocap_launch").string(), launch_file(),
+                                     "--group", name};
+    argv.insert(argv.end(), more.begin(), more.end());
+    return std::make_unique<test::ChildProcess>(argv, environment(97), dir / log);
+  };
+  auto compute = group("compute", "compute.log",
+                       {"--set", "evaluator.summary_file=" + summary.string(), "--set",
+                        "viewer.port=0"});
+  std::vector<std::unique_ptr<test::ChildProcess>> cameras;
+  for (int c = 0; c < 4; ++c) {
+    cameras.push_back(group("cam_" + std::to_string(c), "cam_" + std::to_string(c) + ".log"));
+  }
+  ASSERT_TRUE(compute->wait_for_output("camera cam_1: first fiducials", std::chrono::seconds(30)))
+      << compute->output();
+  std::this_thread::sleep_for(std::chrono::seconds(4));
+
+  cameras[1]->signal(SIGKILL);
+  ASSERT_TRUE(compute->wait_for_output("camera cam_1 is silent", std::chrono::seconds(10)))
+      << compute->output();
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  const auto restarted = std::chrono::steady_clock::now();
+  cameras[1] = group("cam_1", "cam_1_again.log");
+  ASSERT_TRUE(compute->wait_for_output("camera cam_1 is back", std::chrono::seconds(20)))
+      << compute->output();
+  const double back_after_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - restarted).count();
+  std::printf("cam_1 taken back %.2f s after its process was started again\n", back_after_s);
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  compute->signal(SIGTERM);
+  ASSERT_EQ(compute->wait(std::chrono::seconds(20)), 0) << compute->output();
+
+  const Figures figures = read_figures(summary);
+  std::printf("%s", test::read_file(summary).c_str());
+  // A pose array for every frame of the truth camera (cam_0), through the kill and the return.
+  EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << compute->output();
+  EXPECT_GE(figures.tracked_share(), 0.97) << test::read_file(summary);
+  EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
+  EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
+}
+
+// cam_1 knocked by half a degree after calibration: the simulator renders it from where it now
+// points, the fusion still has its calibrated pose. It is named as moved, and poses stay right.
+TEST(VolumeDemo, ABumpedCameraIsNamed) {
+  test::TempDir dir;
+  calibration::CameraFile bumped = calibration::load_camera_file(
+      (test::source_dir() / "config" / "volume" / "cameras" / "cam_1.yaml").string());
+  *bumped.world_from_camera =
+      *bumped.world_from_camera * Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d::UnitY());
+  const auto bumped_file = dir / "cam_1_bumped.yaml";
+  calibration::save_camera_file(bumped_file.string(), bumped);
+  const auto summary = dir / "summary.yaml";
+  auto [code, output] = test::run_command(
+      {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "12", "--set",
+       "cam_1.camera=" + bumped_file.string(), "--set",
+       "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+      environment(98), std::chrono::seconds(90));
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("camera cam_1 has moved since calibration"), std::string::npos) << output;
+  for (const char* other : {"cam_0", "cam_2", "cam_3"}) {
+    EXPECT_EQ(output.find(std::string("camera ") + other + " has moved"), std::string::npos)
+        << output;
+  }
+  const Figures figures = read_figures(summary);
+  EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary);
+  EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
+}
+
+TEST(VolumeDemo, ShippedLaunchFileIsValid) {
+  auto [code, output] =
+      test::run_command({(test::bin_dir() / "mocap_launch").string(), launch_file(), "--check"});
+  EXPECT_EQ(code, 0) << output;
+}
+
+}  // namespace
+}  // namespace mocap
