@@ -2,7 +2,7 @@
 // camera and fiducial tracker each, capturing together) and the compute process fusing them,
 // evaluated against the simulator's truth; then the faults: a camera process killed and
 // started again, and a camera bumped after calibration. Real time on a shared machine: the
-// bounds leave room for a frame or two late.
+// bounds leave room for frames a busy machine delivers late (a camera missing from a frame).
 #include <gtest/gtest.h>
 
 #include <yaml-cpp/yaml.h>
@@ -34,6 +34,10 @@ struct Figures {
   double tracked_share() const {
     return node["tracked"].as<double>() / std::max(1.0, node["expected"].as<double>());
   }
+  // Poses more than 5 cm or 5 degrees off: a body seen by one camera only for a while.
+  double false_share() const {
+    return node["false_identifications"].as<double>() / std::max(1.0, node["expected"].as<double>());
+  }
 };
 
 Figures read_figures(const std::filesystem::path& summary) {
@@ -57,7 +61,7 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
   EXPECT_GE(figures.tracked_share(), 0.98) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
-  EXPECT_LE(figures.node["false_identifications"].as<int>(), 5) << output;
+  EXPECT_LE(figures.false_share(), 0.01) << output;
   EXPECT_GT(figures.node["velocity_errors"].as<int>(), 1000);
   EXPECT_LT(figures.node["velocity_error_median_mps"].as<double>(), 0.05);
   EXPECT_EQ(output.find("DRIFTED"), std::string::npos) << output;
@@ -136,6 +140,40 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
   const Figures figures = read_figures(summary);
   EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
+}
+
+// The occlusion target in the deployment: each camera's view of every board is cut by 40 % from
+// a side of its own (left, right, top, bottom: a hand, a pole), so that no camera sees any board
+// whole, yet the boards are posed in nearly every frame.
+TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
+  test::TempDir dir;
+  const std::string scene =
+      test::read_file(test::source_dir() / "config" / "volume" / "scene.yaml");
+  const char* const sides[] = {"left", "right", "top", "bottom"};
+  std::vector<std::string> argv = {(test::bin_dir() / "mocap_launch").string(), launch_file(),
+                                   "--duration", "20"};
+  for (int c = 0; c < 4; ++c) {
+    std::string occluded = scene;
+    for (size_t at = occluded.find("  - constellation: "); at != std::string::npos;
+         at = occluded.find("  - constellation: ", at + 1)) {
+      const size_t line_end = occluded.find('\n', at) + 1;
+      occluded.insert(line_end,
+                      std::string("    occlusion: {fraction: 0.4, side: ") + sides[c] + "}\n");
+    }
+    const auto file = dir / ("scene_cam_" + std::to_string(c) + ".yaml");
+    test::write_file(file, occluded);
+    argv.insert(argv.end(), {"--set", "cam_" + std::to_string(c) + ".scene=" + file.string()});
+  }
+  const auto summary = dir / "summary.yaml";
+  argv.insert(argv.end(), {"--set", "evaluator.summary_file=" + summary.string(), "--set",
+                           "viewer.port=0", "--set", "evaluator.min_visible_markers=0"});
+  auto [code, output] = test::run_command(argv, environment(99), std::chrono::seconds(90));
+  ASSERT_EQ(code, 0) << output;
+  const Figures figures = read_figures(summary);
+  std::printf("%s", test::read_file(summary).c_str());
+  EXPECT_GE(figures.tracked_share(), 0.97) << test::read_file(summary);
+  EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
+  EXPECT_LE(figures.false_share(), 0.01) << output;
 }
 
 TEST(VolumeDemo, ShippedLaunchFileIsValid) {

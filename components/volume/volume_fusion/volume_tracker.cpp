@@ -16,6 +16,8 @@ constexpr int64_t kViewsBeforeDriftCall = 20;
 // The residual of a camera is measured with detections up to this many times the matching
 // radius away: a bumped camera's markers land beyond the radius that pairs them for fusion.
 constexpr double kResidualRadiusFactor = 3;
+// A track only one camera found is looked for again this many times the matching radius wide.
+constexpr double kRetryRadiusFactor = 3;
 // A track's velocity is measured over its poses of this long (seconds).
 constexpr double kVelocityWindow_s = 0.05;
 
@@ -119,7 +121,17 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
         track->velocity_known
             ? predicted(track->world_from_body, track->linear_velocity, track->angular_velocity, dt_s)
             : track->world_from_body;
-    if (std::optional<Fused> fused = fuse(b, start, for_body(&*track))) {
+    const std::vector<CameraDetections> cameras = for_body(&*track);
+    std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px);
+    if (fused && fused->pose.cameras_used == 1) {
+      // The other cameras' detections may lie beyond the radius from a prediction that one
+      // camera's poor depth put off: from that camera's pose, a wider net, which the fusion's
+      // RMS limit keeps from taking wrong detections.
+      std::optional<Fused> wider = fuse(b, fused->pose.world_from_body, cameras,
+                                        kRetryRadiusFactor * options_.match_radius_px);
+      if (wider && wider->pose.cameras_used >= 2) fused = std::move(wider);
+    }
+    if (fused) {
       if (fused->pose.cameras_used >= 2) {
         take(fused->used, detections);  // what this body used is nobody else's
         posed[b] = update_track(b, stamp_ns, fused->pose);
@@ -150,7 +162,8 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
           std::find_if(untracked.bodies.begin(), untracked.bodies.end(),
                        [&](const RigidBody& body) { return body.name == found.name; }) -
           untracked.bodies.begin())];
-      if (std::optional<Fused> fused = fuse(b, found.world_from_body, detections)) {
+      if (std::optional<Fused> fused =
+              fuse(b, found.world_from_body, detections, options_.match_radius_px)) {
         ++identifications_;
         take(fused->used, detections);
         posed[b] = update_track(b, stamp_ns, fused->pose);
@@ -171,10 +184,10 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
 }
 
 std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
-    size_t body, const Eigen::Isometry3d& start,
-    const std::vector<CameraDetections>& detections) {
+    size_t body, const Eigen::Isometry3d& start, const std::vector<CameraDetections>& detections,
+    double radius_px) {
   const std::vector<Eigen::Vector3d>& markers = bodies_.bodies[body].markers;
-  std::vector<CameraView> views = views_near(detections, markers, start, options_.match_radius_px);
+  std::vector<CameraView> views = views_near(detections, markers, start, radius_px);
   if (points_in(views) < options_.fusion.min_points) return std::nullopt;
   MultiCameraPose fused = estimate_multi_camera_pose(views, start, options_.fusion);
   std::optional<size_t> left_out;

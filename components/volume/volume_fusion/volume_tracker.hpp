@@ -114,10 +114,10 @@ class VolumeTracker {
     MultiCameraPose pose;
     std::vector<std::vector<Eigen::Vector2d>> used;  // per camera, the detections it rests on
   };
-  // The body's pose fused over the cameras' detections near `start`, with a disagreeing camera
-  // left out when the others agree without it.
+  // The body's pose fused over the cameras' detections within `radius_px` of where `start`
+  // puts its markers, with a disagreeing camera left out when the others agree without it.
   std::optional<Fused> fuse(size_t body, const Eigen::Isometry3d& start,
-                            const std::vector<CameraDetections>& detections);
+                            const std::vector<CameraDetections>& detections, double radius_px);
   // Removes the detections `used` from `detections`: one detection belongs to one body.
   static void take(const std::vector<std::vector<Eigen::Vector2d>>& used,
                    std::vector<CameraDetections>& detections);
