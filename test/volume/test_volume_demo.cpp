@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
+#include <regex>
 #include <csignal>
 #include <string>
 #include <thread>
@@ -174,6 +175,32 @@ TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
   EXPECT_GE(figures.tracked_share(), 0.97) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_LE(figures.false_share(), 0.01) << output;
+}
+
+// The multi-host form: each camera on a network-namespace host of its own, the fusion on a
+// fifth (scripts/netns_volume.sh). Poses reach the compute host; a camera host killed and one
+// whose link goes down are reported silent while poses keep coming from the others, and are
+// taken back when they return; over the run the boards are tracked.
+TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
+  auto [code, output] =
+      test::run_command({(test::source_dir() / "scripts" / "netns_volume.sh").string(), "--faults",
+                         "--duration", "20"},
+                        environment(95), std::chrono::seconds(120));
+  if (code == 77) GTEST_SKIP() << output;
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(code, 0) << output;
+  for (const char* phase : {"phase start: PASS", "phase kill_cam_1: PASS", "phase link_cam_2: PASS",
+                            "phase measure: PASS", "result: PASS 4 of 4 phases"}) {
+    EXPECT_NE(output.find(phase), std::string::npos) << phase << "\n" << output;
+  }
+  // The evaluator's row: | frames | lost | tracked % | ...
+  std::smatch row;
+  ASSERT_TRUE(std::regex_search(output, row,
+                                std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) %)")))
+      << output;
+  EXPECT_GT(std::stoi(row[1]), 400) << output;
+  EXPECT_EQ(std::stoi(row[2]), 0) << output;
+  EXPECT_GE(std::stod(row[3]), 97.0) << output;
 }
 
 TEST(VolumeDemo, ShippedLaunchFileIsValid) {

@@ -145,6 +145,7 @@ class FoxgloveBridge final : public Component {
       throw std::invalid_argument(e.what());  // names the parameter at fault
     }
     create_timer(std::chrono::milliseconds(20), [this] {
+      subscribe_first_asked();
       pump_all();
       publish_inbox();
     });
@@ -178,11 +179,15 @@ class FoxgloveBridge final : public Component {
   }
 
  private:
-  // A topic the bridge subscribes to; advertised while it has a channel.
+  // A topic the bridge offers; advertised while it has a channel. Images are subscribed to
+  // when a client first asks for them: a volume's cameras would otherwise stream every frame
+  // of every camera to the bridge's host with nobody watching. The rest at once, so that a
+  // latched topic's last message is there for the first client.
   struct TopicState {
     const MessageType* type = nullptr;
     bool latched = false;
     uint32_t channel_id = 0;  // 0: not advertised now
+    bool subscribed = false;
   };
   struct ChannelState {
     Channel channel;
@@ -244,7 +249,8 @@ class FoxgloveBridge final : public Component {
               return qos.durability == Durability::TransientLocal;
             });
         auto [known, added] = topics_.emplace(topic.topic, TopicState{topic.type, latched, 0});
-        if (added) {
+        if (added && topic.type->name() != kImageType) {
+          known->second.subscribed = true;
           new_topics.emplace_back(topic.topic, known->second);
         } else if (known->second.type != topic.type && warned_types_.insert(topic.topic).second) {
           log().warn("{} is published as {} and as {}; offered as {}", topic.topic,
@@ -252,12 +258,7 @@ class FoxgloveBridge final : public Component {
         }
       }
     }
-    for (const auto& [name, topic] : new_topics) {
-      context().subscribe_any(name, *topic.type, topic.latched ? Qos::latched() : kForwardQos,
-                              [this, topic = name](const std::shared_ptr<const void>& message) {
-                                forward(topic, message);
-                              });
-    }
+    for (const auto& [name, topic] : new_topics) subscribe(name, topic);
     std::vector<Channel> appeared;
     std::vector<uint32_t> gone;
     std::lock_guard lock(mutex_);
@@ -292,6 +293,28 @@ class FoxgloveBridge final : public Component {
       if (!gone.empty()) server_->send_text(client, unadvertise(gone));
       if (!appeared.empty()) server_->send_text(client, advertise(appeared));
     }
+  }
+
+  void subscribe_first_asked() {
+    std::vector<std::pair<std::string, TopicState>> asked;
+    {
+      std::lock_guard lock(mutex_);
+      for (const std::string& name : first_asked_) {
+        TopicState& topic = topics_.at(name);
+        if (topic.subscribed) continue;
+        topic.subscribed = true;
+        asked.emplace_back(name, topic);
+      }
+      first_asked_.clear();
+    }
+    for (const auto& [name, topic] : asked) subscribe(name, topic);
+  }
+
+  void subscribe(const std::string& name, const TopicState& topic) {
+    context().subscribe_any(name, *topic.type, topic.latched ? Qos::latched() : kForwardQos,
+                            [this, name](const std::shared_ptr<const void>& message) {
+                              forward(name, message);
+                            });
   }
 
   void opened(ClientId client) {
@@ -330,19 +353,23 @@ class FoxgloveBridge final : public Component {
       return;
     }
     if (!request) return;
-    if (auto* subscribe = std::get_if<Subscribe>(&*request)) {
+    if (auto* subscription = std::get_if<Subscribe>(&*request)) {
       std::lock_guard lock(mutex_);
       auto state = clients_.find(client);
       if (state == clients_.end()) return;
-      for (const Subscription& s : subscribe->subscriptions) {
+      for (const Subscription& s : subscription->subscriptions) {
         if (!channels_.contains(s.channel_id)) {
           server_->send_text(
               client, status(StatusLevel::Error, "no channel " + std::to_string(s.channel_id)));
           continue;
         }
         state->second.subscription_of_channel[s.channel_id] = s.id;
-        const std::string& latched = channels_.at(s.channel_id).last_frame;
-        if (!latched.empty()) queue_frame(state->second, latched, s.id);
+        const ChannelState& channel = channels_.at(s.channel_id);
+        if (!channel.last_frame.empty()) queue_frame(state->second, channel.last_frame, s.id);
+        // Subscribed by the timer: this is the server's thread, not the component's.
+        if (!topics_.at(channel.channel.topic).subscribed) {
+          first_asked_.insert(channel.channel.topic);
+        }
       }
       pump(client, state->second);
     } else if (auto* unsubscribe = std::get_if<Unsubscribe>(&*request)) {
@@ -558,6 +585,7 @@ class FoxgloveBridge final : public Component {
   std::map<std::string, std::shared_ptr<PublisherPort>> publishers_;  // for clients, by topic
   std::mutex mutex_;                                                  // guards what follows
   std::map<std::string, TopicState> topics_;
+  std::set<std::string> first_asked_;  // images a client asked for, not subscribed to yet
   std::map<uint32_t, ChannelState> channels_;
   uint32_t next_channel_id_ = 1;
   std::map<ClientId, ClientState> clients_;
