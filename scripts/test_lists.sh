@@ -17,6 +17,7 @@
 #   a minute each under the sanitizer; their publisher blocks and wakes as under the stalling
 #   subscriber, which the sanitizer build runs.
 realtime_tests='FollowerDemo\.TurretCentresBase.*|FoxgloveBridgeTest\.(TheViewerDraws|AnIndependentClient).*'
+realtime_tests+='|FoxgloveBridgeVolume\..*'
 realtime_tests+='|CalibrationRecordTool\.CtrlCStopsTheLiveRecording.*|VolumeDemo\..*'
 plain_only_tests="Install\\..*|$realtime_tests"
 plain_only_tests+='|(cyclonedds\.)?Dds/ReliableUnderLoad\.LosesNothingAcrossTenThousandMessages/(BusyCoresAnd)?SlowSubscriber( .*)?'

@@ -7,11 +7,14 @@
 // page must reconnect and draw new frames. With --floor (a PixArt graph, no camera) it checks
 // the floor instead: the ceiling cameras' footprints and the robots drawn. With --refused (a
 // bridge asking for a token the URL lacks) it checks that the page says it is disconnected;
-// with --tf (a bridge offering /tf but not /mocap/poses), that the top view draws the boards.
+// with --tf (a bridge offering /tf but not /mocap/poses), that the top view draws the boards;
+// with --volume (a volume of cameras), every camera's image with its fiducials and the volume
+// from above with the cameras, their views and the bodies.
 // HTTPS certificates are not checked (the TLS test's is self-signed). One line per check; exit 0
 // when all passed.
 //
-//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused | --tf]
+//   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused | --tf |
+//                                          --volume]
 import { chromium } from "playwright-core";
 import { existsSync } from "node:fs";
 
@@ -51,6 +54,22 @@ try {
   const errors = [];
   page.on("pageerror", (error) => errors.push(error.message));
   await page.goto(url);
+  if (mode === "--volume") {
+    const cameras = (s) => Object.keys(s.volumeImagesDrawn);
+    const seen = await snapshot(page, (s) => Object.keys(s?.volumeImagesDrawn ?? {}).length >= 4 &&
+      Object.values(s.volumeImagesDrawn).every((n) => n >= 5) &&
+      Object.values(s.volumeCirclesDrawn).every((n) => n > 0) &&
+      s.volumeConesDrawn >= 4 && s.volumeBodiesDrawn >= 4, 90000);
+    check(true, `volume cameras: ${cameras(seen).sort().map((c) => `${c} ${seen.volumeImagesDrawn[c]} images, ` +
+      `${seen.volumeCirclesDrawn[c]} fiducials`).join("; ")}`);
+    check(true, `from above: ${seen.volumeConesDrawn} cameras with their views, ${seen.volumeBodiesDrawn} bodies`);
+    check(await page.isHidden("#camera-section"), "the single camera's panel is hidden");
+    await page.waitForTimeout(1000);
+    await page.screenshot({ path: screenshot, fullPage: true });
+    check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+    await browser.close();
+    process.exit(failed ? 1 : 0);
+  }
   if (mode === "--tf") {
     // A bridge offering /tf but not /mocap/poses: the top view draws the boards from tf2.
     const seen = await snapshot(page, (s) => s?.transformsUsed >= 30 && s.boardsOnTop > 0, 90000);

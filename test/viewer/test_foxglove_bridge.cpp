@@ -516,6 +516,34 @@ TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
   EXPECT_NE(page.find("PASS floor: 4 footprints, 2 robots"), std::string::npos) << page;
 }
 
+// launch_yaml/volume_demo.yaml as shipped: the page shows each of the four cameras' images with
+// their fiducials side by side, and the volume from above with the cameras, their views and the
+// four boards. Screenshot: MOCAP_VIEWER_SCREENSHOT with "_volume" before the extension, else the
+// test's folder (docs/viewer_volume.png is made this way).
+TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
+  test::TempDir dir;
+  const int port = free_port();
+  test::ChildProcess graph(
+      {(test::bin_dir() / "mocap_launch").string(),
+       (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string(), "--set",
+       fmt::format("viewer.port={}", port), "--set", "viewer.max_image_rate_hz=5"},
+      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(94))}}, dir / "graph.log");
+  ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+      << graph.output();
+  std::filesystem::path screenshot = dir / "volume.png";
+  if (const char* wanted = std::getenv("MOCAP_VIEWER_SCREENSHOT")) {
+    const std::filesystem::path path(wanted);
+    screenshot = path.parent_path() / (path.stem().string() + "_volume" + path.extension().string());
+  }
+  auto [code, page] = test::run_command(
+      {"node", (viewer_tests() / "browser_check.mjs").string(),
+       fmt::format("http://127.0.0.1:{}/", port), screenshot.string(), "--volume"},
+      {}, std::chrono::seconds(120));
+  EXPECT_EQ(code, 0) << page << graph.output();
+  EXPECT_NE(page.find("PASS from above: 4 cameras with their views, 4 bodies"), std::string::npos)
+      << page;
+}
+
 // secure_client.mjs's one line: what a client of the `ws` package got.
 json secure_client(std::vector<std::string> arguments,
                    const std::vector<std::string>& prefix = {}) {

@@ -48,7 +48,8 @@ struct Sequence {
   std::vector<VolumeCamera> cameras() const {
     std::vector<VolumeCamera> cameras;
     for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
-      cameras.push_back({"cam_" + std::to_string(c), volume.camera, volume.extrinsics[c]});
+      const std::string name = "cam_" + std::to_string(c);
+      cameras.push_back({name, volume.camera, volume.extrinsics[c], name + "_optical"});
     }
     return cameras;
   }
@@ -196,7 +197,8 @@ TEST(VolumeTracker, OneCameraAloneKeepsATrackFlaggedAsSuch) {
 TEST(VolumeTracker, BadInputThrows) {
   const test::Volume volume;
   EXPECT_THROW(VolumeTracker({}, RigidBodyDatabase{}), std::invalid_argument);
-  VolumeTracker tracker({{"cam_0", volume.camera, volume.extrinsics[0]}}, RigidBodyDatabase{});
+  VolumeTracker tracker({{"cam_0", volume.camera, volume.extrinsics[0], "cam_0_optical"}},
+                        RigidBodyDatabase{});
   EXPECT_THROW(tracker.track(0, {}), std::invalid_argument);
 }
 

@@ -33,4 +33,22 @@ std::optional<Eigen::Isometry3d> to_isometry(const geometry_msgs::msg::Pose& pos
   return isometry;
 }
 
+geometry_msgs::msg::TransformStamped to_transform(const std_msgs::msg::Header& header,
+                                                  const std::string& child,
+                                                  const Eigen::Isometry3d& parent_from_child) {
+  geometry_msgs::msg::TransformStamped message;
+  message.header(header);
+  message.child_frame_id(child);
+  Eigen::Quaterniond q(parent_from_child.linear());
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  message.transform().translation().x(parent_from_child.translation().x());
+  message.transform().translation().y(parent_from_child.translation().y());
+  message.transform().translation().z(parent_from_child.translation().z());
+  message.transform().rotation().x(q.x());
+  message.transform().rotation().y(q.y());
+  message.transform().rotation().z(q.z());
+  message.transform().rotation().w(q.w());
+  return message;
+}
+
 }  // namespace mocap

@@ -27,7 +27,6 @@ namespace mocap::outputs {
 namespace {
 
 using geometry_msgs::msg::PoseStamped;
-using geometry_msgs::msg::TransformStamped;
 using mocap_msgs::msg::ConstellationPose;
 using mocap_msgs::msg::ConstellationPoseArray;
 using nav_msgs::msg::Odometry;
@@ -44,22 +43,6 @@ geometry_msgs::msg::Vector3 to_vector3(const Eigen::Vector3d& v) {
   message.x(v.x());
   message.y(v.y());
   message.z(v.z());
-  return message;
-}
-
-TransformStamped to_transform(const std_msgs::msg::Header& header, const std::string& child,
-                              const Eigen::Isometry3d& parent_from_child) {
-  TransformStamped message;
-  message.header(header);
-  message.child_frame_id(child);
-  // w >= 0, as static_transform_publisher writes it (q and -q are the same rotation).
-  Eigen::Quaterniond q(parent_from_child.linear());
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  message.transform().translation(to_vector3(parent_from_child.translation()));
-  message.transform().rotation().x(q.x());
-  message.transform().rotation().y(q.y());
-  message.transform().rotation().z(q.z());
-  message.transform().rotation().w(q.w());
   return message;
 }
 
@@ -97,7 +80,9 @@ const ParameterList<Settings> kParameters =
              "of /mocap/poses; poses in world_frame (a volume's) pass as they are, poses "
              "in any other frame are counted and skipped",
              &Settings::optical_frame)
-        .add("camera_in_world", "camera_frame in world_frame: x, y, z (m), roll, pitch, yaw (rad)",
+        .add("camera_in_world",
+             "camera_frame in world_frame: x, y, z (m), roll, pitch, yaw (rad); [] for no "
+             "camera (a volume's poses, in world_frame already): nothing on /tf_static",
              &Settings::camera_in_world)
         .add("child_frame_prefix", "prefix of the boards' frame names (the board's name follows)",
              &Settings::child_frame_prefix)
@@ -150,8 +135,11 @@ class PoseOutputs final : public Component {
                                       {"optical_frame", settings_.optical_frame}}) {
       if (value.empty()) throw std::invalid_argument(std::string(name) + " is empty");
     }
+    // No camera: a volume's poses, in the world frame already; nothing to mount.
+    const bool camera = !settings_.camera_in_world.empty();
     const Eigen::Isometry3d world_from_camera =
-        from_xyz_rpy(settings_.camera_in_world, "camera_in_world");
+        camera ? from_xyz_rpy(settings_.camera_in_world, "camera_in_world")
+               : Eigen::Isometry3d::Identity();
     Eigen::Isometry3d camera_from_optical = Eigen::Isometry3d::Identity();
     camera_from_optical.linear() = optical_in_body().toRotationMatrix();
     world_from_optical_ = world_from_camera * camera_from_optical;
@@ -160,6 +148,11 @@ class PoseOutputs final : public Component {
     create_subscription<ConstellationPoseArray>(
         topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
 
+    if (!camera) {
+      log().info("bodies of {} in frame {} on /mocap/<board>/pose, /mocap/<board>/odom and /tf",
+                 topics::kPoses, settings_.world_frame);
+      return;
+    }
     // Latched: a tf2 listener that starts later still gets the camera's place.
     TFMessage mounted;
     std_msgs::msg::Header header;

@@ -15,6 +15,9 @@ const ROBOTS = "/pixart/robots";
 const TURRET = "/turret/joint_states";
 const FOOTPRINTS = "/pixart/camera_footprints";
 const TF = "/tf";
+const TF_STATIC = "/tf_static";
+// A volume's cameras: /volume/<camera>/image_raw, fiducials and camera_info.
+const VOLUME = /^\/volume\/([^/]+)\/(image_raw|fiducials|camera_info)$/;
 // Large and drawn by the overlay component already: not subscribed.
 const SKIPPED = new Set(["/mocap/overlay"]);
 
@@ -35,6 +38,10 @@ const state = (window.viewerState = {
   latencyMs: null,
   // Each drawn image's age when drawn (ms, page clock minus capture stamp): the last 1000.
   drawLatenciesMs: [],
+  volumeImagesDrawn: {},  // camera -> images drawn
+  volumeCirclesDrawn: {},  // camera -> circles drawn on its last image
+  volumeConesDrawn: 0,  // cameras drawn from above with their view
+  volumeBodiesDrawn: 0,  // bodies drawn from above
 });
 
 const $ = (id) => document.getElementById(id);
@@ -104,6 +111,12 @@ function control(message) {
     }
     if (subscriptions.length) socket.send(JSON.stringify({ op: "subscribe", subscriptions }));
     $("camera-note").textContent = topics.has(IMAGE) ? "" : `no ${IMAGE} in this graph`;
+    const volume = [...topics.keys()].some((t) => VOLUME.test(t));
+    $("volume").hidden = !volume;
+    // A volume alone: the single camera's panels (its image, its top view, the floor) stay empty.
+    const single = [IMAGE, BASE, ROBOTS, FOOTPRINTS].some((t) => topics.has(t));
+    $("camera-section").hidden = volume && !topics.has(IMAGE);
+    $("side-section").hidden = volume && !single;
     renderTopics();
   } else if (message.op === "unadvertise") {
     for (const id of message.channelIds) {
@@ -138,7 +151,7 @@ function data(bytes) {
     console.warn(`${channel.topic}: ${error.message}`);
     return;
   }
-  const handler = handlers[channel.topic];
+  const handler = handlers[channel.topic] ?? volumeHandler(channel.topic);
   if (handler) handler(message, receivedMs);
 }
 
@@ -164,7 +177,149 @@ function addToTrail(name, position) {
 let base = null;
 let robots = [];
 const alerts = [];
-let dirty = { camera: false, side: false };
+let dirty = { camera: false, side: false, volume: false };
+
+// --- a volume of cameras ------------------------------------------------------------------
+
+const worldFrames = new Map();  // frame -> its transform in "world" (/tf_static)
+const volumeCameras = new Map();  // camera -> {figure, canvas, view, info, frameStamp, fiducials}
+const volumeBodies = new Map();  // body -> {x, y, yaw, trail: [{x, y}]}
+
+function addToVolume(name, pose) {
+  const body = volumeBodies.get(name) ?? { trail: [] };
+  const q = pose.orientation;
+  body.x = pose.position.x;
+  body.y = pose.position.y;
+  body.yaw = Math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z));
+  body.trail.push({ x: body.x, y: body.y });
+  if (body.trail.length > 150) body.trail.shift();
+  volumeBodies.set(name, body);
+}
+
+function volumeCamera(name) {
+  let c = volumeCameras.get(name);
+  if (c) return c;
+  const figure = document.createElement("figure");
+  const canvas = document.createElement("canvas");
+  canvas.width = 640;
+  canvas.height = 360;
+  const caption = document.createElement("figcaption");
+  caption.textContent = name;
+  figure.append(canvas, caption);
+  const cameras = $("volume-cameras");
+  const after = [...volumeCameras.keys()].sort().find((other) => other > name);
+  cameras.insertBefore(figure, after ? volumeCameras.get(after).figure : null);
+  const hidden = document.createElement("canvas");
+  c = {
+    figure,
+    canvas,
+    caption,
+    view: { offscreen: hidden, context: hidden.getContext("2d"), imageData: null },
+    info: null,
+    frameStamp: null,
+    fiducials: new Map(),
+  };
+  volumeCameras.set(name, c);
+  return c;
+}
+
+// The handler of a volume camera's topic, or undefined.
+function volumeHandler(topic) {
+  const match = VOLUME.exec(topic);
+  if (!match) return undefined;
+  const c = volumeCamera(match[1]);
+  if (match[2] === "image_raw") {
+    return (image) => {
+      if (!toPixels(image, c.view)) return;
+      c.frameStamp = stampKey(image.header);
+      c.dirty = true;
+      dirty.volume = true;
+    };
+  }
+  if (match[2] === "fiducials") {
+    return (message) => remember(c.fiducials, stampKey(message.header), message.fiducials);
+  }
+  return (info) => {
+    c.info = info;
+  };
+}
+
+function drawVolumeCameras() {
+  for (const [name, c] of volumeCameras) {
+    if (!c.dirty) continue;
+    c.dirty = false;
+    const context = c.canvas.getContext("2d");
+    const scale = c.canvas.width / c.view.offscreen.width;
+    context.drawImage(c.view.offscreen, 0, 0, c.canvas.width, c.canvas.height);
+    const fiducials = c.fiducials.get(c.frameStamp) ?? [];
+    context.strokeStyle = "#ffd54a";
+    context.lineWidth = 1.5;
+    for (const f of fiducials) {
+      context.beginPath();
+      context.arc(f.x * scale, f.y * scale, 5, 0, 2 * Math.PI);
+      context.stroke();
+    }
+    c.caption.textContent = `${name}: ${fiducials.length} fiducials`;
+    state.volumeImagesDrawn[name] = (state.volumeImagesDrawn[name] ?? 0) + 1;
+    state.volumeCirclesDrawn[name] = fiducials.length;
+  }
+}
+
+function drawVolumeTop() {
+  const canvas = $("volume-top");
+  const context = canvas.getContext("2d");
+  const ppm = 80;
+  const ox = canvas.width / 2;
+  const oy = canvas.height / 2;
+  grid(context, canvas.width, canvas.height, ppm, ox, oy);
+  const at = (p) => [ox + p.x * ppm, oy - p.y * ppm];
+  context.font = "12px system-ui, sans-serif";
+  let cones = 0;
+  for (const [name, c] of volumeCameras) {
+    const frame = c.info && worldFrames.get(c.info.header.frame_id);
+    if (!frame) continue;
+    // The optical axis and the image's sides, seen from above, out to 3 m.
+    const half = Math.atan(c.info.width / 2 / c.info.k[0]);
+    const axis = rotate(frame.rotation, { x: 0, y: 0, z: 1 });
+    const heading = Math.atan2(axis.y, axis.x);
+    const [px, py] = at(frame.translation);
+    context.strokeStyle = "#7d8794";
+    context.fillStyle = "rgba(125, 135, 148, 0.12)";
+    context.beginPath();
+    context.moveTo(px, py);
+    context.lineTo(px + 3 * ppm * Math.cos(heading - half), py - 3 * ppm * Math.sin(heading - half));
+    context.lineTo(px + 3 * ppm * Math.cos(heading + half), py - 3 * ppm * Math.sin(heading + half));
+    context.closePath();
+    context.fill();
+    context.stroke();
+    context.fillStyle = "#d8dee6";
+    context.fillRect(px - 5, py - 5, 10, 10);
+    context.fillText(name, px + 8, py + (py > oy ? 16 : -8));
+    cones++;
+  }
+  let k = 0;
+  for (const [name, body] of volumeBodies) {
+    const colour = COLOURS[k++ % COLOURS.length];
+    context.strokeStyle = colour;
+    context.globalAlpha = 0.5;
+    context.beginPath();
+    body.trail.forEach((p, i) => (i ? context.lineTo : context.moveTo).call(context, ...at(p)));
+    context.stroke();
+    context.globalAlpha = 1;
+    const [px, py] = at(body);
+    context.fillStyle = colour;
+    context.beginPath();
+    context.arc(px, py, 6, 0, 2 * Math.PI);
+    context.fill();
+    context.beginPath();
+    context.moveTo(px, py);
+    context.lineTo(px + 16 * Math.cos(body.yaw), py - 16 * Math.sin(body.yaw));
+    context.stroke();
+    context.fillText(name, px + 9, py - 9);
+  }
+  state.volumeConesDrawn = cones;
+  state.volumeBodiesDrawn = volumeBodies.size;
+}
 
 function remember(map, key, value) {
   map.set(key, value);
@@ -197,8 +352,14 @@ const handlers = {
     // difference between this machine's clock and the graph's.
     state.latencyMs = receivedMs - stampSeconds(message.header) * 1000;
     posesAt = Date.now();
-    for (const pose of message.poses) addToTrail(pose.name, pose.pose.pose.position);
-    dirty.side = true;
+    if (message.header.frame_id === "world") {
+      // A volume's bodies, in the world frame.
+      for (const pose of message.poses) addToVolume(pose.name, pose.pose.pose);
+      dirty.volume = true;
+    } else {
+      for (const pose of message.poses) addToTrail(pose.name, pose.pose.pose.position);
+      dirty.side = true;
+    }
     renderPoses();
   },
   // The boards as tf2 has them (pose_outputs, or any ROS 2 graph's /tf), drawn when
@@ -211,6 +372,13 @@ const handlers = {
       state.transformsUsed++;
       dirty.side = true;
     }
+  },
+  // Where a volume's cameras are (volume_fusion latches them).
+  [TF_STATIC](message) {
+    for (const t of message.transforms) {
+      if (t.header.frame_id === "world") worldFrames.set(t.child_frame_id, t.transform);
+    }
+    dirty.volume = true;
   },
   [BASE](message) {
     base = message.pose;
@@ -241,21 +409,26 @@ const handlers = {
   },
 };
 
-// An image message into the offscreen canvas; false for encodings this viewer does not draw.
-let imageData = null;
-function toPixels(image) {
+// An image message into a view's offscreen canvas (the camera's by default); false for
+// encodings this viewer does not draw.
+const mainView = { offscreen, context: offscreenContext, imageData: null, canvas: camera };
+function toPixels(image, view = mainView) {
   const { width, height, encoding, step, data: pixels } = image;
   const channelsOf = { mono8: 1, bgr8: 3, rgb8: 3, bgra8: 4, rgba8: 4 }[encoding];
   if (!channelsOf || pixels.length < step * height) {
     $("camera-note").textContent = `cannot draw ${encoding} images`;
     return false;
   }
-  if (!imageData || imageData.width !== width || imageData.height !== height) {
-    imageData = new ImageData(width, height);
-    offscreen.width = camera.width = width;
-    offscreen.height = camera.height = height;
+  if (!view.imageData || view.imageData.width !== width || view.imageData.height !== height) {
+    view.imageData = new ImageData(width, height);
+    view.offscreen.width = width;
+    view.offscreen.height = height;
+    if (view.canvas) {
+      view.canvas.width = width;
+      view.canvas.height = height;
+    }
   }
-  const out = imageData.data;
+  const out = view.imageData.data;
   const swap = encoding.startsWith("bgr");
   for (let y = 0; y < height; y++) {
     let i = y * step;
@@ -271,7 +444,7 @@ function toPixels(image) {
       out[o + 3] = 255;
     }
   }
-  offscreenContext.putImageData(imageData, 0, 0);
+  view.context.putImageData(view.imageData, 0, 0);
   return true;
 }
 
@@ -565,7 +738,11 @@ function frame() {
     drawTop();
     drawFloor();
   }
-  dirty = { camera: false, side: false };
+  if (dirty.volume) {
+    drawVolumeCameras();
+    drawVolumeTop();
+  }
+  dirty = { camera: false, side: false, volume: false };
   requestAnimationFrame(frame);
 }
 

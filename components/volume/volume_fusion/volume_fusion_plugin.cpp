@@ -22,6 +22,7 @@
 #include <mocap_msgs/msg/alert.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
+#include <tf2_msgs/msg/tf_message.hpp>
 
 #include "frame_assembler.hpp"
 #include "graph_topics.hpp"
@@ -35,6 +36,7 @@ namespace {
 using mocap_msgs::msg::Alert;
 using mocap_msgs::msg::ConstellationPoseArray;
 using mocap_msgs::msg::FiducialArray;
+using tf2_msgs::msg::TFMessage;
 
 constexpr std::chrono::milliseconds kSingleCameraAlert{500};
 
@@ -116,7 +118,8 @@ std::vector<VolumeCamera> load_cameras(const std::vector<std::string>& files) {
         throw std::invalid_argument(file + ": camera_name '" + camera.name + "' is taken");
       }
     }
-    cameras.push_back({camera.name, camera.model, camera.world_from_camera->inverse()});
+    cameras.push_back(
+        {camera.name, camera.model, camera.world_from_camera->inverse(), camera.frame_id});
   }
   return cameras;
 }
@@ -143,6 +146,8 @@ class VolumeFusion final : public Component {
         "points_used counts pixels over every camera");
     spec.publishes<Alert>(topics::kAlerts, Qos::reliable(),
                           "cameras silent, back or drifted; bodies seen by one camera only");
+    spec.publishes<TFMessage>(topics::kTfStatic, Qos::latched(),
+                              "once: each camera's optical frame (its images' frame id) in 'world'");
   }
 
   explicit VolumeFusion(Context& context)
@@ -159,6 +164,7 @@ class VolumeFusion final : public Component {
         drifted_(tracker_.cameras().size(), false) {
     poses_ = create_publisher<ConstellationPoseArray>(topics::kPoses);
     alerts_ = create_publisher<Alert>(topics::kAlerts);
+    publish_camera_frames();
     for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
       create_subscription<FiducialArray>(
           topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name),
@@ -191,6 +197,20 @@ class VolumeFusion final : public Component {
   }
 
  private:
+  // Latched, for tf2 and viewers: where the cameras are.
+  void publish_camera_frames() {
+    TFMessage frames;
+    std_msgs::msg::Header header;
+    header.stamp(to_time_msg(now()));
+    header.frame_id("world");
+    for (const VolumeCamera& camera : tracker_.cameras()) {
+      frames.transforms().push_back(
+          to_transform(header, camera.frame_id, camera.camera_from_world.inverse()));
+    }
+    camera_frames_ = create_publisher<TFMessage>(topics::kTfStatic);
+    camera_frames_.publish(frames);
+  }
+
   void fuse_ready() {
     for (AssembledFrame<FiducialArray>& frame : frames_.take_ready(std::chrono::steady_clock::now())) {
       fuse(frame);
@@ -317,6 +337,7 @@ class VolumeFusion final : public Component {
   uint64_t single_camera_poses_ = 0;
   Publisher<ConstellationPoseArray> poses_;
   Publisher<Alert> alerts_;
+  Publisher<TFMessage> camera_frames_;
   uint64_t fused_frames_ = 0;
   uint64_t incomplete_frames_ = 0;
   uint64_t body_poses_ = 0;

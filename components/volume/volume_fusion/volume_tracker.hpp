@@ -39,6 +39,7 @@ struct VolumeCamera {
   std::string name;
   std::shared_ptr<const calibration::CameraModel> model;
   Eigen::Isometry3d camera_from_world = Eigen::Isometry3d::Identity();
+  std::string frame_id;  // of its images: its optical frame
 };
 
 struct VolumeTrackerOptions {
