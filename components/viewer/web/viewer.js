@@ -726,9 +726,13 @@ setInterval(() => {
     t.bytes = 0;
   }
   renderTopics();
-  const images = topics.get(IMAGE)?.rate;
+  const volumeRates = [...topics.entries()].filter(([t]) => /^\/volume\/[^/]+\/image_raw$/.test(t))
+    .map(([, t]) => t.rate ?? 0);
+  const shown = volumeRates.length && !topics.has(IMAGE)
+    ? `${volumeRates.length} cameras ${Math.min(...volumeRates)}–${Math.max(...volumeRates)} Hz shown`
+    : `camera ${topics.get(IMAGE)?.rate ?? 0} Hz shown`;
   $("rates").textContent = state.connected
-    ? `camera ${images ?? 0} Hz shown · poses ${topics.get(POSES)?.rate ?? 0} Hz · latency to bridge ${state.latencyMs === null ? "—" : state.latencyMs.toFixed(1) + " ms"}`
+    ? `${shown} · poses ${topics.get(POSES)?.rate ?? 0} Hz · latency to bridge ${state.latencyMs === null ? "—" : state.latencyMs.toFixed(1) + " ms"}`
     : "";
 }, 1000);
 
