@@ -11,8 +11,10 @@ namespace {
 
 // How quickly a camera's average residual follows its latest views, and how many views it
 // takes before the average can call the camera drifted.
-constexpr double kResidualSmoothing = 0.05;
-constexpr int64_t kViewsBeforeDriftCall = 20;
+constexpr double kResidualSmoothing = 0.02;
+constexpr int64_t kViewsBeforeDriftCall = 50;
+// Views of fewer points say little of a camera: one marker taken for another is half of two.
+constexpr size_t kMinPointsForResidual = 3;
 // The residual of a camera is measured with detections up to this many times the matching
 // radius away: a bumped camera's markers land beyond the radius that pairs them for fusion.
 constexpr double kResidualRadiusFactor = 3;
@@ -219,15 +221,14 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     for (size_t c = 0; c < views.size(); ++c) {
       const bool in_fusion = !views[c].pixels.empty();
       if (fused.cameras_used - (in_fusion ? 1 : 0) < 2) continue;
-      double residual = std::numeric_limits<double>::quiet_NaN();
-      if (in_fusion) {
-        residual = view_median_error_px(views[c], fused.world_from_body);
-      } else if (left_out == c) {
-        const std::vector<CameraView> wide =
-            views_near({detections[c]}, markers, fused.world_from_body,
-                       kResidualRadiusFactor * options_.match_radius_px);
-        residual = view_median_error_px(wide[0], fused.world_from_body);
+      std::optional<CameraView> wide;
+      if (!in_fusion && left_out == c) {
+        wide = views_near({detections[c]}, markers, fused.world_from_body,
+                          kResidualRadiusFactor * options_.match_radius_px)[0];
       }
+      const CameraView* view = in_fusion ? &views[c] : wide ? &*wide : nullptr;
+      if (view == nullptr || view->pixels.size() < kMinPointsForResidual) continue;
+      const double residual = view_median_error_px(*view, fused.world_from_body);
       if (!std::isnan(residual)) record_residual(c, residual);
     }
   }
