@@ -533,7 +533,8 @@ TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
   std::filesystem::path screenshot = dir / "volume.png";
   if (const char* wanted = std::getenv("MOCAP_VIEWER_SCREENSHOT")) {
     const std::filesystem::path path(wanted);
-    screenshot = path.parent_path() / (path.stem().string() + "_volume" + path.extension().string());
+    screenshot =
+        path.parent_path() / (path.stem().string() + "_volume" + path.extension().string());
   }
   auto [code, page] = test::run_command(
       {"node", (viewer_tests() / "browser_check.mjs").string(),

@@ -47,8 +47,8 @@ TEST(VolumeCalibration, CamerasFromAWavedBoardAndTheFloor) {
     }
   }
   for (int64_t i = 0; i < 600; ++i) {
-    for (BoardSighting& s :
-         sightings(volume, Eigen::Isometry3d::Identity(), 30'000'000'000 + i * 66'000'000, random)) {
+    for (BoardSighting& s : sightings(volume, Eigen::Isometry3d::Identity(),
+                                      30'000'000'000 + i * 66'000'000, random)) {
       floor.push_back(std::move(s));
     }
   }
@@ -59,8 +59,7 @@ TEST(VolumeCalibration, CamerasFromAWavedBoardAndTheFloor) {
   const VolumeCalibration result = calibrate_volume(cameras, test::kBoard, waved, floor);
   ASSERT_EQ(result.camera_from_world.size(), 4u);
   std::printf("%zu capture times, RMS %.3f px; floor seen by %zu cameras, RMS %.3f px\n",
-              result.frames_used, result.report.rms_px, result.floor_cameras,
-              result.floor_rms_px);
+              result.frames_used, result.report.rms_px, result.floor_cameras, result.floor_rms_px);
   EXPECT_LT(result.report.rms_px, 0.5);
   EXPECT_EQ(result.floor_cameras, 4u);
   for (size_t c = 0; c < 4; ++c) {
@@ -80,7 +79,8 @@ TEST(VolumeCalibration, CamerasFromAWavedBoardAndTheFloor) {
     const Eigen::Isometry3d pose = test::random_pose(random);
     std::vector<CameraView> views = test::views_of(volume, pose, 0.3, random);
     const MultiCameraPose truth = estimate_multi_camera_pose(views, pose);
-    for (size_t c = 0; c < views.size(); ++c) views[c].camera_from_world = result.camera_from_world[c];
+    for (size_t c = 0; c < views.size(); ++c)
+      views[c].camera_from_world = result.camera_from_world[c];
     const MultiCameraPose calibrated = estimate_multi_camera_pose(views, pose);
     if (!truth.valid || !calibrated.valid) continue;
     with_truth.push_back((truth.world_from_body.translation() - pose.translation()).norm());

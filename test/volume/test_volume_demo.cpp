@@ -8,8 +8,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
-#include <regex>
 #include <csignal>
+#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -23,7 +23,9 @@
 namespace mocap {
 namespace {
 
-std::string launch_file() { return (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string(); }
+std::string launch_file() {
+  return (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string();
+}
 
 std::map<std::string, std::string> environment(int slot) {
   return {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(slot))}};
@@ -37,7 +39,8 @@ struct Figures {
   }
   // Poses more than 5 cm or 5 degrees off: a body seen by one camera only for a while.
   double false_share() const {
-    return node["false_identifications"].as<double>() / std::max(1.0, node["expected"].as<double>());
+    return node["false_identifications"].as<double>() /
+           std::max(1.0, node["expected"].as<double>());
   }
 };
 
@@ -81,9 +84,9 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
     argv.insert(argv.end(), more.begin(), more.end());
     return std::make_unique<test::ChildProcess>(argv, environment(97), dir / log);
   };
-  auto compute = group("compute", "compute.log",
-                       {"--set", "evaluator.summary_file=" + summary.string(), "--set",
-                        "viewer.port=0"});
+  auto compute =
+      group("compute", "compute.log",
+            {"--set", "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"});
   std::vector<std::unique_ptr<test::ChildProcess>> cameras;
   for (int c = 0; c < 4; ++c) {
     cameras.push_back(group("cam_" + std::to_string(c), "cam_" + std::to_string(c) + ".log"));
@@ -127,11 +130,11 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
   const auto bumped_file = dir / "cam_1_bumped.yaml";
   calibration::save_camera_file(bumped_file.string(), bumped);
   const auto summary = dir / "summary.yaml";
-  auto [code, output] = test::run_command(
-      {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "12", "--set",
-       "cam_1.camera=" + bumped_file.string(), "--set",
-       "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
-      environment(98), std::chrono::seconds(90));
+  auto [code, output] =
+      test::run_command({(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration",
+                         "12", "--set", "cam_1.camera=" + bumped_file.string(), "--set",
+                         "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+                        environment(98), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("camera cam_1 has moved since calibration"), std::string::npos) << output;
   for (const char* other : {"cam_0", "cam_2", "cam_3"}) {
@@ -195,8 +198,8 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
   }
   // The evaluator's row: | frames | lost | tracked % | ...
   std::smatch row;
-  ASSERT_TRUE(std::regex_search(output, row,
-                                std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) %)")))
+  ASSERT_TRUE(
+      std::regex_search(output, row, std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) %)")))
       << output;
   EXPECT_GT(std::stoi(row[1]), 400) << output;
   EXPECT_EQ(std::stoi(row[2]), 0) << output;
@@ -208,10 +211,10 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
 // and 0.05 degrees of where the simulator put it. The demo then runs on the files it wrote.
 TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   test::TempDir dir;
-  auto [code, output] = test::run_command(
-      {(test::source_dir() / "scripts" / "calibrate_volume.sh").string(), dir.path().string(),
-       "--wave", "20", "--floor", "6"},
-      environment(93), std::chrono::seconds(120));
+  auto [code, output] =
+      test::run_command({(test::source_dir() / "scripts" / "calibrate_volume.sh").string(),
+                         dir.path().string(), "--wave", "20", "--floor", "6"},
+                        environment(93), std::chrono::seconds(120));
   ASSERT_EQ(code, 0) << output;
   std::printf("%s", output.c_str());
   const std::regex line(R"((cam_\d): at .* m; ([0-9.]+) mm and ([0-9.]+) deg from the input)");
@@ -229,11 +232,11 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   }
   files += "]";
   const auto summary = dir / "summary.yaml";
-  auto [demo_code, demo] = test::run_command(
-      {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "12", "--set",
-       "fusion.cameras=" + files, "--set", "evaluator.summary_file=" + summary.string(), "--set",
-       "viewer.port=0"},
-      environment(93), std::chrono::seconds(90));
+  auto [demo_code, demo] =
+      test::run_command({(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration",
+                         "12", "--set", "fusion.cameras=" + files, "--set",
+                         "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+                        environment(93), std::chrono::seconds(90));
   ASSERT_EQ(demo_code, 0) << demo;
   const Figures figures = read_figures(summary);
   std::printf("on the calibrated cameras:\n%s", test::read_file(summary).c_str());

@@ -100,8 +100,7 @@ TEST(VolumeTracker, TracksEveryBodyThroughOcclusionAndAStoppedCamera) {
   const int frames = 1200;
   for (int f = 0; f < frames; ++f) {
     const std::vector<Eigen::Isometry3d> truth = truth_at(f / kRate_hz);
-    std::vector<CameraFrame> frame =
-        sequence.frame(stamp_of(f), truth, sequence.volume.extrinsics);
+    std::vector<CameraFrame> frame = sequence.frame(stamp_of(f), truth, sequence.volume.extrinsics);
     if (f >= 400 && f < 640) frame[2] = CameraFrame{};
     const std::vector<TrackedBodyPose> poses = tracker.track(stamp_of(f), frame);
     for (const TrackedBodyPose& pose : poses) {
@@ -112,8 +111,8 @@ TEST(VolumeTracker, TracksEveryBodyThroughOcclusionAndAStoppedCamera) {
         ASSERT_TRUE(pose.velocity_known);
         // The helmet's speed: 2 pi m in 5 s.
         if (pose.name == "helmet") {
-          worst_speed_error =
-              std::max(worst_speed_error, std::abs(pose.linear_velocity.norm() - 2 * test::kPi / 5));
+          worst_speed_error = std::max(worst_speed_error,
+                                       std::abs(pose.linear_velocity.norm() - 2 * test::kPi / 5));
         }
       }
     }
@@ -122,9 +121,10 @@ TEST(VolumeTracker, TracksEveryBodyThroughOcclusionAndAStoppedCamera) {
   EXPECT_EQ(tracker.identifications(), 2);
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2], p99 = errors[errors.size() * 99 / 100];
-  std::printf("%d of %d body poses; position error median %.2f mm, p99 %.2f mm, max %.2f mm; "
-              "helmet speed error up to %.3f m/s\n",
-              posed, 2 * frames, median * 1e3, p99 * 1e3, errors.back() * 1e3, worst_speed_error);
+  std::printf(
+      "%d of %d body poses; position error median %.2f mm, p99 %.2f mm, max %.2f mm; "
+      "helmet speed error up to %.3f m/s\n",
+      posed, 2 * frames, median * 1e3, p99 * 1e3, errors.back() * 1e3, worst_speed_error);
   EXPECT_LT(median, 1.5e-3);
   EXPECT_LT(p99, 3e-3);
   // A frame where a marker is taken for a neighbour stays within the fusion's RMS limit.
@@ -187,9 +187,10 @@ TEST(VolumeTracker, OneCameraAloneKeepsATrackFlaggedAsSuch) {
   }
   std::sort(errors.begin(), errors.end());
   ASSERT_FALSE(errors.empty());
-  std::printf("drone posed from one camera in %d of 240 frames, position error median %.1f mm, "
-              "max %.1f mm\n",
-              single, errors[errors.size() / 2] * 1e3, errors.back() * 1e3);
+  std::printf(
+      "drone posed from one camera in %d of 240 frames, position error median %.1f mm, "
+      "max %.1f mm\n",
+      single, errors[errors.size() / 2] * 1e3, errors.back() * 1e3);
   EXPECT_GE(single, 235);
   EXPECT_LT(errors[errors.size() / 2], 0.03);
 }

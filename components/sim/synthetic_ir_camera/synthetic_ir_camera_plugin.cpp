@@ -131,7 +131,8 @@ class SyntheticIrCamera final : public Component {
     spec.publishes<mocap_msgs::msg::ConstellationPoseArray>(
         topics::kGroundTruth, Qos::reliable(),
         "per frame, the true pose and velocity of every constellation in front of the camera "
-        "(camera frame, or 'world' for a camera placed by its file; mid-exposure); points_used = its "
+        "(camera frame, or 'world' for a camera placed by its file; mid-exposure); points_used = "
+        "its "
         "visible markers; same stamp as the image");
   }
 
@@ -177,7 +178,8 @@ class SyntheticIrCamera final : public Component {
                                                 std::chrono::duration<double>(1 / rate_hz))
                                           : std::chrono::nanoseconds(kBackToBackPeriod);
     if (settings_.synchronized) {
-      create_worker("capture", [this, period](std::stop_token stop) { capture_on_the_clock(period, stop); });
+      create_worker("capture",
+                    [this, period](std::stop_token stop) { capture_on_the_clock(period, stop); });
     } else {
       create_timer(period, [this] { tick(); });
     }
@@ -249,7 +251,8 @@ class SyntheticIrCamera final : public Component {
     auto truth = std::make_shared<mocap_msgs::msg::ConstellationPoseArray>();
     truth->header(truth_header);
     // Into the world's frame for a placed camera: its rotation turns the velocities too.
-    const Eigen::Isometry3d to_truth_frame = world_from_camera_.value_or(Eigen::Isometry3d::Identity());
+    const Eigen::Isometry3d to_truth_frame =
+        world_from_camera_.value_or(Eigen::Isometry3d::Identity());
     for (const ObjectTruth& object : frame.objects) {
       if (!object.in_front) continue;
       const Eigen::Vector3d linear = to_truth_frame.linear() * object.linear_velocity;

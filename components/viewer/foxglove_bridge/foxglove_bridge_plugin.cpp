@@ -311,10 +311,9 @@ class FoxgloveBridge final : public Component {
   }
 
   void subscribe(const std::string& name, const TopicState& topic) {
-    context().subscribe_any(name, *topic.type, topic.latched ? Qos::latched() : kForwardQos,
-                            [this, name](const std::shared_ptr<const void>& message) {
-                              forward(name, message);
-                            });
+    context().subscribe_any(
+        name, *topic.type, topic.latched ? Qos::latched() : kForwardQos,
+        [this, name](const std::shared_ptr<const void>& message) { forward(name, message); });
   }
 
   void opened(ClientId client) {

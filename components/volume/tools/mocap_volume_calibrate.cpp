@@ -77,9 +77,8 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
       sighting.camera = camera_of_topic.at(message.topic->name);
       sighting.pixels.resize(board.points.size());
       for (const auto& line : constellation.sub_constellations()) {
-        const auto model_line =
-            std::find_if(board.lines.begin(), board.lines.end(),
-                         [&](const auto& l) { return l.name == line.name(); });
+        const auto model_line = std::find_if(board.lines.begin(), board.lines.end(),
+                                             [&](const auto& l) { return l.name == line.name(); });
         if (model_line == board.lines.end()) continue;
         const auto& fiducials = line.fiducial_array().fiducials();
         const auto& stamp = line.fiducial_array().header().stamp();
@@ -93,8 +92,10 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
       sightings.push_back(std::move(sighting));
     }
   }
-  for (const std::string& problem : reader.problems()) fmt::print(stderr, "{}: {}\n", path, problem);
-  if (undecodable > 0) fmt::print(stderr, "{}: {} messages could not be decoded\n", path, undecodable);
+  for (const std::string& problem : reader.problems())
+    fmt::print(stderr, "{}: {}\n", path, problem);
+  if (undecodable > 0)
+    fmt::print(stderr, "{}: {} messages could not be decoded\n", path, undecodable);
   std::vector<size_t> per_camera(cameras.size(), 0);
   for (const BoardSighting& s : sightings) ++per_camera[s.camera];
   std::string counts;
@@ -130,10 +131,10 @@ int run(const Arguments& arguments) {
     fmt::print(stderr, "cannot calibrate the volume: {}\n", e.what());
     return 1;
   }
-  fmt::print("waved: {} capture times with the board whole in two cameras or more; RMS "
-             "reprojection error {:.3f} px over {} points ({} iterations)\n",
-             result.frames_used, result.report.rms_px, result.report.points,
-             result.report.iterations);
+  fmt::print(
+      "waved: {} capture times with the board whole in two cameras or more; RMS "
+      "reprojection error {:.3f} px over {} points ({} iterations)\n",
+      result.frames_used, result.report.rms_px, result.report.points, result.report.iterations);
   fmt::print("floor: the board seen by {} cameras, RMS {:.3f} px\n", result.floor_cameras,
              result.floor_rms_px);
   std::filesystem::create_directories(arguments.output);

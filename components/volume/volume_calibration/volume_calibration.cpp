@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <map>
 
-#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <Eigen/Eigenvalues>
 
 #include <mocap/calibration/calibration_config.hpp>
 #include <mocap/calibration/camera_factory.hpp>
@@ -38,7 +38,8 @@ std::optional<std::vector<Eigen::Vector2d>> whole(const BoardSighting& sighting,
   Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
   for (const Eigen::Vector2d& p : pixels) scatter += (p - mean) * (p - mean).transpose();
   scatter /= static_cast<double>(markers);
-  const double narrowest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues().minCoeff();
+  const double narrowest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues().minCoeff();
   if (narrowest < kMinBoardWidthPx * kMinBoardWidthPx) return std::nullopt;
   return pixels;
 }

@@ -50,9 +50,9 @@ struct VolumeCalibration {
   calibration::CalibrationReport report;
   // Per camera, in the input's order: its pose in the floor's frame (the world).
   std::vector<Eigen::Isometry3d> camera_from_world;
-  size_t frames_used = 0;     // capture times of the waved session in the solve
-  size_t floor_cameras = 0;   // cameras that saw the board on the floor
-  double floor_rms_px = 0;    // the floor board's reprojection error over them
+  size_t frames_used = 0;    // capture times of the waved session in the solve
+  size_t floor_cameras = 0;  // cameras that saw the board on the floor
+  double floor_rms_px = 0;   // the floor board's reprojection error over them
 };
 
 // Why a volume cannot be calibrated from the sightings: a camera no shot ties to the others,

@@ -10,8 +10,8 @@
 // camera only (its pose then rests on that camera alone).
 #include <chrono>
 #include <map>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,9 +46,10 @@ std::chrono::nanoseconds seconds(double s) {
 
 // The tracker's options with what only the plugin reads.
 struct Settings : VolumeTrackerOptions {
-  std::vector<std::string> cameras = {
-      mocap::config_file("volume/cameras/cam_0.yaml"), mocap::config_file("volume/cameras/cam_1.yaml"),
-      mocap::config_file("volume/cameras/cam_2.yaml"), mocap::config_file("volume/cameras/cam_3.yaml")};
+  std::vector<std::string> cameras = {mocap::config_file("volume/cameras/cam_0.yaml"),
+                                      mocap::config_file("volume/cameras/cam_1.yaml"),
+                                      mocap::config_file("volume/cameras/cam_2.yaml"),
+                                      mocap::config_file("volume/cameras/cam_3.yaml")};
   std::string bodies = mocap::config_file("volume/bodies.yaml");
   double same_capture_s = 0.002;
   double wait_s = 0.005;
@@ -86,16 +87,14 @@ const ParameterList<Settings> kParameters =
         .add("max_reprojection_rms_px", "a fused pose with a larger RMS is rejected",
              &Settings::fusion, &MultiCameraPoseOptions::max_reprojection_rms_px)
         .range(0.01, 100)
-        .add("lost_after_s", "a track not fused for this long is dropped",
-             &Settings::lost_after_s)
+        .add("lost_after_s", "a track not fused for this long is dropped", &Settings::lost_after_s)
         .range(0, 3600)
         .add("drift_px",
              "a camera whose average residual against the fused poses exceeds this has "
              "moved: reported and left out",
              &Settings::drift_px)
         .range(0.01, 100)
-        .add("same_capture_s", "stamps this close are one capture time",
-             &Settings::same_capture_s)
+        .add("same_capture_s", "stamps this close are one capture time", &Settings::same_capture_s)
         .range(0, 1)
         .add("wait_s", "how long a frame waits for late cameras after its first message",
              &Settings::wait_s)
@@ -110,7 +109,8 @@ std::vector<VolumeCamera> load_cameras(const std::vector<std::string>& files) {
   for (const std::string& file : files) {
     calibration::CameraFile camera = calibration::load_camera_file(file);
     if (!camera.world_from_camera) {
-      throw std::invalid_argument(file + ": no `pose`: a volume camera needs its place in the world");
+      throw std::invalid_argument(file +
+                                  ": no `pose`: a volume camera needs its place in the world");
     }
     if (camera.name.empty()) throw std::invalid_argument(file + ": no camera_name");
     for (const VolumeCamera& other : cameras) {
@@ -146,8 +146,9 @@ class VolumeFusion final : public Component {
         "points_used counts pixels over every camera");
     spec.publishes<Alert>(topics::kAlerts, Qos::reliable(),
                           "cameras silent, back or drifted; bodies seen by one camera only");
-    spec.publishes<TFMessage>(topics::kTfStatic, Qos::latched(),
-                              "once: each camera's optical frame (its images' frame id) in 'world'");
+    spec.publishes<TFMessage>(
+        topics::kTfStatic, Qos::latched(),
+        "once: each camera's optical frame (its images' frame id) in 'world'");
   }
 
   explicit VolumeFusion(Context& context)
@@ -190,10 +191,11 @@ class VolumeFusion final : public Component {
                             tracker_.cameras()[c].name, h.average_error_px, h.views, h.left_out,
                             h.drifted ? ", DRIFTED" : "");
     }
-    log().info("{} frames fused ({} incomplete), {} body poses ({} from one camera), {} "
-               "identifications, {} late messages dropped{}",
-               fused_frames_, incomplete_frames_, body_poses_, single_camera_poses_,
-               tracker_.identifications(), frames_.late_drops(), health);
+    log().info(
+        "{} frames fused ({} incomplete), {} body poses ({} from one camera), {} "
+        "identifications, {} late messages dropped{}",
+        fused_frames_, incomplete_frames_, body_poses_, single_camera_poses_,
+        tracker_.identifications(), frames_.late_drops(), health);
   }
 
  private:
@@ -212,7 +214,8 @@ class VolumeFusion final : public Component {
   }
 
   void fuse_ready() {
-    for (AssembledFrame<FiducialArray>& frame : frames_.take_ready(std::chrono::steady_clock::now())) {
+    for (AssembledFrame<FiducialArray>& frame :
+         frames_.take_ready(std::chrono::steady_clock::now())) {
       fuse(frame);
     }
   }
@@ -234,19 +237,22 @@ class VolumeFusion final : public Component {
     if (!assembled.complete) ++incomplete_frames_;
 
     auto message = std::make_shared<ConstellationPoseArray>();
-    message->header().stamp(to_time_msg(Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns))));
+    message->header().stamp(
+        to_time_msg(Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns))));
     message->header().frame_id("world");
     for (const TrackedBodyPose& body : poses) {
       mocap_msgs::msg::ConstellationPose pose;
       pose.name(body.name);
       pose.pose().header(message->header());
       pose.pose().pose(to_pose_message(body.world_from_body));
-      for (int i = 0; i < 36; ++i) pose.covariance()[static_cast<size_t>(i)] = body.covariance(i / 6, i % 6);
+      for (int i = 0; i < 36; ++i)
+        pose.covariance()[static_cast<size_t>(i)] = body.covariance(i / 6, i % 6);
       pose.reprojection_rms_px(static_cast<float>(body.reprojection_rms_px));
       pose.points_used(static_cast<uint32_t>(body.points_used));
       if (body.velocity_known) {
         for (int i = 0; i < 36; ++i) {
-          pose.velocity_covariance()[static_cast<size_t>(i)] = body.velocity_covariance(i / 6, i % 6);
+          pose.velocity_covariance()[static_cast<size_t>(i)] =
+              body.velocity_covariance(i / 6, i % 6);
         }
         pose.velocity().linear().x(body.linear_velocity.x());
         pose.velocity().linear().y(body.linear_velocity.y());
@@ -326,9 +332,9 @@ class VolumeFusion final : public Component {
 
   VolumeTracker tracker_;
   FrameAssembler<FiducialArray> frames_;
-  std::vector<bool> heard_;          // per camera
-  std::vector<bool> silent_;         // per camera, as last reported
-  std::vector<bool> drifted_;        // per camera, as last reported
+  std::vector<bool> heard_;    // per camera
+  std::vector<bool> silent_;   // per camera, as last reported
+  std::vector<bool> drifted_;  // per camera, as last reported
   struct SingleCamera {
     int64_t since_ns = 0;
     bool reported = false;

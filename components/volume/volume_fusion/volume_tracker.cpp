@@ -24,8 +24,8 @@ constexpr double kRetryRadiusFactor = 3;
 constexpr double kVelocityWindow_s = 0.05;
 
 int cameras_seeing(const std::vector<CameraView>& views) {
-  return static_cast<int>(
-      std::count_if(views.begin(), views.end(), [](const CameraView& v) { return !v.pixels.empty(); }));
+  return static_cast<int>(std::count_if(views.begin(), views.end(),
+                                        [](const CameraView& v) { return !v.pixels.empty(); }));
 }
 
 int points_in(const std::vector<CameraView>& views) {
@@ -41,7 +41,8 @@ double view_median_error_px(const CameraView& view, const Eigen::Isometry3d& wor
   if (view.pixels.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::vector<double> errors;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
-    const Eigen::Vector3d in_camera = view.camera_from_world * world_from_body * view.body_points[i];
+    const Eigen::Vector3d in_camera =
+        view.camera_from_world * world_from_body * view.body_points[i];
     const auto pixel = in_camera.z() > 0 ? view.camera->project(in_camera) : std::nullopt;
     if (!pixel) return std::numeric_limits<double>::quiet_NaN();
     errors.push_back((*pixel - view.pixels[i]).norm());
@@ -119,10 +120,10 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
       track.reset();
       continue;
     }
-    const Eigen::Isometry3d start =
-        track->velocity_known
-            ? predicted(track->world_from_body, track->linear_velocity, track->angular_velocity, dt_s)
-            : track->world_from_body;
+    const Eigen::Isometry3d start = track->velocity_known
+                                        ? predicted(track->world_from_body, track->linear_velocity,
+                                                    track->angular_velocity, dt_s)
+                                        : track->world_from_body;
     const std::vector<CameraDetections> cameras = for_body(&*track);
     std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px);
     if (fused && fused->pose.cameras_used == 1) {
@@ -155,7 +156,8 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
   }
   if (!untracked.bodies.empty()) {
     std::vector<Eigen::Vector3d> markers;
-    for (const TriangulatedMarker& marker : triangulate_markers(detections, options_.triangulation)) {
+    for (const TriangulatedMarker& marker :
+         triangulate_markers(detections, options_.triangulation)) {
       markers.push_back(marker.position);
     }
     for (const IdentifiedBody& found :
@@ -254,10 +256,9 @@ void VolumeTracker::record_residual(size_t camera, double error_px) {
   // it takes several views in a row well above the threshold.
   error_px = std::min(error_px, 2 * options_.drift_px);
   CameraHealth& health = health_[camera];
-  health.average_error_px =
-      health.views == 0
-          ? error_px
-          : (1 - kResidualSmoothing) * health.average_error_px + kResidualSmoothing * error_px;
+  health.average_error_px = health.views == 0 ? error_px
+                                              : (1 - kResidualSmoothing) * health.average_error_px +
+                                                    kResidualSmoothing * error_px;
   ++health.views;
   if (health.views >= kViewsBeforeDriftCall && health.average_error_px > options_.drift_px) {
     health.drifted = true;

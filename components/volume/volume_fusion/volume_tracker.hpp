@@ -79,9 +79,9 @@ struct TrackedBodyPose {
 
 struct CameraHealth {
   double average_error_px = 0;  // its views' median errors against the fused poses, averaged
-  int64_t views = 0;          // views that went into the average
-  int64_t left_out = 0;       // fusions that left it out because the others disagreed with it
-  bool drifted = false;       // average above drift_px: left out of fusion
+  int64_t views = 0;            // views that went into the average
+  int64_t left_out = 0;         // fusions that left it out because the others disagreed with it
+  bool drifted = false;         // average above drift_px: left out of fusion
 };
 
 class VolumeTracker {

@@ -29,8 +29,8 @@ struct ParameterSpec {
   // Inclusive bounds for numbers and for each element of number lists.
   std::optional<double> min;
   std::optional<double> max;
-  // A file or directory (a string), or a list of them. A relative value in a launch file is taken relative to that file's
-  // folder, one given with --set relative to the working directory.
+  // A file or directory (a string), or a list of them. A relative value in a launch file is taken
+  // relative to that file's folder, one given with --set relative to the working directory.
   bool is_path = false;
 
   ParameterType type() const { return type_of(default_value); }

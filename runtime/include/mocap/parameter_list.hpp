@@ -83,8 +83,8 @@ class ParameterList {
     entries_.back().spec.max = max;
     return *this;
   }
-  // The parameter added last (a string or a list of strings) is a file or directory path: a relative value in a
-  // launch file is taken relative to the file's folder.
+  // The parameter added last (a string or a list of strings) is a file or directory path: a
+  // relative value in a launch file is taken relative to the file's folder.
   ParameterList& path() {
     entries_.back().spec.is_path = true;
     return *this;
