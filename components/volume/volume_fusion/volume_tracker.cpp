@@ -96,14 +96,14 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
   }
   // A camera stamped a little off the frame's time saw each body moved on by its velocity:
   // its extrinsics take the shift, per body.
-  auto for_body = [&](const Track* track) {
+  auto for_body = [&](const Track& track) {
     std::vector<CameraDetections> shifted = detections;
-    if (track == nullptr || !track->velocity_known) return shifted;
+    if (!track.velocity_known) return shifted;
     for (size_t c = 0; c < shifted.size(); ++c) {
       const double dt_s = static_cast<double>(frame[c].stamp_ns - stamp_ns) * 1e-9;
       if (frame[c].received && dt_s != 0) {
         shifted[c].camera_from_world =
-            shifted[c].camera_from_world * Eigen::Translation3d(track->linear_velocity * dt_s);
+            shifted[c].camera_from_world * Eigen::Translation3d(track.linear_velocity * dt_s);
       }
     }
     return shifted;
@@ -124,7 +124,7 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
                                         ? predicted(track->world_from_body, track->linear_velocity,
                                                     track->angular_velocity, dt_s)
                                         : track->world_from_body;
-    const std::vector<CameraDetections> cameras = for_body(&*track);
+    const std::vector<CameraDetections> cameras = for_body(*track);
     std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px);
     if (fused && fused->pose.cameras_used == 1) {
       // The other cameras' detections may lie beyond the radius from a prediction that one
@@ -217,8 +217,9 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   }
   if (!fused.valid) return std::nullopt;
 
-  // Each camera's residual against the pose the others fix: a camera in the fusion by its own
-  // points, one left out by the detections nearest to where the pose puts the markers.
+  // Each camera's residual where two other cameras or more hold the pose: a camera in the
+  // fusion by its own points, one left out by its detections nearest to where the pose puts
+  // the markers.
   if (fused.cameras_used >= 2) {
     for (size_t c = 0; c < views.size(); ++c) {
       const bool in_fusion = !views[c].pixels.empty();
