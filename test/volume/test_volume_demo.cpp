@@ -148,7 +148,8 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
 
 // The occlusion target in the deployment: each camera's view of every board is cut by 40 % from
 // a side of its own (left, right, top, bottom: a hand, a pole), so that no camera sees any board
-// whole, yet the boards are posed in nearly every frame.
+// whole, yet once found (identification needs five of a board's markers in two cameras each,
+// which takes up to a few seconds here) the boards are posed in nearly every frame.
 TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
   test::TempDir dir;
   const std::string scene =
@@ -169,13 +170,14 @@ TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
     argv.insert(argv.end(), {"--set", "cam_" + std::to_string(c) + ".scene=" + file.string()});
   }
   const auto summary = dir / "summary.yaml";
-  argv.insert(argv.end(), {"--set", "evaluator.summary_file=" + summary.string(), "--set",
-                           "viewer.port=0", "--set", "evaluator.min_visible_markers=0"});
+  argv.insert(argv.end(),
+              {"--set", "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0",
+               "--set", "evaluator.min_visible_markers=0", "--set", "evaluator.skip_first_s=5"});
   auto [code, output] = test::run_command(argv, environment(99), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
-  EXPECT_GE(figures.tracked_share(), 0.97) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.98) << test::read_file(summary) << output;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_LE(figures.false_share(), 0.01) << output;
 }

@@ -2,6 +2,7 @@
 // a live summary line and a final table (pose_evaluation.hpp).
 #include <chrono>
 #include <fstream>
+#include <optional>
 
 #include <mocap/component.hpp>
 #include <mocap/message_time.hpp>
@@ -44,7 +45,8 @@ std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& a
 struct Settings : EvaluationOptions {
   double report_period_s = 1;
   uint64_t stop_after_frames = 0;  // 0: never
-  std::string summary_file;        // empty: none
+  double skip_first_s = 0;
+  std::string summary_file;  // empty: none
 };
 
 const ParameterList<Settings> kParameters =
@@ -58,6 +60,11 @@ const ParameterList<Settings> kParameters =
         .add("stop_after_frames", "stop the process after evaluating this many frames (0: never)",
              &Settings::stop_after_frames)
         .range(0, 1e9)
+        .add("skip_first_s",
+             "seconds from the first truth array left out of the figures: the time a tracker "
+             "takes to find the bodies, measured apart",
+             &Settings::skip_first_s)
+        .range(0, 3600)
         .add("summary_file", "where the final figures go (YAML), optional", &Settings::summary_file)
         .path()
         .add("max_lag_frames",
@@ -89,13 +96,16 @@ class PoseEvaluatorComponent final : public Component {
           // Once stopping, frames still in flight are not counted: the summary covers
           // stop_after_frames frames however long the stop takes.
           if (stopping_) return;
+          const int64_t stamp_ns = to_nanoseconds(truth.header().stamp());
+          if (!first_truth_ns_) first_truth_ns_ = stamp_ns;
+          if (skipped(stamp_ns)) return;
           ++truth_arrays_;
-          evaluator_.add_truth(to_nanoseconds(truth.header().stamp()), objects(truth, true));
+          evaluator_.add_truth(stamp_ns, objects(truth, true));
           check_done();
         });
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         topics::kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
-          if (stopping_) return;
+          if (stopping_ || skipped(to_nanoseconds(poses.header().stamp()))) return;
           latencies_s_.push_back(
               std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());
           evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses, false));
@@ -109,6 +119,13 @@ class PoseEvaluatorComponent final : public Component {
   ~PoseEvaluatorComponent() override { finish(); }
 
  private:
+  // In the first skip_first_s, or before the first truth array.
+  bool skipped(int64_t stamp_ns) const {
+    if (settings_.skip_first_s <= 0) return false;
+    return !first_truth_ns_ ||
+           static_cast<double>(stamp_ns - *first_truth_ns_) * 1e-9 < settings_.skip_first_s;
+  }
+
   void report() {
     EvaluationSummary window = evaluator_.take_window();
     window_latencies_s_.swap(latencies_s_);
@@ -178,6 +195,7 @@ class PoseEvaluatorComponent final : public Component {
   PoseEvaluator evaluator_;
   bool stopping_ = false;
   uint64_t truth_arrays_ = 0;
+  std::optional<int64_t> first_truth_ns_;  // the first truth array's stamp
   std::vector<double> latencies_s_, window_latencies_s_, all_latencies_s_;
 };
 
