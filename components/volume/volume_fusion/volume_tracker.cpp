@@ -20,6 +20,9 @@ constexpr size_t kMinPointsForResidual = 3;
 constexpr double kResidualRadiusFactor = 3;
 // A track only one camera found is looked for again this many times the matching radius wide.
 constexpr double kRetryRadiusFactor = 3;
+// A point this many times the fusion's RMS limit off the pose is left out, and the pose fitted
+// again without it.
+constexpr double kOutlierFactor = 2;
 // A track's velocity is measured over its poses of this long (seconds).
 constexpr double kVelocityWindow_s = 0.05;
 
@@ -34,21 +37,46 @@ int points_in(const std::vector<CameraView>& views) {
   return points;
 }
 
-// The median distance (pixels) between the view's pixels and where the pose projects its
-// points: a moved camera has all of them off, where a marker merged with a neighbour's, or taken
-// for it, is one; NaN for a view without points or a point that does not project.
-double view_median_error_px(const CameraView& view, const Eigen::Isometry3d& world_from_body) {
-  if (view.pixels.empty()) return std::numeric_limits<double>::quiet_NaN();
+// The distance (pixels) between each of the view's pixels and where the pose projects its
+// point; infinite for a point that does not project.
+std::vector<double> point_errors_px(const CameraView& view,
+                                    const Eigen::Isometry3d& world_from_body) {
   std::vector<double> errors;
   for (size_t i = 0; i < view.pixels.size(); ++i) {
     const Eigen::Vector3d in_camera =
         view.camera_from_world * world_from_body * view.body_points[i];
     const auto pixel = in_camera.z() > 0 ? view.camera->project(in_camera) : std::nullopt;
-    if (!pixel) return std::numeric_limits<double>::quiet_NaN();
-    errors.push_back((*pixel - view.pixels[i]).norm());
+    errors.push_back(pixel ? (*pixel - view.pixels[i]).norm()
+                           : std::numeric_limits<double>::infinity());
   }
+  return errors;
+}
+
+// The median of point_errors_px: a moved camera has all of its points off, where a marker
+// merged with a neighbour's, or taken for it, is one; NaN for a view without points.
+double view_median_error_px(const CameraView& view, const Eigen::Isometry3d& world_from_body) {
+  std::vector<double> errors = point_errors_px(view, world_from_body);
+  if (errors.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
   return errors[errors.size() / 2];
+}
+
+// The views without their points further than `limit_px` from where the pose puts them.
+std::vector<CameraView> without_outliers(const std::vector<CameraView>& views,
+                                         const Eigen::Isometry3d& world_from_body,
+                                         double limit_px) {
+  std::vector<CameraView> kept;
+  for (const CameraView& view : views) {
+    const std::vector<double> errors = point_errors_px(view, world_from_body);
+    CameraView close{view.camera, view.camera_from_world, {}, {}};
+    for (size_t i = 0; i < errors.size(); ++i) {
+      if (errors[i] > limit_px) continue;
+      close.body_points.push_back(view.body_points[i]);
+      close.pixels.push_back(view.pixels[i]);
+    }
+    kept.push_back(std::move(close));
+  }
+  return kept;
 }
 
 // `world_from_body` moved on by the velocities for `dt_s`.
@@ -194,6 +222,21 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   std::vector<CameraView> views = views_near(detections, markers, start, radius_px);
   if (points_in(views) < options_.fusion.min_points) return std::nullopt;
   MultiCameraPose fused = estimate_multi_camera_pose(views, start, options_.fusion);
+  if (!fused.valid && fused.reprojection_rms_px > 0) {
+    // Points far off the least-squares pose: a marker an occluder cut in half (its centre
+    // moved) or one merged with a neighbour's. Without them the others may agree.
+    std::vector<CameraView> kept = without_outliers(
+        views, fused.world_from_body, kOutlierFactor * options_.fusion.max_reprojection_rms_px);
+    const int points = points_in(kept);
+    if (points >= options_.fusion.min_points && points < points_in(views)) {
+      MultiCameraPose again =
+          estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
+      if (again.valid) {
+        views = std::move(kept);
+        fused = std::move(again);
+      }
+    }
+  }
   std::optional<size_t> left_out;
   if (!fused.valid && cameras_seeing(views) >= 3) {
     // One camera that disagrees with the rest: the one whose removal lets them agree.
