@@ -39,6 +39,7 @@ using mocap_msgs::msg::FiducialArray;
 using tf2_msgs::msg::TFMessage;
 
 constexpr std::chrono::milliseconds kSingleCameraAlert{500};
+constexpr size_t kMaxBacklog = 2;  // frames fused at once; older ready ones are skipped
 
 std::chrono::nanoseconds seconds(double s) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
@@ -192,9 +193,9 @@ class VolumeFusion final : public Component {
                             h.drifted ? ", DRIFTED" : "");
     }
     log().info(
-        "{} frames fused ({} incomplete), {} body poses ({} from one camera), {} "
-        "identifications, {} late messages dropped{}",
-        fused_frames_, incomplete_frames_, body_poses_, single_camera_poses_,
+        "{} frames fused ({} incomplete, {} skipped while behind), {} body poses ({} from one "
+        "camera), {} identifications, {} late messages dropped{}",
+        fused_frames_, incomplete_frames_, skipped_frames_, body_poses_, single_camera_poses_,
         tracker_.identifications(), frames_.late_drops(), health);
   }
 
@@ -213,11 +214,14 @@ class VolumeFusion final : public Component {
     camera_frames_.publish(frames);
   }
 
+  // A machine too busy to fuse every frame fuses the newest: poses late by a backlog are worth
+  // less than the next ones, and a backlog only grows.
   void fuse_ready() {
-    for (AssembledFrame<FiducialArray>& frame :
-         frames_.take_ready(std::chrono::steady_clock::now())) {
-      fuse(frame);
-    }
+    std::vector<AssembledFrame<FiducialArray>> ready =
+        frames_.take_ready(std::chrono::steady_clock::now());
+    const size_t skip = ready.size() > kMaxBacklog ? ready.size() - kMaxBacklog : 0;
+    skipped_frames_ += skip;
+    for (size_t f = skip; f < ready.size(); ++f) fuse(ready[f]);
   }
 
   void fuse(const AssembledFrame<FiducialArray>& assembled) {
@@ -346,6 +350,7 @@ class VolumeFusion final : public Component {
   Publisher<TFMessage> camera_frames_;
   uint64_t fused_frames_ = 0;
   uint64_t incomplete_frames_ = 0;
+  uint64_t skipped_frames_ = 0;  // behind: older than the newest kMaxBacklog ready
   uint64_t body_poses_ = 0;
 };
 
