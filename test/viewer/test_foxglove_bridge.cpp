@@ -527,7 +527,7 @@ TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
       {(test::bin_dir() / "mocap_launch").string(),
        (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string(), "--set",
        fmt::format("viewer.port={}", port), "--set", "viewer.max_image_rate_hz=5"},
-      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(94))}}, dir / "graph.log");
+      {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(56))}}, dir / "graph.log");
   ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
       << graph.output();
   std::filesystem::path screenshot = dir / "volume.png";

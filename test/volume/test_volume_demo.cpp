@@ -57,7 +57,7 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
   auto [code, output] = test::run_command(
       {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "20", "--set",
        "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
-      environment(96), std::chrono::seconds(90));
+      environment(76), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
@@ -82,7 +82,7 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
     std::vector<std::string> argv = {(test::bin_dir() / "mocap_launch").string(), launch_file(),
                                      "--group", name};
     argv.insert(argv.end(), more.begin(), more.end());
-    return std::make_unique<test::ChildProcess>(argv, environment(97), dir / log);
+    return std::make_unique<test::ChildProcess>(argv, environment(77), dir / log);
   };
   auto compute =
       group("compute", "compute.log",
@@ -134,7 +134,7 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
       test::run_command({(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration",
                          "12", "--set", "cam_1.camera=" + bumped_file.string(), "--set",
                          "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
-                        environment(98), std::chrono::seconds(90));
+                        environment(78), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("camera cam_1 has moved since calibration"), std::string::npos) << output;
   for (const char* other : {"cam_0", "cam_2", "cam_3"}) {
@@ -173,7 +173,7 @@ TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
   argv.insert(argv.end(),
               {"--set", "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0",
                "--set", "evaluator.min_visible_markers=0", "--set", "evaluator.skip_first_s=5"});
-  auto [code, output] = test::run_command(argv, environment(99), std::chrono::seconds(90));
+  auto [code, output] = test::run_command(argv, environment(79), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
@@ -190,7 +190,7 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
   auto [code, output] =
       test::run_command({(test::source_dir() / "scripts" / "netns_volume.sh").string(), "--faults",
                          "--duration", "20"},
-                        environment(95), std::chrono::seconds(120));
+                        environment(75), std::chrono::seconds(120));
   if (code == 77) GTEST_SKIP() << output;
   std::printf("%s", output.c_str());
   EXPECT_EQ(code, 0) << output;
@@ -216,7 +216,7 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   auto [code, output] =
       test::run_command({(test::source_dir() / "scripts" / "calibrate_volume.sh").string(),
                          dir.path().string(), "--wave", "20", "--floor", "6"},
-                        environment(93), std::chrono::seconds(120));
+                        environment(74), std::chrono::seconds(120));
   ASSERT_EQ(code, 0) << output;
   std::printf("%s", output.c_str());
   const std::regex line(R"((cam_\d): at .* m; ([0-9.]+) mm and ([0-9.]+) deg from the input)");
@@ -238,7 +238,7 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
       test::run_command({(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration",
                          "12", "--set", "fusion.cameras=" + files, "--set",
                          "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
-                        environment(93), std::chrono::seconds(90));
+                        environment(74), std::chrono::seconds(90));
   ASSERT_EQ(demo_code, 0) << demo;
   const Figures figures = read_figures(summary);
   std::printf("on the calibrated cameras:\n%s", test::read_file(summary).c_str());
