@@ -11,6 +11,12 @@
 namespace mocap::volume {
 namespace {
 
+// Steps one body's search may take. Missing markers may be anywhere, so the search is
+// exponential in the worst case (many markers of look-alike distances: ghosts of a bad
+// triangulation, other bodies' markers): bounded, it gives the best assignment found so far
+// rather than hold the frame, and a tracker finds the body in a later frame.
+constexpr long kMaxSearchSteps = 200'000;
+
 // Depth-first over the body's markers: each one placed on a free measured marker whose
 // distances to those placed before match, or left missing.
 class AssignmentSearch {
@@ -48,6 +54,7 @@ class AssignmentSearch {
   }
 
   void extend(size_t k, int found) {
+    if (++steps_ > kMaxSearchSteps) return;
     const int left = static_cast<int>(body_.markers.size() - k);
     if (found + left < std::max(best_found_, options_.min_markers)) return;
     if (left == 0) {
@@ -87,6 +94,7 @@ class AssignmentSearch {
   const std::vector<bool>& taken_;
   const RigidBodyIdentificationOptions& options_;
   std::vector<int> assignment_;
+  long steps_ = 0;
   int best_found_ = 0;
   double best_rms_ = std::numeric_limits<double>::infinity();
   std::vector<int> best_assignment_;
