@@ -207,7 +207,7 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
       << output;
   EXPECT_GT(std::stoi(row[1]), 400) << output;
   EXPECT_EQ(std::stoi(row[2]), 0) << output;
-  EXPECT_GE(std::stod(row[3]), 97.0) << output;
+  EXPECT_GE(std::stod(row[3]), 95.0) << output;
 }
 
 // Calibrated from data (scripts/calibrate_volume.sh): the board carried through the volume for
