@@ -6,8 +6,9 @@
 # `logs_out` (a directory to keep the logs in, or empty) and defines say(). Sourcing makes the
 # network (exit 77 when it cannot) and gives: ns HOST (its namespace), on HOST COMMAND... (run
 # in it, replacing the subshell), run COMMAND... (in the background, waited for, so signals are
-# handled at once), alive HOST, link_bytes HOST rx|tx, the `pid` of each started host's process
-# and `run_dir` for logs. Everything is named mgtest_<pid>_* and removed when the script ends,
+# handled at once), alive HOST, link_bytes HOST rx|tx, the `pid` of each started host's process,
+# `run_dir` for logs, and finish (the traffic, each host's last lines when a phase failed, the
+# result; the scenario counts its phases in `passed` and `failed`). Everything is named mgtest_<pid>_* and removed when the script ends,
 # however it ends.
 if [ "$(id -u)" -ne 0 ]; then
   say "cannot make network namespaces: not root"
@@ -109,3 +110,23 @@ say "hosts up: ${summary%, } on a bridge (namespaces ${prefix}_*; logs in $run_d
 
 alive() { kill -0 "${pid[$1]}" 2>/dev/null; }
 link_bytes() { ip netns exec "$(ns "$1")" cat "/sys/class/net/eth0/statistics/$2_bytes" 2>/dev/null || echo 0; }
+
+# Ends the run: each host's traffic, their logs' last lines when a phase failed, the result.
+passed=0 failed=0
+finish() {
+  local h traffic=""
+  for h in "${hosts[@]}"; do
+    traffic+="$h rx $(($(link_bytes "$h" rx) / 1024)) KiB tx $(($(link_bytes "$h" tx) / 1024)) KiB; "
+  done
+  echo "traffic: ${traffic%; }"
+  if [ $failed -gt 0 ]; then
+    for h in "${hosts[@]}"; do
+      echo "--- last lines of $h's log ---"
+      tail -n 15 "$run_dir/$h.log" 2>/dev/null
+    done
+    echo "result: FAIL $failed of $((passed + failed)) phases failed"
+    exit 1
+  fi
+  echo "result: PASS $passed of $passed phases"
+  exit 0
+}

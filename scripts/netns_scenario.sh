@@ -101,7 +101,6 @@ stopped_others() {
   echo "${out% }"
 }
 
-
 # True once the last line of HOST's log that matches SELECT matches WANT too (waits 10 s).
 log_says() {  # HOST SELECT WANT
   local deadline=$((SECONDS + 10)) last
@@ -129,29 +128,10 @@ settle() {  # PHASE HOST_EXEMPT TEXT
   fi
 }
 
-passed=0 failed=0
 verdict() {  # NAME PASS|FAIL TEXT...
   echo "phase $1: $2 ${*:3}"
   if [ "$2" = PASS ]; then passed=$((passed + 1)); else failed=$((failed + 1)); fi
   if [ "$2" = FAIL ] && [ $keep_going -eq 0 ]; then finish; fi
-}
-
-finish() {
-  local h traffic=""
-  for h in "${hosts[@]}"; do
-    traffic+="$h rx $(($(link_bytes "$h" rx) / 1024)) KiB tx $(($(link_bytes "$h" tx) / 1024)) KiB; "
-  done
-  echo "traffic: ${traffic%; }"
-  if [ $failed -gt 0 ]; then
-    for h in "${hosts[@]}"; do
-      echo "--- last lines of $h's log ---"
-      tail -n 15 "$run_dir/$h.log" 2>/dev/null
-    done
-    echo "result: FAIL $failed of $((passed + failed)) phases failed"
-    exit 1
-  fi
-  echo "result: PASS $passed of $passed phases"
-  exit 0
 }
 
 # --- start: every host; poses must reach the observer.

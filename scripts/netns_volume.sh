@@ -89,28 +89,9 @@ wait_for_log() {  # TEXT SINCE_NS TIMEOUT_S
   done
 }
 
-passed=0 failed=0
 verdict() {  # NAME PASS|FAIL TEXT...
   echo "phase $1: $2 ${*:3}"
   if [ "$2" = PASS ]; then passed=$((passed + 1)); else failed=$((failed + 1)); fi
-}
-
-finish() {
-  local h traffic=""
-  for h in "${hosts[@]}"; do
-    traffic+="$h rx $(($(link_bytes "$h" rx) / 1024)) KiB tx $(($(link_bytes "$h" tx) / 1024)) KiB; "
-  done
-  echo "traffic: ${traffic%; }"
-  if [ $failed -gt 0 ]; then
-    for h in "${hosts[@]}"; do
-      echo "--- last lines of $h's log ---"
-      tail -n 15 "$run_dir/$h.log" 2>/dev/null
-    done
-    echo "result: FAIL $failed of $((passed + failed)) phases failed"
-    exit 1
-  fi
-  echo "result: PASS $passed of $passed phases"
-  exit 0
 }
 
 # --- start: every camera heard, then (the bodies found: a pose array of the first frames may
