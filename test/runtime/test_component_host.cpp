@@ -22,6 +22,7 @@
 
 #include "core/names.hpp"
 #include "dds/dds_transport.hpp"
+#include "plugins/sequence_message.hpp"
 #include "test_support.hpp"
 
 namespace mocap {
@@ -527,6 +528,55 @@ TEST_F(ComponentHostTest, StoppingReleasesAPublisherWaitingForASubscriber) {
   EXPECT_TRUE(std::is_sorted(burst.received.begin(), burst.received.end()));
   EXPECT_EQ(std::adjacent_find(burst.received.begin(), burst.received.end()),
             burst.received.end());  // none twice
+}
+
+// Subscribes to the test sequence of another process and, from its callbacks, once they have
+// shown to be quick (so that a DDS receive thread could run them), subscribes to it once more.
+// Fast DDS attaches a new reader to its receive resources under a lock its receive thread
+// holds while delivering: created on that thread, the reader would never come.
+class SubscribesInItsCallbacks final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) { spec.subscribes_any("the test sequence, twice"); }
+  explicit SubscribesInItsCallbacks(Context& context) : Component(context) {
+    context.subscribe_any(test::kSequenceTopic, message_type<Array>(), Qos::reliable(),
+                          [this](const std::shared_ptr<const void>&) {
+                            if (++first_ != 200) return;
+                            this->context().subscribe_any(
+                                test::kSequenceTopic, message_type<Array>(), Qos::reliable(),
+                                [](const std::shared_ptr<const void>&) { ++second; });
+                          });
+  }
+  static inline std::atomic<int> second{0};
+
+ private:
+  int first_ = 0;
+};
+
+TEST(ComponentHostOverDds, AComponentSubscribingInItsCallbacksKeepsReceiving) {
+  test::TempDir dir;
+  const std::string domain = std::to_string(test::test_domain(86));
+  setenv("MOCAP_DOMAIN_ID", domain.c_str(), 1);
+  test::write_file(dir / "source.yaml", R"(groups:
+  - name: source
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {count: 0, batch: 5, period_s: 0.005, subscribers: 1}
+)");
+  test::ChildProcess source(
+      {(test::bin_dir() / "mocap_launch").string(), (dir / "source.yaml").string()},
+      {{"MOCAP_DOMAIN_ID", domain}, {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}},
+      dir / "source.log");
+  ComponentHost host({.name = "late_subscriber", .threads = 2, .dds = {.enabled = true}});
+  host.add(make_component_factory<SubscribesInItsCallbacks>("subscribes_in_callbacks"),
+           {.name = "subscriber"});
+  host.start();
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (SubscribesInItsCallbacks::second < 100 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_GE(SubscribesInItsCallbacks::second, 100) << source.output();
+  host.stop();
 }
 
 // The lifecycle as components see it: what happened, in order.

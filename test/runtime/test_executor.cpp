@@ -158,6 +158,7 @@ class Recorder final : public Waitable {
       std::this_thread::sleep_for(duration.load());
       std::lock_guard lock(mutex);
       threads.push_back(std::this_thread::get_id());
+      on_transport_thread.push_back(Strand::on_transport_thread());
     });
     return true;
   }
@@ -178,6 +179,7 @@ class Recorder final : public Waitable {
   std::atomic<std::chrono::microseconds> duration{std::chrono::microseconds(0)};
   std::mutex mutex;
   std::vector<std::thread::id> threads;
+  std::vector<bool> on_transport_thread;  // what Strand::on_transport_thread() said
 };
 
 class DispatchTest : public ::testing::Test {
@@ -203,6 +205,11 @@ TEST_F(DispatchTest, RunsCallbacksHereOnceTheyHaveShownToBeQuick) {
   EXPECT_FALSE(recorder->dispatch_ran_here(strand));  // not known to be quick yet
   warm_up();
   for (int i = 0; i < 5; ++i) EXPECT_TRUE(recorder->dispatch_ran_here(strand));
+  // The callbacks can tell: run on the dispatching thread here, on the executor's before.
+  std::lock_guard lock(recorder->mutex);
+  EXPECT_FALSE(recorder->on_transport_thread.front());
+  EXPECT_TRUE(recorder->on_transport_thread.back());
+  EXPECT_FALSE(Strand::on_transport_thread());
 }
 
 TEST_F(DispatchTest, HandsSlowCallbacksToTheExecutor) {
@@ -214,9 +221,9 @@ TEST_F(DispatchTest, HandsSlowCallbacksToTheExecutor) {
   EXPECT_FALSE(recorder->dispatch_ran_here(strand));
 }
 
-TEST_F(DispatchTest, NeverRunsCallbacksThatMayWaitForASubscriberHere) {
+TEST_F(DispatchTest, NeverRunsCallbacksKeptOffTransportThreadsHere) {
   warm_up();
-  strand.set_may_wait();
+  strand.keep_off_transport_threads();
   for (int i = 0; i < 5; ++i) EXPECT_FALSE(recorder->dispatch_ran_here(strand));
 }
 

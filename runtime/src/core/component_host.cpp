@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include <fmt/format.h>
@@ -224,7 +225,12 @@ class ComponentHost::Impl::ComponentContext final : public Context {
         config_(std::move(config)),
         parameters_(std::move(parameters)),
         logger_(config_.name),
-        strand_(host.executor, logger_) {}
+        strand_(host.executor, logger_) {
+    if (spec_.find_any_topic(TopicDirection::Publish) != nullptr ||
+        spec_.find_any_topic(TopicDirection::Subscribe) != nullptr) {
+      strand_.keep_off_transport_threads();  // creates endpoints in its callbacks
+    }
+  }
 
   ~ComponentContext() override {
     request_workers_stop();
@@ -288,8 +294,22 @@ class ComponentHost::Impl::ComponentContext final : public Context {
     return it == config_.remaps.end() ? topic : it->second;
   }
 
+  // A component declared with publishes_any / subscribes_any runs its callbacks on the
+  // executor; one that creates a declared endpoint in a callback does so from then on, and
+  // must not have done it on a transport's thread (Strand::keep_off_transport_threads).
+  void check_created_off_transport_threads(const Endpoint& endpoint) {
+    if (Strand::on_transport_thread()) {
+      throw std::logic_error(fmt::format(
+          "{} for {} created in a callback run on a DDS thread: a component that creates "
+          "publishers or subscriptions in its callbacks declares publishes_any or subscribes_any",
+          endpoint.owner, endpoint.topic));
+    }
+    if (strand_.enabled()) strand_.keep_off_transport_threads();
+  }
+
   std::shared_ptr<PublisherPort> advertise_endpoint(const Endpoint& endpoint) {
-    if (publisher_may_wait(endpoint.qos, Qos::reliable())) strand_.set_may_wait();
+    check_created_off_transport_threads(endpoint);
+    if (publisher_may_wait(endpoint.qos, Qos::reliable())) strand_.keep_off_transport_threads();
     auto publisher = std::make_shared<HostPublisher>(endpoint.topic);
     for (auto& transport : host_.transports) {
       publisher->ports_.push_back(transport->advertise(endpoint));
@@ -299,6 +319,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
   }
 
   void subscribe_endpoint(const Endpoint& endpoint, MessageCallback callback) {
+    check_created_off_transport_threads(endpoint);
     auto subscription = std::make_shared<HostSubscription>("subscription to " + endpoint.topic,
                                                            std::move(callback));
     for (auto& transport : host_.transports) {

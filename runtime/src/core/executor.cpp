@@ -8,6 +8,8 @@ namespace {
 
 // The executor whose thread this is, if any.
 thread_local Executor* current_executor = nullptr;
+// Set while Strand::dispatch() runs callbacks on a transport's thread.
+thread_local bool in_transport_dispatch = false;
 
 }  // namespace
 
@@ -126,19 +128,23 @@ void Strand::notify() {
 }
 
 void Strand::dispatch() {
-  if (may_wait_.load() || mean_callback_ns_.load() > kQuickCallbackNanoseconds) {
+  if (off_transport_threads_.load() || mean_callback_ns_.load() > kQuickCallbackNanoseconds) {
     notify();
     return;
   }
   pending_.store(true);
   if (!enabled_.load() || scheduled_.exchange(true)) return;  // queued or running already
   if (executor_.begin_foreign_run()) {
+    in_transport_dispatch = true;
     run(kDispatchBudget);
+    in_transport_dispatch = false;
     executor_.end_foreign_run();
   } else {
     executor_.schedule(this);  // not started yet; when stopping, this does nothing
   }
 }
+
+bool Strand::on_transport_thread() { return in_transport_dispatch; }
 
 void Strand::enable() {
   enabled_.store(true);

@@ -112,13 +112,18 @@ class Strand {
   // delivery, so that publishing never runs a subscriber's code. Quick callbacks keep the
   // transport's thread free for its other work.
   void dispatch();
-  // The strand's callbacks publish where they may have to wait for a subscriber. dispatch()
-  // then always hands them to the executor: a transport's thread that waited inside a
-  // callback could not receive the acknowledgements it waits for.
-  void set_may_wait() { may_wait_.store(true); }
+  // dispatch() hands this strand's callbacks to the executor from now on: they publish where
+  // they may wait for a subscriber (a transport's thread waiting inside a callback could not
+  // receive the acknowledgements it waits for), or they create publishers and subscriptions
+  // (Fast DDS attaches a new endpoint to its receive resources under a lock its receiving
+  // thread holds while it delivers: a reader created there deadlocks that thread).
+  void keep_off_transport_threads() { off_transport_threads_.store(true); }
+  // True inside callbacks dispatch() runs on a transport's thread.
+  static bool on_transport_thread();
   // A strand runs nothing before it is enabled, so that a component's subscriptions cannot
   // call into it before its constructor has returned. Notifications are kept until then.
   void enable();
+  bool enabled() const { return enabled_.load(); }
   // Called by the executor.
   void run(int budget = kBudget);
   uint64_t callback_errors() const { return callback_errors_.load(); }
@@ -139,7 +144,7 @@ class Strand {
   std::atomic<bool> enabled_{false};
   std::atomic<bool> scheduled_{false};
   std::atomic<bool> pending_{false};
-  std::atomic<bool> may_wait_{false};
+  std::atomic<bool> off_transport_threads_{false};
   std::atomic<uint64_t> callback_errors_{0};
   // Moving average over about 16 callbacks; starts slow, so that a component's callbacks
   // run on a transport's thread only once they have shown to be quick.
