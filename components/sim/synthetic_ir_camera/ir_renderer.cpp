@@ -71,6 +71,17 @@ IrRenderer::IrRenderer(Scene scene, std::shared_ptr<const calibration::CameraMod
         "motion_blur_steps >= 0");
   }
   draw_static_layer();
+  for (int pattern = 0; pattern < noise_.patterns(); ++pattern) {
+    cv::Mat sum;
+    if (noise_.enabled()) {
+      cv::add(static_layer_, noise_.pattern(pattern), sum);
+    } else {
+      sum = static_layer_;
+    }
+    sum.convertTo(backgrounds_.emplace_back(), CV_8U);  // rounds and saturates to 0..255
+  }
+  work_.create(static_layer_.size(), CV_32F);
+  drawn_ = cv::Mat::zeros(static_layer_.size(), CV_8U);
   // A board reaches a marker's radius and a centimetre beyond its outermost markers.
   for (const SceneObject& object : scene_.objects) {
     BoardExtent extent;
@@ -182,10 +193,30 @@ void IrRenderer::draw_static_layer() {
   }
 }
 
+void IrRenderer::begin_drawing(const cv::Rect& area) {
+  for (int v = area.y; v < area.y + area.height; ++v) {
+    uchar* drawn = drawn_.ptr<uchar>(v);
+    float* work = work_.ptr<float>(v);
+    const float* base = static_layer_.ptr<float>(v);
+    const float* noise = noise_pattern_.empty() ? nullptr : noise_pattern_.ptr<float>(v);
+    for (int u = area.x; u < area.x + area.width; ++u) {
+      if (drawn[u]) continue;
+      work[u] = noise ? base[u] + noise[u] : base[u];
+      drawn[u] = 1;
+    }
+  }
+  drawn_areas_.push_back(area);
+}
+
+void IrRenderer::mark_drawn(const cv::Rect& area) {
+  drawn_(area).setTo(1);
+  drawn_areas_.push_back(area);
+}
+
 void IrRenderer::occlude(const Rect& rect, double level_dn, const cv::Mat& noise,
                          cv::Mat& image) const {
   if (rect.empty()) return;
-  cv::Rect area(rect.x0, rect.y0, rect.x1 - rect.x0 + 1, rect.y1 - rect.y0 + 1);
+  const cv::Rect area = area_of(rect);
   double level = level_dn < 0 ? scene_.render.background_dn : level_dn;
   if (noise.empty()) {
     image(area).setTo(level);
@@ -293,7 +324,7 @@ void IrRenderer::add_coverage(const DiscView& view, const Rect& patch_rect, doub
 }
 
 void IrRenderer::draw_marker(const std::vector<Eigen::Isometry3d>& poses,
-                             const Eigen::Vector3d& marker, cv::Mat& image) {
+                             const Eigen::Vector3d& marker) {
   std::vector<DiscView> views;
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
   for (const Eigen::Isometry3d& pose : poses) {
@@ -310,8 +341,7 @@ void IrRenderer::draw_marker(const std::vector<Eigen::Isometry3d>& poses,
   double margin = sigma > 0 ? std::ceil(3 * sigma) + 1 : 0;
   Rect patch_rect = clip(x0 - margin, y0 - margin, x1 + margin, y1 + margin);
   if (patch_rect.empty()) return;
-  cv::Rect area(patch_rect.x0, patch_rect.y0, patch_rect.x1 - patch_rect.x0 + 1,
-                patch_rect.y1 - patch_rect.y0 + 1);
+  const cv::Rect area = area_of(patch_rect);
   patch_.create(area.height, area.width, CV_32F);
   patch_.setTo(0);
   // A pose in which the marker is hidden still takes its share of the exposure.
@@ -321,7 +351,8 @@ void IrRenderer::draw_marker(const std::vector<Eigen::Isometry3d>& poses,
     // The patch's margin holds the blurred light; beyond it there is none.
     cv::GaussianBlur(patch_, patch_, cv::Size(0, 0), sigma, sigma, cv::BORDER_CONSTANT);
   }
-  cv::Mat target = image(area);
+  begin_drawing(area);
+  cv::Mat target = work_(area);
   cv::scaleAdd(patch_, peak_dn_, target, target);
 }
 
@@ -441,6 +472,7 @@ ObjectTruth IrRenderer::object_truth(const SceneObject& object, double time_s) c
 void IrRenderer::add_hot_points(std::mt19937_64& random) {
   const HotPoints& hot = scene_.distractors.hot_points;
   auto add_hot_point = [&](int u, int v) {
+    begin_drawing({u, v, 1, 1});
     work_.at<float>(v, u) += static_cast<float>(hot.brightness_dn);
   };
   if (hot.fixed) {
@@ -459,12 +491,8 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
                                  const Eigen::Isometry3d& camera_from_world) {
   camera_from_world_ = camera_from_world;
   std::mt19937_64 random(splitmix64(scene_.seed ^ splitmix64(frame_number)));
-  cv::Mat noise = noise_.frame(random);
-  if (noise.empty()) {
-    static_layer_.copyTo(work_);
-  } else {
-    cv::add(static_layer_, noise, work_);
-  }
+  const int pattern = static_cast<int>(frame_number % static_cast<uint64_t>(noise_.patterns()));
+  noise_pattern_ = noise_.pattern(pattern);
 
   RenderedFrame frame;
   frame.time_s = time_s;
@@ -493,16 +521,21 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
         truth.markers[m].visible = false;
         continue;
       }
-      draw_marker(poses, object.markers[m], work_);
+      draw_marker(poses, object.markers[m]);
     }
     Rect occlusion = object_occlusion(object, truth, time_s);
     if (!occlusion.empty()) object_occlusions.push_back(occlusion);
   }
 
   // Occluders are in front of every marker: they cover what was drawn.
-  for (const Rect& rect : object_occlusions) occlude(rect, -1, noise, work_);
+  auto occlude_frame = [&](const Rect& rect, double level_dn) {
+    if (rect.empty()) return;
+    occlude(rect, level_dn, noise_pattern_, work_);
+    mark_drawn(area_of(rect));
+  };
+  for (const Rect& rect : object_occlusions) occlude_frame(rect, -1);
   for (size_t k = 0; k < fixed_occluders_.size(); ++k) {
-    occlude(fixed_occluders_[k], scene_.distractors.occluders[k].level_dn, noise, work_);
+    occlude_frame(fixed_occluders_[k], scene_.distractors.occluders[k].level_dn);
   }
   auto covers = [](const Rect& rect, const Eigen::Vector2d& pixel) {
     return pixel.x() >= rect.x0 - 0.5 && pixel.x() < rect.x1 + 0.5 && pixel.y() >= rect.y0 - 0.5 &&
@@ -519,7 +552,13 @@ RenderedFrame IrRenderer::render(double time_s, uint64_t frame_number,
   }
 
   add_hot_points(random);
-  work_.convertTo(frame.image, CV_8U);  // rounds and saturates to 0..255
+  backgrounds_[static_cast<size_t>(pattern)].copyTo(frame.image);
+  for (const cv::Rect& area : drawn_areas_) {
+    cv::Mat target = frame.image(area);
+    work_(area).convertTo(target, CV_8U);  // rounds and saturates to 0..255, as the background
+    drawn_(area).setTo(0);
+  }
+  drawn_areas_.clear();
   return frame;
 }
 
