@@ -36,6 +36,7 @@ TEST(CdrFormat, NestedStructsListsAndArrays) {
   pose.covariance()[0] = 0.25;
   pose.reprojection_rms_px(0.5f);
   pose.points_used(12);
+  pose.cameras_used(3);
   array.poses().push_back(pose);
   std::string text =
       format_cdr(schema_of<mocap_msgs::msg::ConstellationPoseArray>(),
@@ -76,6 +77,7 @@ poses:
         y: 0
         z: 0
     velocity_covariance: [0, 0, 0, 0, ...] # 36 items
+    cameras_used: 3
 )");
 }
 

@@ -56,11 +56,25 @@ Figures read_figures(const std::filesystem::path& summary) {
 TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
   test::TempDir dir;
   const auto summary = dir / "summary.yaml";
+  // What any DDS subscriber reads: each pose says how many cameras it rests on.
+  test::ChildProcess echo(
+      {(test::bin_dir() / "mocap_topic").string(), "echo", "/mocap/poses", "--count", "30"},
+      environment(76), dir / "echo.log");
   auto [code, output] = test::run_command(
       {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "20", "--set",
        "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
       environment(76), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
+  ASSERT_EQ(echo.wait(std::chrono::seconds(30)), 0) << echo.output();
+  const std::string echoed = echo.output();
+  const std::regex cameras_used(R"(cameras_used: (\d+))");
+  int fused = 0, poses = 0;
+  for (std::sregex_iterator it(echoed.begin(), echoed.end(), cameras_used), end; it != end; ++it) {
+    ++poses;
+    if (std::stoi((*it)[1]) >= 2) ++fused;
+  }
+  EXPECT_GE(poses, 30) << echoed;
+  EXPECT_GE(fused, poses * 9 / 10) << echoed;
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
   EXPECT_GT(figures.node["frames"].as<int>(), 450) << output;  // 30 Hz, less the start

@@ -124,6 +124,7 @@ class PoseEstimatorComponent final : public Component {
     }
     out.reprojection_rms_px(static_cast<float>(pose.reprojection_rms_px));
     out.points_used(static_cast<uint32_t>(pose.points_used));
+    out.cameras_used(1);
     return out;
   }
 

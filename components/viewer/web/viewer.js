@@ -696,9 +696,10 @@ function renderPoses() {
     return `<tr><td>${pose.name}</td><td>${p.x.toFixed(3)}</td><td>${p.y.toFixed(3)}</td>
       <td>${p.z.toFixed(3)}</td><td>${roll}</td><td>${pitch}</td><td>${yaw}</td>
       <td>${speed}</td><td>${turn}</td>
-      <td>${pose.points_used}</td><td>${pose.reprojection_rms_px.toFixed(2)}</td></tr>`;
+      <td>${pose.points_used}</td><td>${pose.reprojection_rms_px.toFixed(2)}</td>
+      <td>${pose.cameras_used || ""}</td></tr>`;
   });
-  const html = rows.join("") || `<tr><td colspan="11" class="note">no constellation identified</td></tr>`;
+  const html = rows.join("") || `<tr><td colspan="12" class="note">no constellation identified</td></tr>`;
   $("poses").tBodies[0].innerHTML = html;
   state.poseReadout = $("poses").tBodies[0].textContent;
 }

@@ -144,7 +144,8 @@ class VolumeFusion final : public Component {
     spec.publishes<ConstellationPoseArray>(
         topics::kPoses, Qos::reliable(),
         "each body posed in a frame: frame 'world', stamped with the capture time; "
-        "points_used counts pixels over every camera");
+        "points_used counts pixels over every camera, cameras_used the cameras (1: a "
+        "single camera's pose)");
     spec.publishes<Alert>(topics::kAlerts, Qos::reliable(),
                           "cameras silent, back or drifted; bodies seen by one camera only");
     spec.publishes<TFMessage>(
@@ -253,6 +254,7 @@ class VolumeFusion final : public Component {
         pose.covariance()[static_cast<size_t>(i)] = body.covariance(i / 6, i % 6);
       pose.reprojection_rms_px(static_cast<float>(body.reprojection_rms_px));
       pose.points_used(static_cast<uint32_t>(body.points_used));
+      pose.cameras_used(static_cast<uint32_t>(body.cameras_used));
       if (body.velocity_known) {
         for (int i = 0; i < 36; ++i) {
           pose.velocity_covariance()[static_cast<size_t>(i)] =
