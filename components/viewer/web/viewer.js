@@ -237,7 +237,16 @@ function volumeHandler(topic) {
     };
   }
   if (match[2] === "fiducials") {
-    return (message) => remember(c.fiducials, stampKey(message.header), message.fiducials);
+    return (message) => {
+      const key = stampKey(message.header);
+      remember(c.fiducials, key, message.fiducials);
+      // A camera publishes its image before it has found the fiducials in it: those of the
+      // image on show may come after it was drawn.
+      if (key === c.frameStamp) {
+        c.dirty = true;
+        dirty.volume = true;
+      }
+    };
   }
   return (info) => {
     c.info = info;
