@@ -105,8 +105,8 @@ struct ChunkHeader {
   uint32_t offset;
   int64_t stamp_ns;
 };
-constexpr int kRawPort = 7399;  // below every DDS domain's ports
-constexpr size_t kImageBytes = 1280 * 720;
+constexpr int kRawPort = 7399;                                    // below every DDS domain's ports
+const size_t kImageBytes = size_t{kImage.width} * kImage.height;  // mono8
 
 int udp_socket(int buffer_bytes) {
   const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);

@@ -9,9 +9,9 @@
 #   follower demo's pointing bounds, the browser's frame drawn with its fiducials, the
 #   independent client's poses with their truth and the ROS 2 outputs decoded (the pipeline
 #   keeping up with the camera's 30 Hz; under AddressSanitizer beside other tests the followed
-#   board was lost and no output came in 60 s, twice), the calibration recorder's Ctrl-C in the third LED cycle (under load a camera
-#   missed a whole cycle in 1 of 8 runs), and the tracking volume's demo (four cameras
-#   rendering and detecting 1280x720 frames at 30 Hz).
+#   board was lost and no output came in 60 s, twice), the calibration recorder's Ctrl-C in the
+#   third LED cycle (under load a camera missed a whole cycle in 1 of 8 runs), and the tracking
+#   volume's demo (four cameras rendering and detecting 1280x720 frames at 30 Hz).
 #   They run one at a time (realtime_tests): beside the busy-core loads below the follower
 #   demo's turret fell to 7 Hz.
 # - The two slow-subscriber loads per DDS implementation: paced by the slow subscriber, about
