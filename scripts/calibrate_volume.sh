@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # The volume demo's cameras calibrated from data, in one command: records the board carried
 # through the volume (launch_yaml/volume_calibration.yaml, config/volume/calibration_wave.yaml)
-# and then lying on the floor (config/volume/calibration_floor.yaml), each into a bag, and
-# solves them with mocap_volume_calibrate, which writes the four camera files with their
-# calibrated poses into OUTPUT/cameras.
+# and then lying on the floor at each mark (config/volume/calibration_floor.yaml, moved there),
+# each into a bag, and solves them with mocap_volume_calibrate, which writes the four camera
+# files with their calibrated poses into OUTPUT/cameras.
 #
-#   scripts/calibrate_volume.sh OUTPUT [--wave SECONDS] [--floor SECONDS]
+#   scripts/calibrate_volume.sh OUTPUT [--wave SECONDS] [--floor SECONDS] [--marks "X,Y ..."]
 #
-# Defaults: 30 s of waving, 10 s on the floor. The demo on the calibrated cameras:
+# Defaults: 30 s of waving; 3 s on the floor at each of the marks "0,0 1,0 0,1 -1,0 0,-1"
+# (metres; "0,0" alone: the one board's axes are the room's). The demo on the calibrated cameras:
 #   build/bin/mocap_launch launch_yaml/volume_demo.yaml --set \
 #     "fusion.cameras=[OUTPUT/cameras/cam_0.yaml, ..., OUTPUT/cameras/cam_3.yaml]"
 set -euo pipefail
@@ -20,26 +21,36 @@ usage() {
 [ $# -ge 1 ] || usage
 out="$1"
 shift
-wave_s=30 floor_s=10
+wave_s=30 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1"
 while [ $# -gt 0 ]; do
   case "$1" in
     --wave) wave_s="${2:?}"; shift 2 ;;
     --floor) floor_s="${2:?}"; shift 2 ;;
+    --marks) marks="${2:?}"; shift 2 ;;
     *) echo "calibrate_volume.sh: unknown option $1" >&2; usage ;;
   esac
 done
 launch="$root/launch_yaml/volume_calibration.yaml"
 mkdir -p "$out"
-rm -rf "$out/waved" "$out/floor"
+rm -rf "$out"/waved "$out"/floor*
 echo "calibrate_volume: recording ${wave_s} s of the board carried through the volume"
 "$bin_dir/mocap_launch" "$launch" --duration "$wave_s" --set "recorder.output=$out/waved" \
   > "$out/waved.log" 2>&1 || { tail -n 20 "$out/waved.log"; exit 1; }
-echo "calibrate_volume: recording ${floor_s} s of the board on the floor"
-on_floor=()
-for c in 0 1 2 3; do
-  on_floor+=(--set "cam_$c.scene=$root/config/volume/calibration_floor.yaml")
+floor_scene="$root/config/volume/calibration_floor.yaml"
+floors=()
+for mark in $marks; do
+  x="${mark%,*}" y="${mark#*,}"
+  name="floor_${x}_${y}"
+  # The shipped floor scene, the board's centre moved onto the mark.
+  sed "s/position: \[0, 0, 0\]/position: [$x, $y, 0]/" "$floor_scene" > "$out/$name.yaml"
+  grep -q "position: \[$x, $y, 0\]" "$out/$name.yaml" ||
+    { echo "calibrate_volume: $floor_scene has no board at [0, 0, 0] to move" >&2; exit 1; }
+  echo "calibrate_volume: recording ${floor_s} s of the board on the floor at ($x, $y)"
+  on_floor=()
+  for c in 0 1 2 3; do on_floor+=(--set "cam_$c.scene=$out/$name.yaml"); done
+  "$bin_dir/mocap_launch" "$launch" --duration "$floor_s" --set "recorder.output=$out/$name" \
+    "${on_floor[@]}" > "$out/$name.log" 2>&1 || { tail -n 20 "$out/$name.log"; exit 1; }
+  floors+=(--floor "$out/$name:$x,$y")
 done
-"$bin_dir/mocap_launch" "$launch" --duration "$floor_s" --set "recorder.output=$out/floor" \
-  "${on_floor[@]}" > "$out/floor.log" 2>&1 || { tail -n 20 "$out/floor.log"; exit 1; }
-exec "$bin_dir/mocap_volume_calibrate" --waved "$out/waved" --floor "$out/floor" \
+exec "$bin_dir/mocap_volume_calibrate" --waved "$out/waved" "${floors[@]}" \
   --output "$out/cameras" "$root"/config/volume/cameras/cam_{0,1,2,3}.yaml

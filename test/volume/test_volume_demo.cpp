@@ -225,24 +225,35 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
 }
 
 // Calibrated from data (scripts/calibrate_volume.sh): the board carried through the volume for
-// 20 s and laid on the floor for 6 s, recorded into bags and solved; every camera within 2 mm
-// and 0.05 degrees of where the simulator put it. The demo then runs on the files it wrote.
+// 20 s and laid on the floor at five marks for 3 s each, recorded into bags and solved; every
+// camera within 0.5 mm and 0.01 degrees of where the simulator put it (0.12-0.19 mm, 0.003
+// degrees measured; the issue's bound is 2 mm and 0.05 degrees), each board's centre within
+// 0.3 mm of its mark. The demo then runs on the files it wrote: poses within 0.15 mm (median;
+// 0.05-0.07 mm measured, 0.03 mm on the true cameras, 0.11-0.14 mm with the board laid once).
 TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   test::TempDir dir;
   auto [code, output] =
       test::run_command({(test::source_dir() / "scripts" / "calibrate_volume.sh").string(),
-                         dir.path().string(), "--wave", "20", "--floor", "6"},
-                        environment(74), std::chrono::seconds(120));
+                         dir.path().string(), "--wave", "20", "--floor", "3"},
+                        environment(74), std::chrono::seconds(150));
   ASSERT_EQ(code, 0) << output;
   std::printf("%s", output.c_str());
   const std::regex line(R"((cam_\d): at .* m; ([0-9.]+) mm and ([0-9.]+) deg from the input)");
   int cameras = 0;
   for (std::sregex_iterator it(output.begin(), output.end(), line), end; it != end; ++it) {
     ++cameras;
-    EXPECT_LT(std::stod((*it)[2]), 2.0) << (*it)[0];
-    EXPECT_LT(std::stod((*it)[3]), 0.05) << (*it)[0];
+    EXPECT_LT(std::stod((*it)[2]), 0.5) << (*it)[0];
+    EXPECT_LT(std::stod((*it)[3]), 0.01) << (*it)[0];
   }
   EXPECT_EQ(cameras, 4) << output;
+  const std::regex mark(R"(floor at \(.*\): the board seen by (\d) cameras.*; ([0-9.]+) mm from)");
+  int marks = 0;
+  for (std::sregex_iterator it(output.begin(), output.end(), mark), end; it != end; ++it) {
+    ++marks;
+    EXPECT_GE(std::stoi((*it)[1]), 2) << (*it)[0];
+    EXPECT_LT(std::stod((*it)[2]), 0.3) << (*it)[0];
+  }
+  EXPECT_EQ(marks, 5) << output;
 
   std::string files = "[";
   for (int c = 0; c < 4; ++c) {
@@ -259,7 +270,7 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   const Figures figures = read_figures(summary);
   std::printf("on the calibrated cameras:\n%s", test::read_file(summary).c_str());
   EXPECT_GE(figures.tracked_share(), 0.9) << test::read_file(summary);
-  EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 2e-3);
+  EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 0.15e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
 }
 

@@ -1,10 +1,11 @@
 // mocap_volume_calibrate: a volume's cameras calibrated from two recorded sessions
 // (volume_calibration.hpp): the board waved through the volume, then laid on the floor where
-// the world's origin is to be. Each bag holds the cameras' /volume/<camera>/constellations
-// (launch_yaml/volume_calibration.yaml records them); the camera files give the intrinsics and
-// the names. Writes each camera file again, with its calibrated `pose`, into the output folder.
+// the world's origin is to be, or at three or more measured marks, a bag each. Each bag holds
+// the cameras' /volume/<camera>/constellations (launch_yaml/volume_calibration.yaml records
+// them); the camera files give the intrinsics and the names. Writes each camera file again,
+// with its calibrated `pose`, into the output folder.
 //
-//   mocap_volume_calibrate --waved BAG --floor BAG --output DIR [--board NAME]
+//   mocap_volume_calibrate --waved BAG --floor BAG[:X,Y]... --output DIR [--board NAME]
 //                          [--database FILE] CAMERA_FILE...
 //
 // Exit status: 0 calibrated, 1 the sessions cannot calibrate the volume, 2 bad arguments or
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,14 +35,22 @@ namespace {
 using mocap::volume::BoardSighting;
 
 constexpr const char* kUsage =
-    "usage: mocap_volume_calibrate --waved BAG --floor BAG --output DIR [--board NAME]\n"
-    "                              [--database FILE] CAMERA_FILE...\n"
+    "usage: mocap_volume_calibrate --waved BAG --floor BAG[:X,Y]... --output DIR\n"
+    "                              [--board NAME] [--database FILE] CAMERA_FILE...\n"
     "  BAG: a recording of /volume/<camera>/constellations (launch_yaml/volume_calibration.yaml)\n"
+    "  --floor: the board lying on the floor, its centre at the mark X,Y (metres, default 0,0);\n"
+    "           once (its axes are the room's), or at three marks or more not in a line\n"
     "  --board: the board waved and laid on the floor (default board_a), in --database\n"
     "           (default the shipped config/constellations.yaml)\n";
 
+struct FloorBag {
+  std::string path;
+  Eigen::Vector2d mark = Eigen::Vector2d::Zero();
+};
+
 struct Arguments {
-  std::string waved, floor, output, board = "board_a";
+  std::string waved, output, board = "board_a";
+  std::vector<FloorBag> floor;
   std::string database = mocap::config_file("constellations.yaml");
   std::vector<std::string> cameras;
 };
@@ -106,6 +116,27 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
   return sightings;
 }
 
+// BAG or BAG:X,Y. A path whose last ':' is not followed by a mark is all path.
+std::optional<FloorBag> floor_bag(const std::string& argument) {
+  const size_t colon = argument.rfind(':');
+  if (colon == std::string::npos) return FloorBag{argument};
+  const std::string mark = argument.substr(colon + 1);
+  const size_t comma = mark.find(',');
+  if (comma == std::string::npos) return FloorBag{argument};
+  try {
+    size_t x_end = 0, y_end = 0;
+    const double x = std::stod(mark.substr(0, comma), &x_end);
+    const double y = std::stod(mark.substr(comma + 1), &y_end);
+    if (x_end != comma || y_end != mark.size() - comma - 1 || !std::isfinite(x) ||
+        !std::isfinite(y)) {
+      return std::nullopt;
+    }
+    return FloorBag{argument.substr(0, colon), Eigen::Vector2d(x, y)};
+  } catch (const std::logic_error&) {  // std::stod's invalid_argument, out_of_range
+    return std::nullopt;
+  }
+}
+
 int run(const Arguments& arguments) {
   std::vector<mocap::calibration::CameraFile> files;
   std::vector<mocap::volume::CalibrationCamera> cameras;
@@ -122,7 +153,10 @@ int run(const Arguments& arguments) {
     return 2;
   }
   const auto waved = read_sightings(arguments.waved, names, *board);
-  const auto floor = read_sightings(arguments.floor, names, *board);
+  std::vector<mocap::volume::FloorPlacement> floor;
+  for (const FloorBag& bag : arguments.floor) {
+    floor.push_back({bag.mark, read_sightings(bag.path, names, *board)});
+  }
 
   mocap::volume::VolumeCalibration result;
   try {
@@ -135,8 +169,13 @@ int run(const Arguments& arguments) {
       "waved: {} capture times with the board whole in two cameras or more; RMS "
       "reprojection error {:.3f} px over {} points ({} iterations)\n",
       result.frames_used, result.report.rms_px, result.report.points, result.report.iterations);
-  fmt::print("floor: the board seen by {} cameras, RMS {:.3f} px\n", result.floor_cameras,
-             result.floor_rms_px);
+  for (size_t p = 0; p < floor.size(); ++p) {
+    const auto& placement = result.floor[p];
+    fmt::print("floor at ({}, {}): the board seen by {} cameras, RMS {:.3f} px", floor[p].mark.x(),
+               floor[p].mark.y(), placement.cameras, placement.rms_px);
+    if (floor.size() > 1) fmt::print("; {:.3f} mm from its mark", placement.off_mark_m * 1e3);
+    fmt::print("\n");
+  }
   std::filesystem::create_directories(arguments.output);
   for (size_t c = 0; c < files.size(); ++c) {
     const Eigen::Isometry3d world_from_camera = result.camera_from_world[c].inverse();
@@ -176,7 +215,12 @@ int main(int argc, char** argv) {
     if (argument == "--waved") {
       arguments.waved = value();
     } else if (argument == "--floor") {
-      arguments.floor = value();
+      std::optional<FloorBag> bag = floor_bag(value());
+      if (!bag) {
+        fmt::print(stderr, "--floor {}: the mark after ':' is not X,Y in metres\n", argv[i]);
+        return 2;
+      }
+      arguments.floor.push_back(*bag);
     } else if (argument == "--output") {
       arguments.output = value();
     } else if (argument == "--board") {

@@ -144,15 +144,56 @@ calibration::CalibrationConfig problem_of(const std::vector<CalibrationCamera>& 
   return config;
 }
 
+// The board lying on the floor, fitted over every camera that saw it whole: its pose in the
+// reference camera's frame.
+Eigen::Isometry3d board_on_floor(const std::vector<CalibrationCamera>& cameras,
+                                 const std::vector<Eigen::Isometry3d>& camera_from_reference,
+                                 const std::vector<Eigen::Vector3d>& board,
+                                 const FloorPlacement& placement,
+                                 VolumeCalibration::Placement& fitted) {
+  const std::string where =
+      fmt::format("the board on the floor at ({}, {})", placement.mark.x(), placement.mark.y());
+  std::vector<CameraView> views;
+  std::optional<Eigen::Isometry3d> start;
+  std::vector<bool> saw(cameras.size(), false);
+  for (const BoardSighting& sighting : placement.sightings) {
+    std::optional<std::vector<Eigen::Vector2d>> pixels = whole(sighting, board.size());
+    if (!pixels || sighting.camera >= cameras.size()) continue;
+    const calibration::CameraModel& model = *cameras[sighting.camera].model;
+    const Eigen::Isometry3d& extrinsics = camera_from_reference[sighting.camera];
+    if (!start) {
+      const pose::PlanarPose pose = pose::estimate_planar_pose(model, board, *pixels);
+      if (pose.valid) start = extrinsics.inverse() * pose.camera_from_object;
+    }
+    views.push_back({&model, extrinsics, board, std::move(*pixels)});
+    saw[sighting.camera] = true;
+  }
+  if (!start) throw VolumeCalibrationError("no camera saw " + where + " whole");
+  MultiCameraPoseOptions fit;
+  fit.max_reprojection_rms_px = 1e9;  // reported, not judged: the views are the user's
+  const MultiCameraPose pose = estimate_multi_camera_pose(views, *start, fit);
+  if (!pose.valid) throw VolumeCalibrationError(where + ": " + pose.rejection);
+  fitted.cameras = static_cast<size_t>(std::count(saw.begin(), saw.end(), true));
+  fitted.rms_px = pose.reprojection_rms_px;
+  return pose.world_from_body;
+}
+
 }  // namespace
 
 VolumeCalibration calibrate_volume(const std::vector<CalibrationCamera>& cameras,
                                    const std::vector<Eigen::Vector3d>& board,
                                    const std::vector<BoardSighting>& waved,
-                                   const std::vector<BoardSighting>& on_floor,
+                                   const std::vector<FloorPlacement>& on_floor,
                                    const VolumeCalibrationOptions& options) {
   if (cameras.empty()) throw VolumeCalibrationError("no cameras");
   if (board.size() < 4) throw VolumeCalibrationError("the board needs 4 markers or more");
+  if (on_floor.empty()) {
+    throw VolumeCalibrationError("no placement of the board on the floor: it sets the world frame");
+  }
+  if (on_floor.size() == 2) {
+    throw VolumeCalibrationError(
+        "the board on the floor at two marks: lay it at one, or at three or more not in a line");
+  }
   const std::vector<Frame> frames = frames_of(waved, board.size(), options);
   const std::vector<Eigen::Isometry3d> start = starting_poses(cameras, board, frames);
 
@@ -177,34 +218,39 @@ VolumeCalibration calibrate_volume(const std::vector<CalibrationCamera>& cameras
     throw VolumeCalibrationError(e.what());
   }
 
-  // The board on the floor, fitted over every camera that saw it whole, in camera 0's frame.
-  std::vector<CameraView> views;
-  std::optional<Eigen::Isometry3d> floor_start;
-  std::vector<bool> saw(cameras.size(), false);
-  for (const BoardSighting& sighting : on_floor) {
-    std::optional<std::vector<Eigen::Vector2d>> pixels = whole(sighting, board.size());
-    if (!pixels || sighting.camera >= cameras.size()) continue;
-    const calibration::CameraModel& model = *cameras[sighting.camera].model;
-    const Eigen::Isometry3d& extrinsics = camera_from_reference[sighting.camera];
-    if (!floor_start) {
-      const pose::PlanarPose pose = pose::estimate_planar_pose(model, board, *pixels);
-      if (pose.valid) floor_start = extrinsics.inverse() * pose.camera_from_object;
+  std::vector<Eigen::Isometry3d> reference_from_board;
+  for (const FloorPlacement& placement : on_floor) {
+    VolumeCalibration::Placement fitted;
+    reference_from_board.push_back(
+        board_on_floor(cameras, camera_from_reference, board, placement, fitted));
+    result.floor.push_back(fitted);
+  }
+  Eigen::Isometry3d reference_from_world;
+  if (on_floor.size() == 1) {
+    reference_from_world =
+        calibration::reference_from_world_of_board(reference_from_board[0], on_floor[0].mark);
+  } else {
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<Eigen::Vector2d> marks;
+    for (size_t p = 0; p < on_floor.size(); ++p) {
+      centres.push_back(reference_from_board[p].translation());
+      marks.push_back(on_floor[p].mark);
     }
-    views.push_back({&model, extrinsics, board, std::move(*pixels)});
-    saw[sighting.camera] = true;
+    const std::optional<Eigen::Isometry3d> fitted =
+        calibration::reference_from_world_of_marks(centres, marks);
+    if (!fitted) {
+      throw VolumeCalibrationError(
+          "the floor's marks lie in a line, or set the cameras under the floor (x and y "
+          "swapped?): give three or more marks that span the floor");
+    }
+    reference_from_world = *fitted;
+    for (size_t p = 0; p < on_floor.size(); ++p) {
+      const Eigen::Vector3d centre = reference_from_world.inverse() * centres[p];
+      result.floor[p].off_mark_m = (centre - Eigen::Vector3d(marks[p].x(), marks[p].y(), 0)).norm();
+    }
   }
-  if (!floor_start) {
-    throw VolumeCalibrationError(
-        "no camera saw the whole board on the floor: it sets the world frame");
-  }
-  MultiCameraPoseOptions fit;
-  fit.max_reprojection_rms_px = 1e9;  // reported, not judged: the views are the user's
-  const MultiCameraPose floor = estimate_multi_camera_pose(views, *floor_start, fit);
-  if (!floor.valid) throw VolumeCalibrationError("the floor board's pose: " + floor.rejection);
-  result.floor_cameras = static_cast<size_t>(std::count(saw.begin(), saw.end(), true));
-  result.floor_rms_px = floor.reprojection_rms_px;
   result.camera_from_world =
-      calibration::cameras_in_floor_frame(camera_from_reference, floor.world_from_body);
+      calibration::cameras_in_world(camera_from_reference, reference_from_world);
   return result;
 }
 

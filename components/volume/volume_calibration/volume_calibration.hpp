@@ -1,11 +1,11 @@
 // A volume's cameras calibrated from data: a board waved through the volume gives the cameras'
 // poses relative to one of them (CalibrationProblem, the rig solver of mocap_calibrate: every
 // shot's board pose and every camera's transform fitted to the pixels at once), and the same
-// board laid on the floor then sets the world frame (floor_frame.hpp). The cameras' intrinsics
-// are taken as known (their camera files); the extrinsics are what a volume loses when it is
-// set up or bumped.
+// board laid on the floor, at one mark or several, then sets the world frame (floor_frame.hpp).
+// The cameras' intrinsics are taken as known (their camera files); the extrinsics are what a
+// volume loses when it is set up or bumped.
 //
-//   VolumeCalibration result = calibrate_volume(cameras, board_markers, waved, on_floor);
+//   VolumeCalibration result = calibrate_volume(cameras, board_markers, waved, {{mark, seen}});
 //   for (c ...) save world_from_camera = result.camera_from_world[c].inverse();
 #pragma once
 
@@ -31,6 +31,13 @@ struct BoardSighting {
   std::vector<std::optional<Eigen::Vector2d>> pixels;
 };
 
+// The board lying still on the floor at a mark: every camera's sightings of it.
+struct FloorPlacement {
+  // World x, y of the board's origin (the shipped boards' centre), metres.
+  Eigen::Vector2d mark = Eigen::Vector2d::Zero();
+  std::vector<BoardSighting> sightings;
+};
+
 struct CalibrationCamera {
   std::string name;
   std::shared_ptr<const calibration::CameraModel> model;  // the intrinsics, held constant
@@ -50,24 +57,34 @@ struct VolumeCalibration {
   calibration::CalibrationReport report;
   // Per camera, in the input's order: its pose in the floor's frame (the world).
   std::vector<Eigen::Isometry3d> camera_from_world;
-  size_t frames_used = 0;    // capture times of the waved session in the solve
-  size_t floor_cameras = 0;  // cameras that saw the board on the floor
-  double floor_rms_px = 0;   // the floor board's reprojection error over them
+  size_t frames_used = 0;  // capture times of the waved session in the solve
+  // Per placement on the floor: the cameras that saw the board whole, its reprojection error
+  // over them, and (three marks or more) how far its centre lies from its mark in the world the
+  // marks set, metres: a board laid off its mark, or a mark measured wrong.
+  struct Placement {
+    size_t cameras = 0;
+    double rms_px = 0;
+    double off_mark_m = 0;
+  };
+  std::vector<Placement> floor;
 };
 
 // Why a volume cannot be calibrated from the sightings: a camera no shot ties to the others,
-// no camera that saw the board on the floor, a solve that did not converge.
+// a placement on the floor no camera saw, two marks or marks in a line, a solve that did not
+// converge.
 class VolumeCalibrationError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
 // `board`: the board's markers in its frame (metres, planar), indexing the sightings' pixels;
-// camera 0 is the reference of the solve. Throws VolumeCalibrationError.
+// camera 0 is the reference of the solve. `on_floor`: one placement, whose board's axes are the
+// room's, or three or more at marks not in a line, whose centres alone set the frame.
+// Throws VolumeCalibrationError.
 VolumeCalibration calibrate_volume(const std::vector<CalibrationCamera>& cameras,
                                    const std::vector<Eigen::Vector3d>& board,
                                    const std::vector<BoardSighting>& waved,
-                                   const std::vector<BoardSighting>& on_floor,
+                                   const std::vector<FloorPlacement>& on_floor,
                                    const VolumeCalibrationOptions& options = {});
 
 }  // namespace mocap::volume
