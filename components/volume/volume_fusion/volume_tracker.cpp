@@ -23,6 +23,10 @@ constexpr double kRetryRadiusFactor = 3;
 // A point this many times the fusion's RMS limit off the pose is left out, and the pose fitted
 // again without it.
 constexpr double kOutlierFactor = 2;
+// In a pose that holds, a point further off than this many times the points' median error,
+// and than kStrayFloorPx, is a stray: left out, and the pose fitted again.
+constexpr double kStrayFactor = 5;
+constexpr double kStrayFloorPx = 0.3;
 // A track's velocity is measured over its poses of this long (seconds).
 constexpr double kVelocityWindow_s = 0.05;
 
@@ -259,6 +263,7 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     }
   }
   if (!fused.valid) return std::nullopt;
+  trim_strays(views, fused);
 
   // Each camera's residual where two other cameras or more hold the pose: a camera in the
   // fusion by its own points, one left out by its detections nearest to where the pose puts
@@ -282,6 +287,34 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   Fused result{fused, std::vector<std::vector<Eigen::Vector2d>>(views.size())};
   for (size_t c = 0; c < views.size(); ++c) result.used[c] = views[c].pixels;
   return result;
+}
+
+void VolumeTracker::trim_strays(std::vector<CameraView>& views, MultiCameraPose& fused) const {
+  std::vector<std::vector<double>> errors;
+  std::vector<double> all;
+  for (const CameraView& view : views) {
+    errors.push_back(point_errors_px(view, fused.world_from_body));
+    all.insert(all.end(), errors.back().begin(), errors.back().end());
+  }
+  if (all.empty()) return;
+  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+  const double limit = std::max(kStrayFloorPx, kStrayFactor * all[all.size() / 2]);
+  std::vector<CameraView> kept;
+  for (size_t c = 0; c < views.size(); ++c) {
+    CameraView close{views[c].camera, views[c].camera_from_world, {}, {}};
+    for (size_t i = 0; i < errors[c].size(); ++i) {
+      if (errors[c][i] > limit) continue;
+      close.body_points.push_back(views[c].body_points[i]);
+      close.pixels.push_back(views[c].pixels[i]);
+    }
+    kept.push_back(std::move(close));
+  }
+  const int points = points_in(kept);
+  if (points == points_in(views) || points < options_.fusion.min_points) return;
+  MultiCameraPose again = estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
+  if (!again.valid) return;
+  views = std::move(kept);
+  fused = std::move(again);
 }
 
 void VolumeTracker::take(const std::vector<std::vector<Eigen::Vector2d>>& used,

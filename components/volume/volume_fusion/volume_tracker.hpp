@@ -119,6 +119,11 @@ class VolumeTracker {
   // puts its markers, with a disagreeing camera left out when the others agree without it.
   std::optional<Fused> fuse(size_t body, const Eigen::Isometry3d& start,
                             const std::vector<CameraDetections>& detections, double radius_px);
+  // A marker merged with a neighbour's, half hidden by another board, or another body's taken
+  // for one of this body's moves its pixel by a pixel or more where the rest agree within a
+  // tenth: a few such points stay under the RMS limit yet tilt the pose. The points far above
+  // the fit's typical error are left out of `views` and `fused` fitted again without them.
+  void trim_strays(std::vector<CameraView>& views, MultiCameraPose& fused) const;
   // Removes the detections `used` from `detections`: one detection belongs to one body.
   static void take(const std::vector<std::vector<Eigen::Vector2d>>& used,
                    std::vector<CameraDetections>& detections);

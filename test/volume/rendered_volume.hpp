@@ -1,0 +1,138 @@
+// The volume demo (config/volume/) without processes: its scene rendered through each of its
+// cameras by the simulator's renderer and detected by the fiducial detector, frame by frame,
+// as its camera processes do; each body's fused pose (VolumeTracker: identified by its
+// markers' distances, tracked) beside each camera's own pose of it (planar PnP on that
+// camera's detections of the body's markers, matched to them through the renderer's truth:
+// the best a single camera could do, with no identification to get wrong), both against the
+// truth. What the volume accuracy test and bench measure.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <mocap/calibration/camera_file.hpp>
+
+#include "constellation_database.hpp"
+#include "fiducial_detector.hpp"
+#include "ir_renderer.hpp"
+#include "planar_pose.hpp"
+#include "rigid_body_database.hpp"
+#include "scene.hpp"
+#include "volume_tracker.hpp"
+
+namespace mocap::volume::test {
+
+struct PoseError {
+  double position_m = std::numeric_limits<double>::quiet_NaN();
+  double rotation_deg = std::numeric_limits<double>::quiet_NaN();
+  bool posed() const { return std::isfinite(position_m); }
+};
+
+inline PoseError pose_error(const Eigen::Isometry3d& found, const Eigen::Isometry3d& truth) {
+  return {(found.translation() - truth.translation()).norm(),
+          Eigen::AngleAxisd(found.linear() * truth.linear().transpose()).angle() * 180 / M_PI};
+}
+
+// One body in one frame.
+struct BodyFrame {
+  std::string body;
+  int frame = 0;
+  PoseError fused;
+  int cameras_used = 0;              // of the fused pose
+  std::vector<PoseError> by_camera;  // each camera's own pose; not posed where it had none
+};
+
+struct RenderedVolume {
+  std::vector<std::string> cameras;
+  std::vector<BodyFrame> body_frames;  // every body in every frame
+};
+
+// `frames` frames at `rate_hz` from scene time 0, with the demo's files under `config_dir`
+// and the volume_fusion component's settings (min_markers 5).
+inline RenderedVolume render_volume(const std::string& config_dir, int frames,
+                                    double rate_hz = 30) {
+  const std::string volume = config_dir + "/volume/";
+  const auto boards = constellations::load_database(volume + "boards.yaml");
+  const synthetic::Scene scene = synthetic::load_scene(volume + "scene.yaml", boards);
+  VolumeTrackerOptions options;
+  options.identification.min_markers = 5;
+  std::vector<VolumeCamera> cameras;
+  std::vector<std::unique_ptr<synthetic::IrRenderer>> renderers;  // each keeps its buffers
+  RenderedVolume out;
+  for (int c = 0; c < 4; ++c) {
+    const auto file =
+        calibration::load_camera_file(volume + "cameras/cam_" + std::to_string(c) + ".yaml");
+    cameras.push_back({file.name, file.model, file.world_from_camera->inverse(), file.frame_id});
+    renderers.push_back(std::make_unique<synthetic::IrRenderer>(scene, file.model));
+    out.cameras.push_back(file.name);
+  }
+  VolumeTracker tracker(cameras,
+                        load_rigid_bodies(volume + "bodies.yaml", options.identification.tolerance,
+                                          options.identification.min_markers),
+                        options);
+  tracking::FiducialDetector detector;
+  for (int f = 0; f < frames; ++f) {
+    const double time_s = f / rate_hz;
+    const auto stamp_ns = static_cast<int64_t>(std::llround(time_s * 1e9));
+    std::vector<CameraFrame> detections(cameras.size());
+    std::vector<synthetic::RenderedFrame> rendered;
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      rendered.push_back(
+          renderers[c]->render(time_s, static_cast<uint64_t>(f), cameras[c].camera_from_world));
+      detections[c] = {true, stamp_ns, {}};
+      for (const auto& fiducial : detector.detect(rendered.back().image)) {
+        detections[c].pixels.emplace_back(fiducial.x, fiducial.y);
+      }
+    }
+    const std::vector<TrackedBodyPose> fused = tracker.track(stamp_ns, detections);
+    for (size_t b = 0; b < scene.objects.size(); ++b) {
+      BodyFrame body{scene.objects[b].constellation, f, {}, 0, {}};
+      const Eigen::Isometry3d truth =
+          cameras[0].camera_from_world.inverse() * rendered[0].objects[b].pose;
+      for (const TrackedBodyPose& pose : fused) {
+        if (pose.name != body.body) continue;
+        body.fused = pose_error(pose.world_from_body, truth);
+        body.cameras_used = pose.cameras_used;
+      }
+      for (size_t c = 0; c < cameras.size(); ++c) {
+        // Each marker the camera sees, paired with its nearest detection within 1.5 px.
+        std::vector<Eigen::Vector3d> markers;
+        std::vector<Eigen::Vector2d> pixels;
+        const synthetic::ObjectTruth& object = rendered[c].objects[b];
+        for (size_t m = 0; m < object.markers.size(); ++m) {
+          if (!object.markers[m].visible) continue;
+          const Eigen::Vector2d* nearest = nullptr;
+          for (const Eigen::Vector2d& pixel : detections[c].pixels) {
+            if ((pixel - object.markers[m].pixel).norm() < 1.5 &&
+                (!nearest || (pixel - object.markers[m].pixel).norm() <
+                                 (*nearest - object.markers[m].pixel).norm())) {
+              nearest = &pixel;
+            }
+          }
+          if (!nearest) continue;
+          markers.push_back(scene.objects[b].markers[m]);
+          pixels.push_back(*nearest);
+        }
+        PoseError error;
+        if (markers.size() >= 4) {
+          const pose::PlanarPose pose =
+              pose::estimate_planar_pose(*cameras[c].model, markers, pixels);
+          if (pose.valid) {
+            error =
+                pose_error(cameras[c].camera_from_world.inverse() * pose.camera_from_object, truth);
+          }
+        }
+        body.by_camera.push_back(error);
+      }
+      out.body_frames.push_back(std::move(body));
+    }
+  }
+  return out;
+}
+
+}  // namespace mocap::volume::test
