@@ -68,7 +68,7 @@ run() {  # NAME FILE CLIENT_COMMAND...
   table="$(grep -E '\]: \| [0-9]+ \| [0-9]+ \| [0-9.]+ % \|' "$work/run.log" | tail -n 1 | sed 's/^.*\]: //')"
   frames="$(echo "$table" | awk -F'|' '{ gsub(/ /, "", $2); print $2 }')"
   lost="$(echo "$table" | awk -F'|' '{ gsub(/ /, "", $3); print $3 }')"
-  latency="$(echo "$table" | awk -F'|' '{ gsub(/^ +| +$/, "", $8); print $8 }')"
+  latency="$(echo "$table" | awk -F'|' '{ gsub(/^ +| +$/, "", $(NF - 1)); print $(NF - 1) }')"  # the last column
   local cpu rate
   cpu=$(awk -v c="$((c1 - c0))" -v t0="$t0" -v t1="$t1" -v hz="$(getconf CLK_TCK)" \
     'BEGIN { printf "%.0f", 100 * c / hz / (t1 - t0) }')

@@ -579,6 +579,67 @@ TEST(ComponentHostOverDds, AComponentSubscribingInItsCallbacksKeepsReceiving) {
   host.stop();
 }
 
+// Takes 100 of another process's test sequence, lets go of it from the 100th callback, waits
+// 0.3 s, and subscribes again: nothing arrives in between, the stream comes back after.
+class UnsubscribesInItsCallbacks final : public Component {
+ public:
+  static void declare(ComponentSpec& spec) {
+    spec.subscribes_any("the test sequence, let go of and taken again");
+  }
+  explicit UnsubscribesInItsCallbacks(Context& context) : Component(context) {
+    subscribe([this] {
+      if (++first != 100) return;
+      this->context().unsubscribe_any(test::kSequenceTopic);
+      let_go = Clock::now();
+    });
+    create_timer(std::chrono::milliseconds(20), [this] {
+      if (let_go && !again && Clock::now() - *let_go > std::chrono::milliseconds(300)) {
+        first_when_taken_again = first.load();
+        again = true;
+        subscribe([] { ++second; });
+      }
+    });
+  }
+  static inline std::atomic<int> first{0}, second{0}, first_when_taken_again{-1};
+
+ private:
+  void subscribe(std::function<void()> on_message) {
+    context().subscribe_any(test::kSequenceTopic, message_type<Array>(), Qos::reliable(),
+                            [on_message](const std::shared_ptr<const void>&) { on_message(); });
+  }
+  std::optional<Clock::time_point> let_go;
+  bool again = false;
+};
+
+TEST(ComponentHostOverDds, AComponentLetsGoOfATopicAndTakesItAgain) {
+  test::TempDir dir;
+  const std::string domain = std::to_string(test::test_domain(85));
+  setenv("MOCAP_DOMAIN_ID", domain.c_str(), 1);
+  test::write_file(dir / "source.yaml", R"(groups:
+  - name: source
+    components:
+      - plugin: sequence_source
+        name: source
+        parameters: {count: 0, batch: 5, period_s: 0.005, subscribers: 1}
+)");
+  test::ChildProcess source(
+      {(test::bin_dir() / "mocap_launch").string(), (dir / "source.yaml").string()},
+      {{"MOCAP_DOMAIN_ID", domain}, {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}},
+      dir / "source.log");
+  ComponentHost host({.name = "unsubscriber", .threads = 2, .dds = {.enabled = true}});
+  host.add(make_component_factory<UnsubscribesInItsCallbacks>("unsubscribes"),
+           {.name = "unsubscriber"});
+  host.start();
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (UnsubscribesInItsCallbacks::second < 100 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  host.stop();
+  EXPECT_EQ(UnsubscribesInItsCallbacks::first_when_taken_again, 100) << "none after letting go";
+  EXPECT_EQ(UnsubscribesInItsCallbacks::first, 100);
+  EXPECT_GE(UnsubscribesInItsCallbacks::second, 100) << source.output();
+}
+
 // The lifecycle as components see it: what happened, in order.
 struct Lifecycle {
   std::mutex mutex;

@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -182,6 +183,44 @@ TEST_F(FoxgloveBridgeTest, AnIndependentClientDecodesPosesFiducialsAndImages) {
         0.08)
         << "max_image_rate_hz: 10";
   }
+}
+
+// The camera's images reach the bridge only while a client watches them: the bridge's reader
+// appears when a client subscribes and goes when the last one leaves, as another process on
+// the domain sees it (mocap_topic list: the image topic's subscribers), so that a camera on
+// another host stops sending a megabyte a frame to nobody. Asked again, images flow again.
+TEST_F(FoxgloveBridgeTest, ImagesReachTheBridgeOnlyWhileAClientWatchesThem) {
+  const std::string topic = "/camera/ir/image_raw";
+  auto subscribers = [&] {
+    auto [code, output] = test::run_command(
+        {(test::bin_dir() / "mocap_topic").string(), "list", "--wait", "2"}, domain());
+    EXPECT_EQ(code, 0) << output;
+    std::smatch match;
+    const std::regex line(topic + R"( \[.*\] \d+ publisher\(s\), (\d+) subscriber\(s\))");
+    return std::regex_search(output, match, line) ? std::stoi(match[1]) : -1;
+  };
+  // Waits until the count is `expected`, for at most about 20 s.
+  auto wait_for_subscribers = [&](int expected) {
+    int seen = -1;
+    for (int i = 0; i < 8 && (seen = subscribers()) != expected; ++i) {
+    }
+    return seen;
+  };
+  const int unwatched = subscribers();
+  ASSERT_GE(unwatched, 1) << "the tracker subscribes to the images";
+
+  test::ChildProcess watcher(
+      {"node", (viewer_tests() / "foxglove_client.mjs").string(), url(), "150", topic}, {},
+      dir_ / "watcher.log");  // 15 s of images at 10 a second
+  ASSERT_TRUE(watcher.wait_for_output(topic, std::chrono::seconds(30))) << watcher.output();
+  EXPECT_EQ(wait_for_subscribers(unwatched + 1), unwatched + 1) << graph_->output();
+  watcher.signal(SIGTERM);
+  watcher.wait(std::chrono::seconds(10));
+  EXPECT_EQ(wait_for_subscribers(unwatched), unwatched) << graph_->output();
+  EXPECT_TRUE(graph_->wait_for_output("lets go of " + topic, std::chrono::seconds(5)));
+
+  auto messages = receive(3, {topic});
+  EXPECT_EQ(messages[topic].size(), 3u) << "images again once asked again";
 }
 
 // pose_outputs as ROS 2 tools see it: ROS 2 Humble's own definitions (Foxglove's copy)

@@ -145,6 +145,7 @@ class FoxgloveBridge final : public Component {
       throw std::invalid_argument(e.what());  // names the parameter at fault
     }
     create_timer(std::chrono::milliseconds(20), [this] {
+      unsubscribe_unwatched();
       subscribe_first_asked();
       pump_all();
       publish_inbox();
@@ -180,9 +181,10 @@ class FoxgloveBridge final : public Component {
 
  private:
   // A topic the bridge offers; advertised while it has a channel. Images are subscribed to
-  // when a client first asks for them: a volume's cameras would otherwise stream every frame
-  // of every camera to the bridge's host with nobody watching. The rest at once, so that a
-  // latched topic's last message is there for the first client.
+  // when a client first asks for them, and let go of when the last client that asked stops
+  // watching: a volume's cameras would otherwise stream every frame of every camera to the
+  // bridge's host with nobody watching. The rest at once, so that a latched topic's last
+  // message is there for the first client.
   struct TopicState {
     const MessageType* type = nullptr;
     bool latched = false;
@@ -295,6 +297,44 @@ class FoxgloveBridge final : public Component {
     }
   }
 
+  // Images whose last watching client unsubscribed or left (`unwatched_`): let go of, unless a
+  // client asked for them again since.
+  void unsubscribe_unwatched() {
+    std::vector<std::string> names;
+    {
+      std::lock_guard lock(mutex_);
+      for (const std::string& name : unwatched_) {
+        TopicState& topic = topics_.at(name);
+        if (!topic.subscribed || first_asked_.contains(name) || watched(topic.channel_id)) {
+          continue;
+        }
+        topic.subscribed = false;
+        names.push_back(name);
+      }
+      unwatched_.clear();
+    }
+    for (const std::string& name : names) {
+      context().unsubscribe_any(name);
+      log().info("lets go of {}: no client watches it", name);
+    }
+  }
+
+  // Requires mutex_.
+  bool watched(uint32_t channel_id) const {
+    return channel_id != 0 && std::any_of(clients_.begin(), clients_.end(), [&](const auto& c) {
+             return c.second.subscription_of_channel.contains(channel_id);
+           });
+  }
+
+  // Requires mutex_. The images among `channels` that nobody watches now, for the timer.
+  void note_unwatched(const std::vector<uint32_t>& channels) {
+    for (uint32_t id : channels) {
+      auto channel = channels_.find(id);
+      if (channel == channels_.end() || channel->second.type->name() != kImageType) continue;
+      if (!watched(id)) unwatched_.insert(channel->second.channel.topic);
+    }
+  }
+
   void subscribe_first_asked() {
     std::vector<std::pair<std::string, TopicState>> asked;
     {
@@ -335,7 +375,12 @@ class FoxgloveBridge final : public Component {
     auto found = clients_.find(client);
     if (found == clients_.end()) return;
     dropped_ += found->second.queue.dropped();
+    std::vector<uint32_t> channels;
+    for (const auto& [channel, subscription] : found->second.subscription_of_channel) {
+      channels.push_back(channel);
+    }
     clients_.erase(found);
+    note_unwatched(channels);
   }
 
   void refuse(ClientId client, const std::string& reason) {
@@ -377,8 +422,13 @@ class FoxgloveBridge final : public Component {
       if (state == clients_.end()) return;
       std::set<uint32_t> ids(unsubscribe->subscription_ids.begin(),
                              unsubscribe->subscription_ids.end());
-      std::erase_if(state->second.subscription_of_channel,
-                    [&](const auto& entry) { return ids.contains(entry.second); });
+      std::vector<uint32_t> channels;
+      std::erase_if(state->second.subscription_of_channel, [&](const auto& entry) {
+        if (!ids.contains(entry.second)) return false;
+        channels.push_back(entry.first);
+        return true;
+      });
+      note_unwatched(channels);
     } else if (!settings_.client_publish) {
       refuse(client, "client publishing is off (client_publish: false)");
     } else if (auto* advertised = std::get_if<ClientAdvertise>(&*request)) {
@@ -585,6 +635,7 @@ class FoxgloveBridge final : public Component {
   std::mutex mutex_;                                                  // guards what follows
   std::map<std::string, TopicState> topics_;
   std::set<std::string> first_asked_;  // images a client asked for, not subscribed to yet
+  std::set<std::string> unwatched_;    // images the last watching client stopped watching
   std::map<uint32_t, ChannelState> channels_;
   uint32_t next_channel_id_ = 1;
   std::map<ClientId, ClientState> clients_;

@@ -116,6 +116,11 @@ class Context {
                                                        const MessageType& type, const Qos& qos) = 0;
   virtual void subscribe_any(std::string_view topic, const MessageType& type, const Qos& qos,
                              MessageCallback callback) = 0;
+  // Ends what subscribe_any started on `topic` (the name given to it): no more of its messages
+  // reach the callbacks, those waiting are dropped, and the transports stop receiving it, so
+  // that other processes see the subscriber go and stop sending. For components that follow
+  // what their users ask for (a viewer). A topic not subscribed to is no error.
+  virtual void unsubscribe_any(std::string_view topic) = 0;
   // The topics the launch file's components declare, in every group, with their types.
   virtual std::vector<KnownTopic> known_topics() const = 0;
   // The topics other processes on the DDS domain publish right now, with the QoS their

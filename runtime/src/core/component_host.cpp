@@ -87,8 +87,12 @@ class HostPublisher final : public PublisherPort {
 // A subscription as the executor sees it: takes from every transport in turn.
 class HostSubscription final : public Waitable {
  public:
-  HostSubscription(std::string label, MessageCallback callback)
-      : Waitable(std::move(label)), callback_(std::move(callback)) {}
+  HostSubscription(std::string topic, MessageCallback callback)
+      : Waitable("subscription to " + topic),
+        topic_(std::move(topic)),
+        callback_(std::move(callback)) {}
+
+  const std::string& topic() const { return topic_; }
 
   bool execute_one() override {
     ReceivedMessage received;
@@ -104,9 +108,11 @@ class HostSubscription final : public Waitable {
     return false;
   }
 
+  // None once unsubscribed: it runs nothing more.
   std::vector<std::unique_ptr<TransportSubscription>> sources_;
 
  private:
+  std::string topic_;  // after remaps
   MessageCallback callback_;
   size_t next_ = 0;
 };
@@ -268,6 +274,17 @@ class ComponentHost::Impl::ComponentContext final : public Context {
                        std::move(callback));
   }
 
+  void unsubscribe_any(std::string_view topic) override {
+    const std::string name = remapped(std::string(topic));
+    std::erase_if(waitables_, [&](const std::shared_ptr<Waitable>& waitable) {
+      auto* subscription = dynamic_cast<HostSubscription*>(waitable.get());
+      if (subscription == nullptr || subscription->topic() != name) return false;
+      subscription->sources_.clear();  // the transports' readers go now
+      strand_.remove(subscription);
+      return true;
+    });
+  }
+
   std::vector<KnownTopic> known_topics() const override { return host_.known_topics(); }
   std::vector<KnownTopic> discovered_topics() const override { return host_.discovered_topics(); }
 
@@ -320,8 +337,7 @@ class ComponentHost::Impl::ComponentContext final : public Context {
 
   void subscribe_endpoint(const Endpoint& endpoint, MessageCallback callback) {
     check_created_off_transport_threads(endpoint);
-    auto subscription = std::make_shared<HostSubscription>("subscription to " + endpoint.topic,
-                                                           std::move(callback));
+    auto subscription = std::make_shared<HostSubscription>(endpoint.topic, std::move(callback));
     for (auto& transport : host_.transports) {
       subscription->sources_.push_back(
           transport->subscribe(endpoint, [strand = &strand_](bool may_run_callbacks) {

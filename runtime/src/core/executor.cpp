@@ -178,6 +178,12 @@ void Strand::run(int budget) {
   // arrived during this one.
   do {
     pending_.store(false);
+    if (!removed_.empty()) {
+      std::erase_if(waitables_, [&](const std::shared_ptr<Waitable>& waitable) {
+        return std::find(removed_.begin(), removed_.end(), waitable.get()) != removed_.end();
+      });
+      removed_.clear();
+    }
     // Index loop: a callback may add waitables to its own strand.
     for (size_t i = 0; i < waitables_.size(); ++i) {
       std::shared_ptr<Waitable> waitable = waitables_[i];

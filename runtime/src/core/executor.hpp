@@ -102,8 +102,14 @@ class Strand {
 
   // Not thread-safe against run(): call while the strand cannot run, or from its callbacks.
   void add(std::shared_ptr<Waitable> waitable);
+  // As add(). Let go of at the start of the strand's next pass over its waitables, so that a
+  // callback may remove any waitable of its own strand, its own too.
+  void remove(const Waitable* waitable) { removed_.push_back(waitable); }
   // Lets go of every waitable; for the owner's destruction.
-  void clear() { waitables_.clear(); }
+  void clear() {
+    waitables_.clear();
+    removed_.clear();
+  }
   // Thread-safe; called by transports and timers when a waitable may have work.
   void notify();
   // For transports that call from threads of their own (DDS listeners): runs the ready
@@ -141,6 +147,7 @@ class Strand {
   Executor& executor_;
   const Logger& logger_;
   std::vector<std::shared_ptr<Waitable>> waitables_;
+  std::vector<const Waitable*> removed_;  // by remove(), until the next pass
   std::atomic<bool> enabled_{false};
   std::atomic<bool> scheduled_{false};
   std::atomic<bool> pending_{false};
