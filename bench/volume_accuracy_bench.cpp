@@ -50,7 +50,9 @@ int main(int argc, char** argv) {
     }
   }
   const int frames = static_cast<int>(seconds * 30);
-  const auto volume = mocap::volume::test::render_volume(MOCAP_CONFIG_DIR, frames);
+  mocap::volume::test::RenderedVolumeOptions options;
+  options.frames = frames;
+  const auto volume = mocap::volume::test::render_volume(MOCAP_CONFIG_DIR, options);
   size_t fused_count = 0;
   for (const BodyFrame& body : volume.body_frames) fused_count += body.fused.posed() ? 1 : 0;
   fmt::print(

@@ -7,7 +7,9 @@
 // truth. What the volume accuracy test and bench measure.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -45,6 +47,15 @@ struct BodyFrame {
   PoseError fused;
   int cameras_used = 0;              // of the fused pose
   std::vector<PoseError> by_camera;  // each camera's own pose; not posed where it had none
+  int most_markers_seen = 0;         // by any one camera (the renderer's visible markers)
+};
+
+struct RenderedVolumeOptions {
+  int frames = 150;
+  double rate_hz = 30;
+  // Each camera's view of the scene changed before rendering (occluders of its own); none:
+  // every camera renders the demo's scene as it is.
+  std::function<void(size_t camera, synthetic::Scene& scene)> per_camera;
 };
 
 struct RenderedVolume {
@@ -52,10 +63,12 @@ struct RenderedVolume {
   std::vector<BodyFrame> body_frames;  // every body in every frame
 };
 
-// `frames` frames at `rate_hz` from scene time 0, with the demo's files under `config_dir`
-// and the volume_fusion component's settings (min_markers 5).
-inline RenderedVolume render_volume(const std::string& config_dir, int frames,
-                                    double rate_hz = 30) {
+// Frames from scene time 0, with the demo's files under `config_dir` and the volume_fusion
+// component's settings (min_markers 5).
+inline RenderedVolume render_volume(const std::string& config_dir,
+                                    const RenderedVolumeOptions& rendering = {}) {
+  const int frames = rendering.frames;
+  const double rate_hz = rendering.rate_hz;
   const std::string volume = config_dir + "/volume/";
   const auto boards = constellations::load_database(volume + "boards.yaml");
   const synthetic::Scene scene = synthetic::load_scene(volume + "scene.yaml", boards);
@@ -68,7 +81,9 @@ inline RenderedVolume render_volume(const std::string& config_dir, int frames,
     const auto file =
         calibration::load_camera_file(volume + "cameras/cam_" + std::to_string(c) + ".yaml");
     cameras.push_back({file.name, file.model, file.world_from_camera->inverse(), file.frame_id});
-    renderers.push_back(std::make_unique<synthetic::IrRenderer>(scene, file.model));
+    synthetic::Scene seen = scene;
+    if (rendering.per_camera) rendering.per_camera(static_cast<size_t>(c), seen);
+    renderers.push_back(std::make_unique<synthetic::IrRenderer>(seen, file.model));
     out.cameras.push_back(file.name);
   }
   VolumeTracker tracker(cameras,
@@ -104,6 +119,7 @@ inline RenderedVolume render_volume(const std::string& config_dir, int frames,
         std::vector<Eigen::Vector3d> markers;
         std::vector<Eigen::Vector2d> pixels;
         const synthetic::ObjectTruth& object = rendered[c].objects[b];
+        body.most_markers_seen = std::max(body.most_markers_seen, object.visible_markers());
         for (size_t m = 0; m < object.markers.size(); ++m) {
           if (!object.markers[m].visible) continue;
           const Eigen::Vector2d* nearest = nullptr;
