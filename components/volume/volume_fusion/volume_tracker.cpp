@@ -263,21 +263,25 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     }
   }
   if (!fused.valid) return std::nullopt;
+  const std::vector<CameraView> untrimmed = views;
   trim_strays(views, fused);
 
   // Each camera's residual where two other cameras or more hold the pose: a camera in the
-  // fusion by its own points, one left out by its detections nearest to where the pose puts
+  // fusion by its own points, strays included (a moved camera's points are all strays: its
+  // residual must see them), one left out by its detections nearest to where the pose puts
   // the markers.
   if (fused.cameras_used >= 2) {
     for (size_t c = 0; c < views.size(); ++c) {
       const bool in_fusion = !views[c].pixels.empty();
       if (fused.cameras_used - (in_fusion ? 1 : 0) < 2) continue;
       std::optional<CameraView> wide;
-      if (!in_fusion && left_out == c) {
+      if (untrimmed[c].pixels.empty() && left_out == c) {
         wide = views_near({detections[c]}, markers, fused.world_from_body,
                           kResidualRadiusFactor * options_.match_radius_px)[0];
       }
-      const CameraView* view = in_fusion ? &views[c] : wide ? &*wide : nullptr;
+      const CameraView* view = !untrimmed[c].pixels.empty() ? &untrimmed[c]
+                               : wide                       ? &*wide
+                                                            : nullptr;
       if (view == nullptr || view->pixels.size() < kMinPointsForResidual) continue;
       const double residual = view_median_error_px(*view, fused.world_from_body);
       if (!std::isnan(residual)) record_residual(c, residual);
