@@ -552,9 +552,10 @@ class SubscribesInItsCallbacks final : public Component {
   int first_ = 0;
 };
 
-TEST(ComponentHostOverDds, AComponentSubscribingInItsCallbacksKeepsReceiving) {
-  test::TempDir dir;
-  const std::string domain = std::to_string(test::test_domain(86));
+// Another process publishing the test sequence endlessly (1,000 a second) on the DDS domain
+// of `slot`, which this process then uses too.
+std::unique_ptr<test::ChildProcess> sequence_process(const test::TempDir& dir, int slot) {
+  const std::string domain = std::to_string(test::test_domain(slot));
   setenv("MOCAP_DOMAIN_ID", domain.c_str(), 1);
   test::write_file(dir / "source.yaml", R"(groups:
   - name: source
@@ -563,10 +564,17 @@ TEST(ComponentHostOverDds, AComponentSubscribingInItsCallbacksKeepsReceiving) {
         name: source
         parameters: {count: 0, batch: 5, period_s: 0.005, subscribers: 1}
 )");
-  test::ChildProcess source(
-      {(test::bin_dir() / "mocap_launch").string(), (dir / "source.yaml").string()},
-      {{"MOCAP_DOMAIN_ID", domain}, {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}},
+  return std::make_unique<test::ChildProcess>(
+      std::vector<std::string>{(test::bin_dir() / "mocap_launch").string(),
+                               (dir / "source.yaml").string()},
+      std::map<std::string, std::string>{{"MOCAP_DOMAIN_ID", domain},
+                                         {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}},
       dir / "source.log");
+}
+
+TEST(ComponentHostOverDds, AComponentSubscribingInItsCallbacksKeepsReceiving) {
+  test::TempDir dir;
+  const auto source = sequence_process(dir, 86);
   ComponentHost host({.name = "late_subscriber", .threads = 2, .dds = {.enabled = true}});
   host.add(make_component_factory<SubscribesInItsCallbacks>("subscribes_in_callbacks"),
            {.name = "subscriber"});
@@ -575,7 +583,7 @@ TEST(ComponentHostOverDds, AComponentSubscribingInItsCallbacksKeepsReceiving) {
   while (SubscribesInItsCallbacks::second < 100 && std::chrono::steady_clock::now() < end) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  EXPECT_GE(SubscribesInItsCallbacks::second, 100) << source.output();
+  EXPECT_GE(SubscribesInItsCallbacks::second, 100) << source->output();
   host.stop();
 }
 
@@ -613,19 +621,7 @@ class UnsubscribesInItsCallbacks final : public Component {
 
 TEST(ComponentHostOverDds, AComponentLetsGoOfATopicAndTakesItAgain) {
   test::TempDir dir;
-  const std::string domain = std::to_string(test::test_domain(85));
-  setenv("MOCAP_DOMAIN_ID", domain.c_str(), 1);
-  test::write_file(dir / "source.yaml", R"(groups:
-  - name: source
-    components:
-      - plugin: sequence_source
-        name: source
-        parameters: {count: 0, batch: 5, period_s: 0.005, subscribers: 1}
-)");
-  test::ChildProcess source(
-      {(test::bin_dir() / "mocap_launch").string(), (dir / "source.yaml").string()},
-      {{"MOCAP_DOMAIN_ID", domain}, {"MOCAP_PLUGIN_PATH", test::test_plugin_dir().string()}},
-      dir / "source.log");
+  const auto source = sequence_process(dir, 85);
   ComponentHost host({.name = "unsubscriber", .threads = 2, .dds = {.enabled = true}});
   host.add(make_component_factory<UnsubscribesInItsCallbacks>("unsubscribes"),
            {.name = "unsubscriber"});
@@ -637,7 +633,7 @@ TEST(ComponentHostOverDds, AComponentLetsGoOfATopicAndTakesItAgain) {
   host.stop();
   EXPECT_EQ(UnsubscribesInItsCallbacks::first_when_taken_again, 100) << "none after letting go";
   EXPECT_EQ(UnsubscribesInItsCallbacks::first, 100);
-  EXPECT_GE(UnsubscribesInItsCallbacks::second, 100) << source.output();
+  EXPECT_GE(UnsubscribesInItsCallbacks::second, 100) << source->output();
 }
 
 // The lifecycle as components see it: what happened, in order.
