@@ -304,7 +304,8 @@ class VolumeFusion final : public Component {
     }
     ++single_camera_poses_;
     if (!single) single = SingleCamera{stamp_ns, false};
-    if (!single->reported && stamp_ns - single->since_ns >= kSingleCameraAlert.count()) {
+    if (!single->reported &&
+        stamp_ns - single->since_ns >= std::chrono::nanoseconds(kSingleCameraAlert).count()) {
       single->reported = true;
       alert(1, fmt::format("{} is seen by one camera only for {} s: its depth is poor", body.name,
                            std::chrono::duration<double>(kSingleCameraAlert).count()));
