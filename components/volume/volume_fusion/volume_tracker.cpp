@@ -294,25 +294,15 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
 }
 
 void VolumeTracker::trim_strays(std::vector<CameraView>& views, MultiCameraPose& fused) const {
-  std::vector<std::vector<double>> errors;
-  std::vector<double> all;
+  std::vector<double> errors;
   for (const CameraView& view : views) {
-    errors.push_back(point_errors_px(view, fused.world_from_body));
-    all.insert(all.end(), errors.back().begin(), errors.back().end());
+    const std::vector<double> view_errors = point_errors_px(view, fused.world_from_body);
+    errors.insert(errors.end(), view_errors.begin(), view_errors.end());
   }
-  if (all.empty()) return;
-  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
-  const double limit = std::max(kStrayFloorPx, kStrayFactor * all[all.size() / 2]);
-  std::vector<CameraView> kept;
-  for (size_t c = 0; c < views.size(); ++c) {
-    CameraView close{views[c].camera, views[c].camera_from_world, {}, {}};
-    for (size_t i = 0; i < errors[c].size(); ++i) {
-      if (errors[c][i] > limit) continue;
-      close.body_points.push_back(views[c].body_points[i]);
-      close.pixels.push_back(views[c].pixels[i]);
-    }
-    kept.push_back(std::move(close));
-  }
+  if (errors.empty()) return;
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  const double limit = std::max(kStrayFloorPx, kStrayFactor * errors[errors.size() / 2]);
+  std::vector<CameraView> kept = without_outliers(views, fused.world_from_body, limit);
   const int points = points_in(kept);
   if (points == points_in(views) || points < options_.fusion.min_points) return;
   MultiCameraPose again = estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
