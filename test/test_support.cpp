@@ -251,6 +251,8 @@ std::map<std::string, long long> read_summary(const fs::path& path) {
     if (colon == std::string::npos) continue;
     summary[line.substr(0, colon)] = std::stoll(line.substr(colon + 1));
   }
+  // A missing summary would otherwise surface as a bare `map::at` in the caller.
+  if (summary.empty()) throw std::runtime_error(path.string() + ": no summary written");
   return summary;
 }
 

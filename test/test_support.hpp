@@ -126,7 +126,7 @@ class TwoHosts {
   std::string host_a_, host_b_, link_a_, link_b_, address_a_, address_b_, error_;
 };
 
-// "key: integer" lines, as sequence_sink writes them.
+// "key: integer" lines, as sequence_sink writes them; throws naming the file when it has none.
 std::map<std::string, long long> read_summary(const std::filesystem::path& path);
 
 }  // namespace mocap::test

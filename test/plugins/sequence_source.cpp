@@ -78,10 +78,6 @@ class SequenceSource final : public Component {
       reported_ = true;
       PublisherStats stats = publisher_.stats();
       auto ms = [](std::chrono::nanoseconds d) { return d.count() / 1000000; };
-      log().info(
-          "published {} messages in {:.3f} s; {} waited for subscribers, {} ms in all", count_,
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count(),
-          stats.waited, ms(stats.blocked));
       if (!summary_file_.empty()) {
         std::ofstream(summary_file_) << fmt::format(
             "published: {}\nwaited: {}\nblocked_ms: {}\nlongest_wait_ms: {}\ndropped: {}\n"
@@ -89,6 +85,11 @@ class SequenceSource final : public Component {
             stats.published, stats.waited, ms(stats.blocked), ms(stats.longest_wait), stats.dropped,
             ms(std::chrono::steady_clock::now() - started_at_));
       }
+      // Logged after the summary is on disk: tests read it once they see this line.
+      log().info(
+          "published {} messages in {:.3f} s; {} waited for subscribers, {} ms in all", count_,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count(),
+          stats.waited, ms(stats.blocked));
       if (stop_when_done_) request_shutdown();
     }
   }
