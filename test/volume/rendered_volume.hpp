@@ -53,6 +53,8 @@ struct BodyFrame {
 struct RenderedVolumeOptions {
   int frames = 150;
   double rate_hz = 30;
+  // cam_0 .. cam_{cameras-1} of config/volume/cameras: 4 is the demo, 8 its larger form.
+  int cameras = 4;
   // Each camera's view of the scene changed before rendering (occluders of its own); none:
   // every camera renders the demo's scene as it is.
   std::function<void(size_t camera, synthetic::Scene& scene)> per_camera;
@@ -77,7 +79,7 @@ inline RenderedVolume render_volume(const std::string& config_dir,
   std::vector<VolumeCamera> cameras;
   std::vector<std::unique_ptr<synthetic::IrRenderer>> renderers;  // each keeps its buffers
   RenderedVolume out;
-  for (int c = 0; c < 4; ++c) {
+  for (int c = 0; c < rendering.cameras; ++c) {
     const auto file =
         calibration::load_camera_file(volume + "cameras/cam_" + std::to_string(c) + ".yaml");
     cameras.push_back({file.name, file.model, file.world_from_camera->inverse(), file.frame_id});

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "rendered_volume.hpp"
@@ -22,14 +23,18 @@ double quantile(std::vector<double> values, double q) {
   return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
 }
 
-TEST(VolumeAccuracy, FusedPosesAreTwiceAsAccurateAsTheBestSingleCamerasOnTheSameFrames) {
-  const test::RenderedVolume volume =
-      test::render_volume((mocap::test::source_dir() / "config").string());
+// The fused and the best single camera's errors (lowest median position error) on the
+// body-frames both posed, each camera required to pose 100 of them or more.
+struct AgainstBestCamera {
+  std::string camera;
+  std::vector<double> camera_m, fused_m, camera_deg, fused_deg;
+};
+
+AgainstBestCamera against_best_camera(const test::RenderedVolume& volume) {
   size_t fused = 0;
   for (const test::BodyFrame& body : volume.body_frames) fused += body.fused.posed() ? 1 : 0;
   EXPECT_GE(fused, volume.body_frames.size() * 95 / 100) << "of " << volume.body_frames.size();
 
-  // Per camera, the body-frames it and the fusion both posed.
   double best_median = 1e9;
   size_t best = 0;
   std::vector<std::vector<const test::BodyFrame*>> shared(volume.cameras.size());
@@ -40,37 +45,64 @@ TEST(VolumeAccuracy, FusedPosesAreTwiceAsAccurateAsTheBestSingleCamerasOnTheSame
       shared[c].push_back(&body);
       own.push_back(body.by_camera[c].position_m);
     }
-    ASSERT_GE(shared[c].size(), 100u) << volume.cameras[c];
-    if (quantile(own, 0.5) < best_median) {
+    EXPECT_GE(shared[c].size(), 100u) << volume.cameras[c] << " posed too few: does it look away?";
+    if (!own.empty() && quantile(own, 0.5) < best_median) {
       best_median = quantile(own, 0.5);
       best = c;
     }
   }
-  std::vector<double> camera_m, fused_m, camera_deg, fused_deg;
+  AgainstBestCamera out{volume.cameras[best], {}, {}, {}, {}};
   for (const test::BodyFrame* body : shared[best]) {
-    camera_m.push_back(body->by_camera[best].position_m);
-    camera_deg.push_back(body->by_camera[best].rotation_deg);
-    fused_m.push_back(body->fused.position_m);
-    fused_deg.push_back(body->fused.rotation_deg);
+    out.camera_m.push_back(body->by_camera[best].position_m);
+    out.camera_deg.push_back(body->by_camera[best].rotation_deg);
+    out.fused_m.push_back(body->fused.position_m);
+    out.fused_deg.push_back(body->fused.rotation_deg);
   }
   std::printf(
-      "best single camera %s over %zu body-frames: position %.3f / %.3f mm (median / p95), "
-      "fused %.3f / %.3f; orientation %.4f / %.4f deg, fused %.4f / %.4f\n",
-      volume.cameras[best].c_str(), camera_m.size(), quantile(camera_m, 0.5) * 1e3,
-      quantile(camera_m, 0.95) * 1e3, quantile(fused_m, 0.5) * 1e3, quantile(fused_m, 0.95) * 1e3,
-      quantile(camera_deg, 0.5), quantile(camera_deg, 0.95), quantile(fused_deg, 0.5),
-      quantile(fused_deg, 0.95));
+      "%zu cameras; best single camera %s over %zu body-frames: position %.3f / %.3f mm (median "
+      "/ p95), fused %.3f / %.3f; orientation %.4f / %.4f deg, fused %.4f / %.4f\n",
+      volume.cameras.size(), out.camera.c_str(), out.camera_m.size(),
+      quantile(out.camera_m, 0.5) * 1e3, quantile(out.camera_m, 0.95) * 1e3,
+      quantile(out.fused_m, 0.5) * 1e3, quantile(out.fused_m, 0.95) * 1e3,
+      quantile(out.camera_deg, 0.5), quantile(out.camera_deg, 0.95), quantile(out.fused_deg, 0.5),
+      quantile(out.fused_deg, 0.95));
+  return out;
+}
+
+TEST(VolumeAccuracy, FusedPosesAreTwiceAsAccurateAsTheBestSingleCamerasOnTheSameFrames) {
+  const AgainstBestCamera errors =
+      against_best_camera(test::render_volume((mocap::test::source_dir() / "config").string()));
+  ASSERT_FALSE(errors.camera_m.empty());
   for (double q : {0.5, 0.95}) {
-    EXPECT_LE(quantile(fused_m, q), quantile(camera_m, q) / 2) << "position, quantile " << q;
+    EXPECT_LE(quantile(errors.fused_m, q), quantile(errors.camera_m, q) / 2)
+        << "position, quantile " << q;
   }
-  EXPECT_LE(quantile(fused_deg, 0.95), quantile(camera_deg, 0.95) / 2) << "orientation, p95";
+  EXPECT_LE(quantile(errors.fused_deg, 0.95), quantile(errors.camera_deg, 0.95) / 2)
+      << "orientation, p95";
   // The issue asks for 2x at the median too; measured 1.5x here (1.4-1.7x over longer runs, and
   // 1.5x on the frames all four cameras see). A single camera's orientation, unlike its depth,
   // is nearly as good as the fusion's: both rest on the same markers' detection errors, which in
   // rendered images are 0.05 px of bias per marker and camera (the blob's place on the pixel
   // grid), so four cameras bring the square root of four at best, and the best camera is better
-  // than the average.
-  EXPECT_LE(quantile(fused_deg, 0.5), quantile(camera_deg, 0.5) / 1.4) << "orientation, median";
+  // than the average. Eight cameras reach it (the next test).
+  EXPECT_LE(quantile(errors.fused_deg, 0.5), quantile(errors.camera_deg, 0.5) / 1.4)
+      << "orientation, median";
+}
+
+// The larger volume, eight cameras: every one of them poses the boards, and the fusion is twice
+// as accurate as the best of them in orientation at the median too.
+TEST(VolumeAccuracy, EightCamerasAreTwiceAsAccurateInOrientationToo) {
+  test::RenderedVolumeOptions eight;
+  eight.cameras = 8;
+  const AgainstBestCamera errors = against_best_camera(
+      test::render_volume((mocap::test::source_dir() / "config").string(), eight));
+  ASSERT_FALSE(errors.camera_m.empty());
+  for (double q : {0.5, 0.95}) {
+    EXPECT_LE(quantile(errors.fused_m, q), quantile(errors.camera_m, q) / 2)
+        << "position, quantile " << q;
+    EXPECT_LE(quantile(errors.fused_deg, q), quantile(errors.camera_deg, q) / 2)
+        << "orientation, quantile " << q;
+  }
 }
 
 // A marker merged with another's or half hidden, kept in the fit, tilts a pose by tenths of a
