@@ -7,21 +7,25 @@
 #
 #   scripts/calibrate_volume.sh OUTPUT [--wave SECONDS] [--floor SECONDS] [--marks "X,Y ..."]
 #
-# Defaults: 30 s of waving; 3 s on the floor at each of the marks "0,0 1,0 0,1 -1,0 0,-1"
-# (metres; "0,0" alone: the one board's axes are the room's). The demo on the calibrated cameras:
+# Defaults: 60 s of waving; 3 s on the floor at each of the marks "0,0 1,0 0,1 -1,0 0,-1 1,1
+# -1,1 -1,-1 1,-1" (metres: the centre, 1 m along each axis and the corners of that square; "0,0"
+# alone: the one board's axes are the room's), laid twice at each, the second time turned half
+# round about its centre: the two centres' mean cancels much of what the still board adds (its
+# markers' detection biases, a pattern whose centre is off its origin). volume_calibration_bench
+# compares waves and floors. The demo on the calibrated cameras:
 #   build/bin/mocap_launch launch_yaml/volume_demo.yaml --set \
 #     "fusion.cameras=[OUTPUT/cameras/cam_0.yaml, ..., OUTPUT/cameras/cam_3.yaml]"
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin_dir="${MOCAP_BIN_DIR:-$root/build/bin}"
 usage() {
-  sed -n '2,13p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,17p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
   exit 2
 }
 [ $# -ge 1 ] || usage
 out="$1"
 shift
-wave_s=30 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1"
+wave_s=60 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1"
 while [ $# -gt 0 ]; do
   case "$1" in
     --wave) wave_s="${2:?}"; shift 2 ;;
@@ -38,19 +42,29 @@ echo "calibrate_volume: recording ${wave_s} s of the board carried through the v
   > "$out/waved.log" 2>&1 || { tail -n 20 "$out/waved.log"; exit 1; }
 floor_scene="$root/config/volume/calibration_floor.yaml"
 floors=()
+turns="0 180"
+[ "$(wc -w <<< "$marks")" -ge 3 ] || turns=0  # laid once, the board's axes are the room's
 for mark in $marks; do
   x="${mark%,*}" y="${mark#*,}"
-  name="floor_${x}_${y}"
-  # The shipped floor scene, the board's centre moved onto the mark.
-  sed "s/position: \[0, 0, 0\]/position: [$x, $y, 0]/" "$floor_scene" > "$out/$name.yaml"
-  grep -q "position: \[$x, $y, 0\]" "$out/$name.yaml" ||
-    { echo "calibrate_volume: $floor_scene has no board at [0, 0, 0] to move" >&2; exit 1; }
-  echo "calibrate_volume: recording ${floor_s} s of the board on the floor at ($x, $y)"
-  on_floor=()
-  for c in 0 1 2 3; do on_floor+=(--set "cam_$c.scene=$out/$name.yaml"); done
-  "$bin_dir/mocap_launch" "$launch" --duration "$floor_s" --set "recorder.output=$out/$name" \
-    "${on_floor[@]}" > "$out/$name.log" 2>&1 || { tail -n 20 "$out/$name.log"; exit 1; }
-  floors+=(--floor "$out/$name:$x,$y")
+  for turn in $turns; do
+    name="floor_${x}_${y}"
+    [ "$turn" = 0 ] || name+="_turned"
+    # The shipped floor scene, the board's centre moved onto the mark and turned about its
+    # normal (the scene's roll).
+    sed -e "s/position: \[0, 0, 0\]/position: [$x, $y, 0]/" \
+      -e "s/rpy_deg: \[0, 180, 0\]/rpy_deg: [$turn, 180, 0]/" "$floor_scene" > "$out/$name.yaml"
+    grep -q "position: \[$x, $y, 0\], rpy_deg: \[$turn, 180, 0\]" "$out/$name.yaml" || {
+      echo "calibrate_volume: $floor_scene has no board at [0, 0, 0], rpy_deg [0, 180, 0]" >&2
+      exit 1
+    }
+    echo "calibrate_volume: recording ${floor_s} s of the board on the floor at ($x, $y)," \
+      "turned ${turn} deg"
+    on_floor=()
+    for c in 0 1 2 3; do on_floor+=(--set "cam_$c.scene=$out/$name.yaml"); done
+    "$bin_dir/mocap_launch" "$launch" --duration "$floor_s" --set "recorder.output=$out/$name" \
+      "${on_floor[@]}" > "$out/$name.log" 2>&1 || { tail -n 20 "$out/$name.log"; exit 1; }
+    floors+=(--floor "$out/$name:$x,$y")
+  done
 done
 exec "$bin_dir/mocap_volume_calibrate" --waved "$out/waved" "${floors[@]}" \
   --output "$out/cameras" "$root"/config/volume/cameras/cam_{0,1,2,3}.yaml

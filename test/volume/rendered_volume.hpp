@@ -55,6 +55,9 @@ struct RenderedVolumeOptions {
   double rate_hz = 30;
   // cam_0 .. cam_{cameras-1} of config/volume/cameras: 4 is the demo, 8 its larger form.
   int cameras = 4;
+  // The extrinsics the tracker uses, by camera (a calibration's); empty: the true ones, which
+  // the cameras render from.
+  std::vector<Eigen::Isometry3d> tracked_camera_from_world;
   // Each camera's view of the scene changed before rendering (occluders of its own); none:
   // every camera renders the demo's scene as it is.
   std::function<void(size_t camera, synthetic::Scene& scene)> per_camera;
@@ -88,7 +91,11 @@ inline RenderedVolume render_volume(const std::string& config_dir,
     renderers.push_back(std::make_unique<synthetic::IrRenderer>(seen, file.model));
     out.cameras.push_back(file.name);
   }
-  VolumeTracker tracker(cameras,
+  std::vector<VolumeCamera> tracked = cameras;
+  for (size_t c = 0; c < rendering.tracked_camera_from_world.size() && c < tracked.size(); ++c) {
+    tracked[c].camera_from_world = rendering.tracked_camera_from_world[c];
+  }
+  VolumeTracker tracker(tracked,
                         load_rigid_bodies(volume + "bodies.yaml", options.identification.tolerance,
                                           options.identification.min_markers),
                         options);

@@ -228,17 +228,19 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
 }
 
 // Calibrated from data (scripts/calibrate_volume.sh): the board carried through the volume for
-// 20 s and laid on the floor at five marks for 3 s each, recorded into bags and solved; every
-// camera within 0.5 mm and 0.01 degrees of where the simulator put it (0.12-0.19 mm, 0.003
-// degrees measured; the issue's bound is 2 mm and 0.05 degrees), each board's centre within
-// 0.3 mm of its mark. The demo then runs on the files it wrote: poses within 0.15 mm (median;
-// 0.05-0.07 mm measured, 0.03 mm on the true cameras, 0.11-0.14 mm with the board laid once).
+// 30 s and laid on the floor at five marks, twice at each, for 2 s, recorded into bags and
+// solved; every camera within 0.5 mm and 0.01 degrees of where the simulator put it (the
+// issue's bound is 2 mm and 0.05 degrees), each board's centre within 0.3 mm of its mark. The
+// demo then runs on the files it wrote: poses within 0.15 mm (median; 0.03 mm on the true
+// cameras). Live, the wave's 30 s fall anywhere on its 120 s path, and how well they tie the
+// cameras together varies from run to run (0.07 mm measured once); the issue's 20 % is asserted
+// on rendered sessions (VolumeAccuracy.CamerasCalibratedFromRenderedImagesFuseWithin...).
 TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   test::TempDir dir;
-  auto [code, output] =
-      test::run_command({(test::source_dir() / "scripts" / "calibrate_volume.sh").string(),
-                         dir.path().string(), "--wave", "20", "--floor", "3"},
-                        environment(74), std::chrono::seconds(150));
+  auto [code, output] = test::run_command(
+      {(test::source_dir() / "scripts" / "calibrate_volume.sh").string(), dir.path().string(),
+       "--wave", "30", "--floor", "2", "--marks", "0,0 1,0 0,1 -1,0 0,-1"},
+      environment(74), std::chrono::seconds(150));
   ASSERT_EQ(code, 0) << output;
   std::printf("%s", output.c_str());
   const std::regex line(R"((cam_\d): at .* m; ([0-9.]+) mm and ([0-9.]+) deg from the input)");
@@ -256,7 +258,7 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
     EXPECT_GE(std::stoi((*it)[1]), 2) << (*it)[0];
     EXPECT_LT(std::stod((*it)[2]), 0.3) << (*it)[0];
   }
-  EXPECT_EQ(marks, 5) << output;
+  EXPECT_EQ(marks, 10) << output;  // each laid twice, the second time turned
 
   std::string files = "[";
   for (int c = 0; c < 4; ++c) {

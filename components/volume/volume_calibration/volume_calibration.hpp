@@ -47,8 +47,9 @@ struct VolumeCalibrationOptions {
   // Sightings whose stamps differ by no more than this are one capture time.
   double same_capture_s = 0.002;
   // Of the waved session's capture times with the board whole in two cameras or more, at most
-  // this many, evenly spread, go into the solve (its time grows with the shots).
-  size_t max_frames = 400;
+  // this many, evenly spread, go into the solve: its time grows with the shots (a second for
+  // 1,300 on one core), and every one of a few minutes' waving still counts.
+  size_t max_frames = 6000;
   // Huber loss scale on each point's pixel error: a mis-detected marker cannot drag the fit.
   double robust_scale_px = 1.0;
 };
