@@ -30,14 +30,6 @@ double quantile(std::vector<double> values, double q) {
   return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
 }
 
-std::vector<double> fused_errors_mm(const test::RenderedVolume& volume) {
-  std::vector<double> mm;
-  for (const test::BodyFrame& body : volume.body_frames) {
-    if (body.fused.posed()) mm.push_back(body.fused.position_m * 1e3);
-  }
-  return mm;
-}
-
 // One calibration's row: its cameras against the truth, and the demo's poses fused through
 // them against `on_truth`.
 void print_row(const std::string& wave, const std::string& floor,
@@ -49,17 +41,14 @@ void print_row(const std::string& wave, const std::string& floor,
       calibrate_volume(scenes.cameras(), scenes.board(), waved, placements);
   double worst_m = 0, worst_deg = 0;
   for (size_t c = 0; c < scenes.cameras().size(); ++c) {
-    const Eigen::Isometry3d world_from_camera = calibrated.camera_from_world[c].inverse();
-    const Eigen::Isometry3d truth = scenes.true_camera_from_world()[c].inverse();
-    worst_m = std::max(worst_m, (world_from_camera.translation() - truth.translation()).norm());
-    worst_deg = std::max(
-        worst_deg,
-        Eigen::AngleAxisd(world_from_camera.linear().transpose() * truth.linear()).angle() * 180 /
-            std::acos(-1.0));
+    const test::CameraOffset off =
+        test::camera_offset(calibrated.camera_from_world[c], scenes.true_camera_from_world()[c]);
+    worst_m = std::max(worst_m, off.position_m);
+    worst_deg = std::max(worst_deg, off.rotation_deg);
   }
   rendering.tracked_camera_from_world = calibrated.camera_from_world;
   const std::vector<double> fused =
-      fused_errors_mm(test::render_volume(MOCAP_CONFIG_DIR, rendering));
+      test::render_volume(MOCAP_CONFIG_DIR, rendering).fused_position_errors_mm();
   const double median = quantile(fused, 0.5) / quantile(on_truth, 0.5) - 1;
   const double p95 = quantile(fused, 0.95) / quantile(on_truth, 0.95) - 1;
   const bool met = worst_m < 2e-3 && worst_deg < 0.05 && median <= 0.2 && p95 <= 0.2;
@@ -94,7 +83,7 @@ int main(int argc, char** argv) {
   test::RenderedVolumeOptions rendering;
   rendering.frames = static_cast<int>(seconds * 30);
   const std::vector<double> on_truth =
-      fused_errors_mm(test::render_volume(MOCAP_CONFIG_DIR, rendering));
+      test::render_volume(MOCAP_CONFIG_DIR, rendering).fused_position_errors_mm();
   fmt::print(
       "The demo's poses fused over {} frames through the true cameras: position {:.4f} mm "
       "median, {:.4f} mm p95\n\n",

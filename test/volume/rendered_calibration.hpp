@@ -11,6 +11,7 @@
 //   VolumeCalibration result = calibrate_volume(scenes.cameras(), scenes.board(), waved, floor);
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,6 +31,21 @@ namespace mocap::volume::test {
 // of that square.
 inline const std::vector<Eigen::Vector2d> kFloorMarks = {
     {0, 0}, {1, 0}, {0, 1}, {-1, 0}, {0, -1}, {1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+
+// How far a calibrated camera lies from where it renders from.
+struct CameraOffset {
+  double position_m = 0;
+  double rotation_deg = 0;
+};
+
+inline CameraOffset camera_offset(const Eigen::Isometry3d& calibrated_camera_from_world,
+                                  const Eigen::Isometry3d& true_camera_from_world) {
+  const Eigen::Isometry3d calibrated = calibrated_camera_from_world.inverse();
+  const Eigen::Isometry3d truth = true_camera_from_world.inverse();
+  return {(calibrated.translation() - truth.translation()).norm(),
+          Eigen::AngleAxisd(calibrated.linear().transpose() * truth.linear()).angle() * 180 /
+              std::acos(-1.0)};
+}
 
 class RenderedCalibrationScenes {
  public:

@@ -66,6 +66,15 @@ struct RenderedVolumeOptions {
 struct RenderedVolume {
   std::vector<std::string> cameras;
   std::vector<BodyFrame> body_frames;  // every body in every frame
+
+  // Of every body-frame the fusion posed, millimetres.
+  std::vector<double> fused_position_errors_mm() const {
+    std::vector<double> mm;
+    for (const BodyFrame& body : body_frames) {
+      if (body.fused.posed()) mm.push_back(body.fused.position_m * 1e3);
+    }
+    return mm;
+  }
 };
 
 // Frames from scene time 0, with the demo's files under `config_dir` and the volume_fusion

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -184,32 +183,21 @@ TEST(VolumeAccuracy, CamerasCalibratedFromRenderedImagesFuseWithinTwentyPercentO
       calibrate_volume(scenes.cameras(), scenes.board(), scenes.waved(60),
                        scenes.on_floor(test::kFloorMarks, {0, 180}));
   for (size_t c = 0; c < scenes.cameras().size(); ++c) {
-    const Eigen::Isometry3d world_from_camera = calibrated.camera_from_world[c].inverse();
-    const Eigen::Isometry3d true_world_from_camera = scenes.true_camera_from_world()[c].inverse();
-    const double off_m =
-        (world_from_camera.translation() - true_world_from_camera.translation()).norm();
-    const double off_deg =
-        Eigen::AngleAxisd(world_from_camera.linear().transpose() * true_world_from_camera.linear())
-            .angle() *
-        180 / std::acos(-1.0);
+    const test::CameraOffset off =
+        test::camera_offset(calibrated.camera_from_world[c], scenes.true_camera_from_world()[c]);
     std::printf("%s: %.3f mm, %.4f deg from the truth\n", scenes.cameras()[c].name.c_str(),
-                off_m * 1e3, off_deg);
-    EXPECT_LT(off_m, 2e-3) << scenes.cameras()[c].name;
-    EXPECT_LT(off_deg, 0.05) << scenes.cameras()[c].name;
+                off.position_m * 1e3, off.rotation_deg);
+    EXPECT_LT(off.position_m, 2e-3) << scenes.cameras()[c].name;
+    EXPECT_LT(off.rotation_deg, 0.05) << scenes.cameras()[c].name;
   }
 
   test::RenderedVolumeOptions rendering;
   rendering.frames = 300;
-  auto fused_errors_mm = [&](const test::RenderedVolume& volume) {
-    std::vector<double> mm;
-    for (const test::BodyFrame& body : volume.body_frames) {
-      if (body.fused.posed()) mm.push_back(body.fused.position_m * 1e3);
-    }
-    return mm;
-  };
-  const std::vector<double> on_truth = fused_errors_mm(test::render_volume(config, rendering));
+  const std::vector<double> on_truth =
+      test::render_volume(config, rendering).fused_position_errors_mm();
   rendering.tracked_camera_from_world = calibrated.camera_from_world;
-  const std::vector<double> on_calibrated = fused_errors_mm(test::render_volume(config, rendering));
+  const std::vector<double> on_calibrated =
+      test::render_volume(config, rendering).fused_position_errors_mm();
   ASSERT_GE(on_calibrated.size(), on_truth.size() * 99 / 100);
   for (double q : {0.5, 0.95}) {
     std::printf(
