@@ -7,25 +7,25 @@
 #
 #   scripts/calibrate_volume.sh OUTPUT [--wave SECONDS] [--floor SECONDS] [--marks "X,Y ..."]
 #
-# Defaults: 60 s of waving; 3 s on the floor at each of the marks "0,0 1,0 0,1 -1,0 0,-1 1,1
-# -1,1 -1,-1 1,-1" (metres: the centre, 1 m along each axis and the corners of that square; "0,0"
-# alone: the one board's axes are the room's), laid twice at each, the second time turned half
-# round about its centre: the two centres' mean cancels much of what the still board adds (its
-# markers' detection biases, a pattern whose centre is off its origin). volume_calibration_bench
-# compares waves and floors. The demo on the calibrated cameras:
+# Defaults: 120 s of waving (the wave's path once round); 3 s on the floor at each of the marks
+# "0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1" (metres: the centre, 1 m along each axis and the
+# corners of that square; "0,0" alone: the one board's axes are the room's), laid twice at each,
+# the second time turned half round about its centre: the two centres' mean cancels much of what
+# the still board adds (its markers' detection biases, a pattern whose centre is off its origin).
+# volume_calibration_bench compares waves and floors. The demo on the calibrated cameras:
 #   build/bin/mocap_launch launch_yaml/volume_demo.yaml --set \
 #     "fusion.cameras=[OUTPUT/cameras/cam_0.yaml, ..., OUTPUT/cameras/cam_3.yaml]"
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin_dir="${MOCAP_BIN_DIR:-$root/build/bin}"
 usage() {
-  sed -n '2,17p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
   exit 2
 }
 [ $# -ge 1 ] || usage
 out="$1"
 shift
-wave_s=60 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1"
+wave_s=120 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1"
 while [ $# -gt 0 ]; do
   case "$1" in
     --wave) wave_s="${2:?}"; shift 2 ;;

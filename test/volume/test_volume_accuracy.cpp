@@ -171,11 +171,11 @@ TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
 }
 
 // The calibration targets on rendered images (rendered_calibration.hpp), calibrated as
-// scripts/calibrate_volume.sh does by default: a minute of the board carried through the volume
-// and the board laid at nine marks, twice at each (turned half round). The cameras are within
-// 2 mm and 0.05 degrees of the truth, and poses fused through them within 20 % of the accuracy
-// the true cameras give, median and p95. volume_calibration_bench: the same for other waves and
-// floors.
+// scripts/calibrate_volume.sh does, with half its default wave: a minute of the board carried
+// through the volume and the board laid at nine marks, twice at each (turned half round). The
+// cameras are within 2 mm and 0.05 degrees of the truth, and poses fused through them within 20 %
+// of the accuracy the true cameras give, median and p95. volume_calibration_bench: the same for
+// other waves and floors.
 TEST(VolumeAccuracy, CamerasCalibratedFromRenderedImagesFuseWithinTwentyPercentOfTheTrueOnes) {
   const std::string config = (mocap::test::source_dir() / "config").string();
   const test::RenderedCalibrationScenes scenes(config);
