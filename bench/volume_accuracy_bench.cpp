@@ -108,8 +108,8 @@ int main(int argc, char** argv) {
                            quantile(o.rotation_deg, 0.95) / quantile(f.rotation_deg, 0.95)};
   fmt::print(
       "\ntarget: fused >= 2x better than the best single camera ({}, lowest median position "
-      "error) on the same frames: position median {:.1f}x {}, p95 {:.1f}x {}; orientation "
-      "median {:.1f}x {}, p95 {:.1f}x {}\n",
+      "error) on the same frames: position median {:.2f}x {}, p95 {:.2f}x {}; orientation "
+      "median {:.2f}x {}, p95 {:.2f}x {}\n",
       volume.cameras[best], ratios[0], met(ratios[0]), ratios[1], met(ratios[1]), ratios[2],
       met(ratios[2]), ratios[3], met(ratios[3]));
   return 0;

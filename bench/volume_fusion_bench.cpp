@@ -104,7 +104,7 @@ std::vector<std::vector<CameraFrame>> make_detections(const test::Volume& volume
     const int64_t stamp_ns = static_cast<int64_t>(f * 1e9 / 120);
     std::vector<CameraFrame> frame(volume.extrinsics.size());
     for (size_t c = 0; c < frame.size(); ++c) {
-      frame[c] = {true, stamp_ns, {}};
+      frame[c] = {true, stamp_ns, {}, {}};
       for (size_t b = 0; b < bodies.bodies.size(); ++b) {
         const double angle = 2 * test::kPi * (f / 120.0 / 6 + static_cast<double>(b) / kBodies);
         Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();

@@ -117,9 +117,10 @@ inline RenderedVolume render_volume(const std::string& config_dir,
     for (size_t c = 0; c < cameras.size(); ++c) {
       rendered.push_back(
           renderers[c]->render(time_s, static_cast<uint64_t>(f), cameras[c].camera_from_world));
-      detections[c] = {true, stamp_ns, {}};
+      detections[c] = {true, stamp_ns, {}, {}};
       for (const auto& fiducial : detector.detect(rendered.back().image)) {
         detections[c].pixels.emplace_back(fiducial.x, fiducial.y);
+        detections[c].pixel_sigma_px.push_back(fiducial.uncertainty_px);
       }
     }
     const std::vector<TrackedBodyPose> fused = tracker.track(stamp_ns, detections);

@@ -65,7 +65,7 @@ inline std::vector<CameraView> views_of(const Volume& volume,
   std::normal_distribution<double> noise(0, noise_px);
   std::vector<CameraView> views;
   for (const Eigen::Isometry3d& extrinsic : volume.extrinsics) {
-    CameraView view{volume.camera.get(), extrinsic, {}, {}};
+    CameraView view{volume.camera.get(), extrinsic, {}, {}, {}};
     for (const Eigen::Vector3d& point : kBoard) {
       auto pixel = volume.camera->project(extrinsic * world_from_body * point);
       if (!pixel || !volume.camera->in_image(*pixel)) {

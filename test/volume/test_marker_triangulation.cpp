@@ -27,7 +27,7 @@ std::vector<CameraDetections> detections_of(const test::Volume& volume,
   std::vector<CameraDetections> cameras;
   truth.assign(volume.extrinsics.size(), {});
   for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
-    CameraDetections camera{volume.camera.get(), volume.extrinsics[c], {}};
+    CameraDetections camera{volume.camera.get(), volume.extrinsics[c], {}, {}};
     std::vector<int> order;
     for (size_t p = 0; p < points.size(); ++p) {
       if (visible != nullptr && !(*visible)[c][p]) continue;

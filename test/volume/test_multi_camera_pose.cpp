@@ -145,9 +145,42 @@ TEST(MultiCameraPose, ABumpedCameraStandsOutInItsResiduals) {
   EXPECT_NE(strict.rejection.find("reprojection RMS"), std::string::npos) << strict.rejection;
 }
 
+// Points whose detections err differently, and say so: most within 0.05 px, one pulled 1 px
+// (a blob merged with a neighbour) whose detector says 1 px. Weighed by their sigmas, the pull
+// barely moves the pose; weighed alike, it tilts it. The RMS stays in pixels either way.
+TEST(MultiCameraPose, EachPointCountsByItsSigma) {
+  const Volume volume;
+  std::mt19937 random(5);
+  double weighted_deg = 0, alike_deg = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Eigen::Isometry3d truth = random_pose(random);
+    std::vector<CameraView> views = views_of(volume, truth, 0.05, random);
+    bool pulled = false;
+    for (CameraView& view : views) {
+      view.pixel_sigma_px.assign(view.pixels.size(), 0.05);
+      if (!pulled && !view.pixels.empty()) {
+        view.pixels[0].x() += 1.0;
+        view.pixel_sigma_px[0] = 1.0;
+        pulled = true;
+      }
+    }
+    const MultiCameraPose weighted = estimate_multi_camera_pose(views, truth);
+    for (CameraView& view : views) view.pixel_sigma_px.clear();
+    const MultiCameraPose alike = estimate_multi_camera_pose(views, truth);
+    ASSERT_TRUE(weighted.valid && alike.valid) << weighted.rejection << alike.rejection;
+    weighted_deg += rotation_error(weighted.world_from_body, truth) / 50;
+    alike_deg += rotation_error(alike.world_from_body, truth) / 50;
+    // The weighted fit leaves the pulled point its whole pull: a larger RMS in pixels.
+    EXPECT_GT(weighted.reprojection_rms_px, alike.reprojection_rms_px);
+  }
+  std::printf("mean orientation error: %.4f deg weighed by sigma, %.4f deg alike\n", weighted_deg,
+              alike_deg);
+  EXPECT_LT(weighted_deg, alike_deg / 2);
+}
+
 TEST(MultiCameraPose, TooFewPointsAreSaidAndBadOptionsThrow) {
   const Volume volume;
-  CameraView view{volume.camera.get(), volume.extrinsics[0], {kBoard[0], kBoard[1]}, {}};
+  CameraView view{volume.camera.get(), volume.extrinsics[0], {kBoard[0], kBoard[1]}, {}, {}};
   view.pixels = {{600, 300}, {620, 300}};
   const MultiCameraPose result = estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity());
   EXPECT_FALSE(result.valid);
@@ -156,6 +189,10 @@ TEST(MultiCameraPose, TooFewPointsAreSaidAndBadOptionsThrow) {
   options.min_points = 2;
   EXPECT_THROW(estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity(), options),
                std::invalid_argument);
+  view.pixel_sigma_px = {0.1};  // one sigma for two pixels
+  EXPECT_THROW(estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity()),
+               std::invalid_argument);
+  view.pixel_sigma_px.clear();
   view.pixels.pop_back();
   EXPECT_THROW(estimate_multi_camera_pose({view}, Eigen::Isometry3d::Identity()),
                std::invalid_argument);

@@ -80,13 +80,13 @@ TEST(VolumeAccuracy, FusedPosesAreTwiceAsAccurateAsTheBestSingleCamerasOnTheSame
   }
   EXPECT_LE(quantile(errors.fused_deg, 0.95), quantile(errors.camera_deg, 0.95) / 2)
       << "orientation, p95";
-  // The issue asks for 2x at the median too; measured 1.5x here (1.4-1.7x over longer runs, and
-  // 1.5x on the frames all four cameras see). A single camera's orientation, unlike its depth,
-  // is nearly as good as the fusion's: both rest on the same markers' detection errors, which in
-  // rendered images are 0.05 px of bias per marker and camera (the blob's place on the pixel
-  // grid), so four cameras bring the square root of four at best, and the best camera is better
-  // than the average. Eight cameras reach it (the next test).
-  EXPECT_LE(quantile(errors.fused_deg, 0.5), quantile(errors.camera_deg, 0.5) / 1.4)
+  // The issue asks for 2x at the median too; measured 1.85x here and 1.99x over 20 s
+  // (volume_accuracy_bench). A single camera's orientation, unlike its depth, is nearly as good
+  // as the fusion's: both rest on the same markers' detection errors, so four cameras bring the
+  // square root of four at best, and the best camera is better than the average. Weighing each
+  // point by the detector's uncertainty took it from 1.5x (1.6x over 20 s). Eight cameras reach
+  // it (the next test).
+  EXPECT_LE(quantile(errors.fused_deg, 0.5), quantile(errors.camera_deg, 0.5) / 1.7)
       << "orientation, median";
 }
 

@@ -201,6 +201,10 @@ TEST(VolumeTracker, BadInputThrows) {
   VolumeTracker tracker({{"cam_0", volume.camera, volume.extrinsics[0], "cam_0_optical"}},
                         RigidBodyDatabase{});
   EXPECT_THROW(tracker.track(0, {}), std::invalid_argument);
+  CameraFrame frame{true, 0, {{600, 300}, {620, 300}}, {0.05}};  // a sigma for one pixel of two
+  EXPECT_THROW(tracker.track(0, {frame}), std::invalid_argument);
+  frame.pixel_sigma_px.push_back(0.05);
+  EXPECT_NO_THROW(tracker.track(0, {frame}));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "multi_camera_pose.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -12,9 +13,13 @@
 namespace mocap::volume {
 namespace {
 
-// Every view's pixel residuals, one after the other, at the body pose `world_from_body`.
+// A sigma this small or smaller counts as this: a zero from a detector cannot weigh infinitely.
+constexpr double kSmallestSigmaPx = 1e-3;
+
+// Every view's pixel residuals, one after the other, at the body pose `world_from_body`;
+// `weighted`: each divided by its pixel's sigma.
 std::optional<Eigen::VectorXd> residuals(const std::vector<CameraView>& views, int points,
-                                         const Eigen::Isometry3d& world_from_body) {
+                                         const Eigen::Isometry3d& world_from_body, bool weighted) {
   Eigen::VectorXd values(2 * points);
   Eigen::Index at = 0;
   for (const CameraView& view : views) {
@@ -23,6 +28,9 @@ std::optional<Eigen::VectorXd> residuals(const std::vector<CameraView>& views, i
       auto projected = view.camera->project(camera_from_body * view.body_points[i]);
       if (!projected) return std::nullopt;
       values.segment<2>(at) = *projected - view.pixels[i];
+      if (weighted && !view.pixel_sigma_px.empty()) {
+        values.segment<2>(at) /= std::max(view.pixel_sigma_px[i], kSmallestSigmaPx);
+      }
       at += 2;
     }
   }
@@ -36,7 +44,7 @@ std::vector<CameraView> views_near(const std::vector<CameraDetections>& cameras,
                                    const Eigen::Isometry3d& world_from_body, double radius_px) {
   std::vector<CameraView> views;
   for (const CameraDetections& camera : cameras) {
-    CameraView view{camera.camera, camera.camera_from_world, {}, {}};
+    CameraView view{camera.camera, camera.camera_from_world, {}, {}, {}};
     std::vector<std::optional<Eigen::Vector2d>> projected;
     for (const Eigen::Vector3d& point : body_points) {
       const Eigen::Vector3d in_camera = camera.camera_from_world * world_from_body * point;
@@ -64,6 +72,9 @@ std::vector<CameraView> views_near(const std::vector<CameraDetections>& cameras,
       if (!mutual) continue;
       view.body_points.push_back(body_points[m]);
       view.pixels.push_back(camera.pixels[nearest]);
+      if (!camera.pixel_sigma_px.empty()) {
+        view.pixel_sigma_px.push_back(camera.pixel_sigma_px[nearest]);
+      }
     }
     views.push_back(std::move(view));
   }
@@ -80,8 +91,11 @@ MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
   }
   MultiCameraPose result;
   for (const CameraView& view : views) {
-    if (view.camera == nullptr || view.body_points.size() != view.pixels.size()) {
-      throw std::invalid_argument("a CameraView needs a camera and as many pixels as points");
+    if (view.camera == nullptr || view.body_points.size() != view.pixels.size() ||
+        (!view.pixel_sigma_px.empty() && view.pixel_sigma_px.size() != view.pixels.size())) {
+      throw std::invalid_argument(
+          "a CameraView needs a camera, as many pixels as points and a sigma for each pixel or "
+          "none");
     }
     result.points_used += static_cast<int>(view.body_points.size());
     if (!view.body_points.empty()) ++result.cameras_used;
@@ -92,16 +106,19 @@ MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
     return result;
   }
   const pose::RefinedPose refined = pose::refine_pose(
-      [&](const Eigen::Isometry3d& pose) { return residuals(views, result.points_used, pose); },
+      [&](const Eigen::Isometry3d& pose) {
+        return residuals(views, result.points_used, pose, /*weighted=*/true);
+      },
       start, options.max_iterations);
   if (!refined.valid) {
     result.rejection = "no pose near the start puts every point in front of its camera";
     return result;
   }
   result.world_from_body = refined.pose;
-  result.reprojection_rms_px = std::sqrt(refined.squared_error / result.points_used);
   result.covariance = pose::pose_covariance(refined, 2 * result.points_used);
-  const Eigen::VectorXd final_residuals = *residuals(views, result.points_used, refined.pose);
+  const Eigen::VectorXd final_residuals =
+      *residuals(views, result.points_used, refined.pose, /*weighted=*/false);
+  result.reprojection_rms_px = std::sqrt(final_residuals.squaredNorm() / result.points_used);
   Eigen::Index at = 0;
   for (const CameraView& view : views) {
     const Eigen::Index length = 2 * static_cast<Eigen::Index>(view.body_points.size());

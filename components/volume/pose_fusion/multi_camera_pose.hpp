@@ -30,6 +30,9 @@ struct CameraView {
   Eigen::Isometry3d camera_from_world = Eigen::Isometry3d::Identity();  // the extrinsics
   std::vector<Eigen::Vector3d> body_points;                             // metres, body frame
   std::vector<Eigen::Vector2d> pixels;
+  // Each pixel's 1-sigma error, index by index; empty: all alike. Each point's residual counts
+  // divided by it; the RMS figures stay in pixels.
+  std::vector<double> pixel_sigma_px;
 };
 
 struct MultiCameraPoseOptions {

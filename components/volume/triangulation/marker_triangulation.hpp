@@ -26,6 +26,10 @@ struct CameraDetections {
   const calibration::CameraModel* camera = nullptr;
   Eigen::Isometry3d camera_from_world = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector2d> pixels;  // the markers this camera found, in any order
+  // Each pixel's 1-sigma error (the detector's uncertainty), index by index; empty: all alike.
+  // The fusion weighs each point by it: a faint or merged blob errs several times more than a
+  // bright round one.
+  std::vector<double> pixel_sigma_px;
 };
 
 struct MarkerTriangulationOptions {

@@ -165,7 +165,7 @@ Eigen::Isometry3d board_on_floor(const std::vector<CalibrationCamera>& cameras,
       const pose::PlanarPose pose = pose::estimate_planar_pose(model, board, *pixels);
       if (pose.valid) start = extrinsics.inverse() * pose.camera_from_object;
     }
-    views.push_back({&model, extrinsics, board, std::move(*pixels)});
+    views.push_back({&model, extrinsics, board, std::move(*pixels), {}});
     saw[sighting.camera] = true;
   }
   if (!start) throw VolumeCalibrationError("no camera saw " + where + " whole");

@@ -235,6 +235,7 @@ class VolumeFusion final : public Component {
       frame[c].stamp_ns = to_nanoseconds(message->header().stamp());
       for (const auto& fiducial : message->fiducials()) {
         frame[c].pixels.emplace_back(fiducial.x(), fiducial.y());
+        frame[c].pixel_sigma_px.push_back(fiducial.uncertainty());
       }
     }
     const std::vector<TrackedBodyPose> poses = tracker_.track(assembled.stamp_ns, frame);

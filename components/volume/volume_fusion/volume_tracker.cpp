@@ -72,11 +72,12 @@ std::vector<CameraView> without_outliers(const std::vector<CameraView>& views,
   std::vector<CameraView> kept;
   for (const CameraView& view : views) {
     const std::vector<double> errors = point_errors_px(view, world_from_body);
-    CameraView close{view.camera, view.camera_from_world, {}, {}};
+    CameraView close{view.camera, view.camera_from_world, {}, {}, {}};
     for (size_t i = 0; i < errors.size(); ++i) {
       if (errors[i] > limit_px) continue;
       close.body_points.push_back(view.body_points[i]);
       close.pixels.push_back(view.pixels[i]);
+      if (!view.pixel_sigma_px.empty()) close.pixel_sigma_px.push_back(view.pixel_sigma_px[i]);
     }
     kept.push_back(std::move(close));
   }
@@ -120,10 +121,18 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
   if (frame.size() != cameras_.size()) {
     throw std::invalid_argument("a frame needs one entry per camera");
   }
+  for (const CameraFrame& camera : frame) {
+    if (!camera.pixel_sigma_px.empty() && camera.pixel_sigma_px.size() != camera.pixels.size()) {
+      throw std::invalid_argument("a camera's pixel_sigma_px needs one value per pixel, or none");
+    }
+  }
   std::vector<CameraDetections> detections;
   for (size_t c = 0; c < cameras_.size(); ++c) {
-    CameraDetections camera{cameras_[c].model.get(), cameras_[c].camera_from_world, {}};
-    if (frame[c].received && !health_[c].drifted) camera.pixels = frame[c].pixels;
+    CameraDetections camera{cameras_[c].model.get(), cameras_[c].camera_from_world, {}, {}};
+    if (frame[c].received && !health_[c].drifted) {
+      camera.pixels = frame[c].pixels;
+      camera.pixel_sigma_px = frame[c].pixel_sigma_px;
+    }
     detections.push_back(std::move(camera));
   }
   // A camera stamped a little off the frame's time saw each body moved on by its velocity:
@@ -253,11 +262,13 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
       std::vector<CameraView> others = views;
       others[best].body_points.clear();
       others[best].pixels.clear();
+      others[best].pixel_sigma_px.clear();
       fused = estimate_multi_camera_pose(others, start, options_.fusion);
       if (fused.valid) {
         left_out = best;
         ++health_[best].left_out;
         views[best].pixels.clear();  // its detections stay for others
+        views[best].pixel_sigma_px.clear();
         views[best].body_points.clear();
       }
     }
@@ -315,9 +326,12 @@ void VolumeTracker::take(const std::vector<std::vector<Eigen::Vector2d>>& used,
                          std::vector<CameraDetections>& detections) {
   for (size_t c = 0; c < used.size(); ++c) {
     std::vector<Eigen::Vector2d>& pixels = detections[c].pixels;
+    std::vector<double>& sigmas = detections[c].pixel_sigma_px;
     for (const Eigen::Vector2d& pixel : used[c]) {
       auto it = std::find(pixels.begin(), pixels.end(), pixel);
-      if (it != pixels.end()) pixels.erase(it);
+      if (it == pixels.end()) continue;
+      if (!sigmas.empty()) sigmas.erase(sigmas.begin() + (it - pixels.begin()));
+      pixels.erase(it);
     }
   }
 }

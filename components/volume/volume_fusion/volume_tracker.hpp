@@ -60,6 +60,8 @@ struct CameraFrame {
   bool received = false;  // false: no message from this camera for this capture time
   int64_t stamp_ns = 0;   // its capture time (may differ a little from the frame's)
   std::vector<Eigen::Vector2d> pixels;
+  // Each pixel's 1-sigma error (Fiducial.uncertainty), index by index; empty: all alike.
+  std::vector<double> pixel_sigma_px;
 };
 
 struct TrackedBodyPose {
