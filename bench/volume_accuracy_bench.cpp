@@ -22,12 +22,7 @@
 namespace {
 
 using mocap::volume::test::BodyFrame;
-
-double quantile(std::vector<double> values, double q) {
-  if (values.empty()) return NAN;
-  std::sort(values.begin(), values.end());
-  return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
-}
+using mocap::volume::test::quantile;
 
 struct Errors {
   std::vector<double> position_mm, rotation_deg;

@@ -23,12 +23,7 @@
 namespace {
 
 using namespace mocap::volume;
-
-double quantile(std::vector<double> values, double q) {
-  if (values.empty()) return NAN;
-  std::sort(values.begin(), values.end());
-  return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
-}
+using test::quantile;
 
 // One calibration's row: its cameras against the truth, and the demo's poses fused through
 // them against `on_truth`.

@@ -22,6 +22,7 @@
 #include "constellation_database.hpp"
 #include "fiducial_detector.hpp"
 #include "ir_renderer.hpp"
+#include "rendered_volume.hpp"
 #include "scene.hpp"
 #include "volume_calibration.hpp"
 
@@ -110,20 +111,16 @@ class RenderedCalibrationScenes {
       for (int f = 0; f < frames; ++f) {
         const synthetic::RenderedFrame rendered = renderer.render(
             f / kRateHz, static_cast<uint64_t>(f), true_camera_from_world_[c] * world_from_scene);
-        const auto detections = detector.detect(rendered.image);
+        std::vector<Eigen::Vector2d> detections;
+        for (const auto& fiducial : detector.detect(rendered.image)) {
+          detections.emplace_back(fiducial.x, fiducial.y);
+        }
         BoardSighting sighting{static_cast<int64_t>(f * 1e9 / kRateHz), c, {}};
         bool seen = false;
         for (const synthetic::MarkerTruth& marker : rendered.objects[0].markers) {
-          std::optional<Eigen::Vector2d>& pixel = sighting.pixels.emplace_back();
-          if (!marker.visible) continue;
-          for (const auto& detection : detections) {
-            const Eigen::Vector2d at(detection.x, detection.y);
-            if ((at - marker.pixel).norm() < 1.5 &&
-                (!pixel || (at - marker.pixel).norm() < (*pixel - marker.pixel).norm())) {
-              pixel = at;
-              seen = true;
-            }
-          }
+          sighting.pixels.push_back(marker.visible ? detection_of(detections, marker.pixel)
+                                                   : std::nullopt);
+          seen = seen || sighting.pixels.back().has_value();
         }
         if (seen) out.push_back(std::move(sighting));
       }

@@ -12,6 +12,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,27 @@
 #include "volume_tracker.hpp"
 
 namespace mocap::volume::test {
+
+// The value at quantile q of `values` (nearest rank below); NaN for none.
+inline double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
+}
+
+// The detection nearest a marker's true pixel, if one lies within 1.5 px: how a marker is
+// paired with what the detector found in a rendered frame.
+inline std::optional<Eigen::Vector2d> detection_of(const std::vector<Eigen::Vector2d>& detections,
+                                                   const Eigen::Vector2d& true_pixel) {
+  std::optional<Eigen::Vector2d> nearest;
+  for (const Eigen::Vector2d& pixel : detections) {
+    if ((pixel - true_pixel).norm() < 1.5 &&
+        (!nearest || (pixel - true_pixel).norm() < (*nearest - true_pixel).norm())) {
+      nearest = pixel;
+    }
+  }
+  return nearest;
+}
 
 struct PoseError {
   double position_m = std::numeric_limits<double>::quiet_NaN();
@@ -141,14 +163,8 @@ inline RenderedVolume render_volume(const std::string& config_dir,
         body.most_markers_seen = std::max(body.most_markers_seen, object.visible_markers());
         for (size_t m = 0; m < object.markers.size(); ++m) {
           if (!object.markers[m].visible) continue;
-          const Eigen::Vector2d* nearest = nullptr;
-          for (const Eigen::Vector2d& pixel : detections[c].pixels) {
-            if ((pixel - object.markers[m].pixel).norm() < 1.5 &&
-                (!nearest || (pixel - object.markers[m].pixel).norm() <
-                                 (*nearest - object.markers[m].pixel).norm())) {
-              nearest = &pixel;
-            }
-          }
+          const std::optional<Eigen::Vector2d> nearest =
+              detection_of(detections[c].pixels, object.markers[m].pixel);
           if (!nearest) continue;
           markers.push_back(scene.objects[b].markers[m]);
           pixels.push_back(*nearest);

@@ -19,10 +19,7 @@
 namespace mocap::volume {
 namespace {
 
-double quantile(std::vector<double> values, double q) {
-  std::sort(values.begin(), values.end());
-  return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
-}
+using test::quantile;
 
 // The fused and the best single camera's errors (lowest median position error) on the
 // body-frames both posed, each camera required to pose 100 of them or more.

@@ -65,6 +65,14 @@ double view_median_error_px(const CameraView& view, const Eigen::Isometry3d& wor
   return errors[errors.size() / 2];
 }
 
+// A view with no points left: the camera is left out of the fit. Its pixels' sigmas go with
+// them, so the lists stay index by index.
+void empty_view(CameraView& view) {
+  view.body_points.clear();
+  view.pixels.clear();
+  view.pixel_sigma_px.clear();
+}
+
 // The views without their points further than `limit_px` from where the pose puts them.
 std::vector<CameraView> without_outliers(const std::vector<CameraView>& views,
                                          const Eigen::Isometry3d& world_from_body,
@@ -260,16 +268,12 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     }
     if (best < views.size() && without[best] <= options_.fusion.max_reprojection_rms_px) {
       std::vector<CameraView> others = views;
-      others[best].body_points.clear();
-      others[best].pixels.clear();
-      others[best].pixel_sigma_px.clear();
+      empty_view(others[best]);
       fused = estimate_multi_camera_pose(others, start, options_.fusion);
       if (fused.valid) {
         left_out = best;
         ++health_[best].left_out;
-        views[best].pixels.clear();  // its detections stay for others
-        views[best].pixel_sigma_px.clear();
-        views[best].body_points.clear();
+        empty_view(views[best]);  // its detections stay for others
       }
     }
   }
