@@ -155,7 +155,7 @@ TEST(FiducialDetector, UncertaintyMatchesTheScatterUnderNoise) {
   scene.noise_sigma = 4;
   FiducialDetectorOptions options;
   options.pixel_noise = 4;
-  options.uncertainty_floor_px = 0;
+  options.sampling_error_px = 0;
   FiducialDetector detector(options);
   const double cx = 100.3, cy = 75.6;
   double squared = 0, predicted = 0;
@@ -173,15 +173,71 @@ TEST(FiducialDetector, UncertaintyMatchesTheScatterUnderNoise) {
   EXPECT_GT(mean_predicted, 0.7 * scatter);
   EXPECT_LT(mean_predicted, 1.3 * scatter);
 
-  // Fainter means less certain; the floor is the least any fiducial claims.
+  // Fainter means less certain; without noise what is left is the sampling error.
   scene.noise_seed = 1;
   const double bright = detector.detect(render(scene, {disc(cx, cy, 3.5, 230)}))[0].uncertainty_px;
   const double faint = detector.detect(render(scene, {disc(cx, cy, 3.5, 80)}))[0].uncertainty_px;
   EXPECT_LT(bright, faint);
-  options.uncertainty_floor_px = 0.01;
+  options.sampling_error_px = 0.06;
   options.pixel_noise = 0;
-  EXPECT_DOUBLE_EQ(
-      detect_fiducials(render(scene, {disc(cx, cy, 3.5, 230)}), options)[0].uncertainty_px, 0.01);
+  const DetectedFiducial lone =
+      detect_fiducials(render(scene, {disc(cx, cy, 3.5, 230)}), options)[0];
+  EXPECT_DOUBLE_EQ(lone.uncertainty_px, 0.06 / std::sqrt(lone.area_px));
+}
+
+// Without noise a centroid still keeps some of the pixel grid, the more the smaller the blob;
+// the uncertainty says so (FiducialDetectorOptions::sampling_error_px), and does not claim
+// less than the error these exactly sampled discs show.
+TEST(FiducialDetector, UncertaintyWithoutNoiseFollowsTheBlobSize) {
+  Scene scene;
+  FiducialDetectorOptions options;
+  options.pixel_noise = 0;
+  options.min_circularity = 0;
+  FiducialDetector detector(options);
+  std::vector<double> actual, predicted;
+  for (double radius : {0.8, 3.5}) {
+    double squared = 0, claimed = 0;
+    constexpr int kTrials = 49;
+    for (int trial = 0; trial < kTrials; ++trial) {
+      const double cx = 100 + (trial % 7) / 7.0, cy = 75 + (trial / 7) / 7.0;
+      const auto& found = detector.detect(render(scene, {disc(cx, cy, radius, 200)}));
+      ASSERT_EQ(found.size(), 1u);
+      squared += (std::pow(found[0].x - cx, 2) + std::pow(found[0].y - cy, 2)) / 2;
+      claimed += found[0].uncertainty_px;
+    }
+    actual.push_back(std::sqrt(squared / kTrials));
+    predicted.push_back(claimed / kTrials);
+    EXPECT_GE(predicted.back(), actual.back()) << "radius " << radius;
+  }
+  EXPECT_GT(actual[0], 3 * actual[1]);
+  EXPECT_GT(predicted[0], 2 * predicted[1]);
+  RecordProperty("small_blob_px", fmt::format("{:.4f} claimed {:.4f}", actual[0], predicted[0]));
+  RecordProperty("large_blob_px", fmt::format("{:.4f} claimed {:.4f}", actual[1], predicted[1]));
+}
+
+// Markers a few pixels apart share their centroid windows. Each window is cut to a disc on its
+// own marker's side, so neither flank pulls the other's centroid; the threshold-only centroid
+// it replaced erred by 0.023 px RMS here.
+TEST(FiducialDetector, MarkersCloseTogetherKeepTheirOwnCentroids) {
+  Scene scene;
+  scene.noise_sigma = 1;
+  FiducialDetector detector;
+  for (double gap : {7.0, 8.0}) {
+    double squared = 0;
+    constexpr int kTrials = 25;
+    for (int trial = 0; trial < kTrials; ++trial) {
+      const double cx = 100 + (trial % 5) / 5.0, cy = 75 + (trial / 5) / 5.0;
+      scene.noise_seed = static_cast<unsigned>(trial + 1);
+      const auto& found = detector.detect(
+          render(scene, {disc(cx, cy, 2.0, 220), disc(cx + gap, cy + 0.3 * gap, 2.0, 150)}));
+      ASSERT_EQ(found.size(), 2u) << "gap " << gap;
+      const DetectedFiducial& left = found[0].x < found[1].x ? found[0] : found[1];
+      squared += (std::pow(left.x - cx, 2) + std::pow(left.y - cy, 2)) / 2;
+    }
+    const double rms = std::sqrt(squared / kTrials);
+    EXPECT_LT(rms, 0.015) << "gap " << gap;
+    RecordProperty(fmt::format("rms_px_at_gap_{}", gap), fmt::format("{:.4f}", rms));
+  }
 }
 
 // --- Filters --------------------------------------------------------------------------------

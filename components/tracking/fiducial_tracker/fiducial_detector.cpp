@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -54,6 +55,11 @@ double centroid_sigma(double noise, double weight, double n, double x, double su
   return noise * std::sqrt((spread_x + spread_y) / 2) / weight;
 }
 
+// How much more a threshold-only centroid keeps of the pixel grid than a windowed one
+// (FiducialDetectorOptions::sampling_error_px): 0.19 against 0.06 px·sqrt(pixels) on the
+// volume demo's images.
+constexpr double kThresholdOnlySampling = 3;
+
 // Regions whose bounding box holds more pixels than this are not outlined when their size
 // alone rules them out as round (see circularity()).
 constexpr int64_t kLargestOutlinedBox = 1 << 16;
@@ -82,7 +88,7 @@ void validate(const FiducialDetectorOptions& o) {
   check(o.centroid_level >= 0 && o.centroid_level <= 1,
         "centroid_level must be in [0, 1], got " + std::to_string(o.centroid_level));
   check(o.pixel_noise >= 0, "pixel_noise must not be negative");
-  check(o.uncertainty_floor_px >= 0, "uncertainty_floor_px must not be negative");
+  check(o.sampling_error_px >= 0, "sampling_error_px must not be negative");
 }
 
 // The length and twice the area of the outline where `values` (a patch of `height` rows of
@@ -189,7 +195,6 @@ const std::vector<DetectedFiducial>& FiducialDetector::detect(const cv::Mat& mon
   mark_crowded_regions();
   s.regions = static_cast<int>(regions_.size());
 
-  const double floor_variance = options_.uncertainty_floor_px * options_.uncertainty_floor_px;
   for (int index = 0; index < static_cast<int>(regions_.size()); ++index) {
     const Region& region = regions_[index];
     if (region.pixels < options_.min_area_px) {
@@ -212,8 +217,10 @@ const std::vector<DetectedFiducial>& FiducialDetector::detect(const cv::Mat& mon
       continue;
     }
     Centroid centroid;
-    if (!window_centroid(roi, region, threshold, centroid)) {
+    double sampling_error = options_.sampling_error_px;
+    if (!window_centroid(roi, index, threshold, centroid)) {
       centroid = region_centroid(region, threshold);
+      sampling_error *= kThresholdOnlySampling;
     }
     DetectedFiducial& fiducial = fiducials_.emplace_back();
     fiducial.x = centroid.x + area.x;
@@ -221,7 +228,8 @@ const std::vector<DetectedFiducial>& FiducialDetector::detect(const cv::Mat& mon
     fiducial.area_px = static_cast<double>(region.pixels);
     fiducial.circularity = roundness;
     fiducial.peak = region.peak;
-    fiducial.uncertainty_px = std::sqrt(centroid.sigma * centroid.sigma + floor_variance);
+    fiducial.uncertainty_px = std::sqrt(centroid.sigma * centroid.sigma +
+                                        sampling_error * sampling_error / fiducial.area_px);
     fiducial.touches_border = touches_border;
   }
   s.accepted = static_cast<int>(fiducials_.size());
@@ -246,29 +254,84 @@ FiducialDetector::Centroid FiducialDetector::region_centroid(const Region& regio
 }
 
 // Weights Iᵢ - level over a window around the region (see DetectedFiducial::x). False when
-// the window is off (centroid_margin_px = 0) or another region is near enough to lend it
-// pixels (mark_crowded_regions()).
-bool FiducialDetector::window_centroid(const cv::Mat& roi, const Region& region, double threshold,
+// the window is off (centroid_margin_px = 0) or has no dark surround to take a level from.
+//
+// A crowded region (mark_crowded_regions()) would share its window with another region, whose
+// flank pulls the centroid towards it: falling back to the threshold-only centroid cost
+// 0.12 px RMS on the volume demo's images, five times a lone blob's error. Its window is
+// instead cut to a disc about the region's centre reaching halfway to the nearest
+// neighbour's, which keeps the neighbour out and cuts the region's own flank alike on every
+// side; the disc is centred on the threshold-only centroid first, then once more on the
+// centroid that gives.
+bool FiducialDetector::window_centroid(const cv::Mat& roi, int index, double threshold,
                                        Centroid& out) {
+  const Region& region = regions_[index];
   const int margin = options_.centroid_margin_px;
   if (margin == 0) return false;
-  const int left = std::max(0, region.x_min - margin);
-  const int right = std::min(roi.cols - 1, region.x_max + margin);
-  const int top = std::max(0, region.y_min - margin);
-  const int bottom = std::min(roi.rows - 1, region.y_max + margin);
-  if (right - left < 2 || bottom - top < 2) return false;  // no rim apart from the blob
-  if (region.crowded) return false;
+  Window window;
+  window.left = std::max(0, region.x_min - margin);
+  window.right = std::min(roi.cols - 1, region.x_max + margin);
+  window.top = std::max(0, region.y_min - margin);
+  window.bottom = std::min(roi.rows - 1, region.y_max + margin);
+  if (window.right - window.left < 2 || window.bottom - window.top < 2) return false;
+  if (!region.crowded) return weighted_centroid(roi, window, threshold, out);
 
-  // The local background: the median of the window's rim, which lies beyond the threshold's
-  // reach by `margin` pixels. The median ignores the few rim pixels a blob's flank may reach.
+  const Centroid own = region_centroid(region, threshold);
+  double nearest = std::numeric_limits<double>::infinity();
+  const auto neighbours =
+      std::equal_range(crowding_.begin(), crowding_.end(), std::pair<int, int>(index, -1),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto it = neighbours.first; it != neighbours.second; ++it) {
+    const Centroid other = region_centroid(regions_[it->second], threshold);
+    nearest = std::min(nearest, std::hypot(other.x - own.x, other.y - own.y));
+  }
+  window.radius = nearest / 2;
+  // Below this the disc would cut the blob itself, not its flank.
+  constexpr double kLeastRadiusPx = 2;
+  if (window.radius < kLeastRadiusPx) return false;
+  window.centre_x = own.x;
+  window.centre_y = own.y;
+  if (!weighted_centroid(roi, window, threshold, out)) return false;
+  window.centre_x = out.x;
+  window.centre_y = out.y;
+  return weighted_centroid(roi, window, threshold, out);
+}
+
+bool FiducialDetector::weighted_centroid(const cv::Mat& roi, const Window& window, double threshold,
+                                         Centroid& out) {
+  const int left = window.left, right = window.right, top = window.top, bottom = window.bottom;
+  const bool disc = std::isfinite(window.radius);
+  const double radius_squared = window.radius * window.radius;
+  auto inside = [&](int x, int y) {
+    const double dx = x - window.centre_x, dy = y - window.centre_y;
+    return dx * dx + dy * dy <= radius_squared;
+  };
+
+  // The local background: the median of the rim (of the window, or of its disc), which lies
+  // beyond the threshold's reach. The median ignores the few rim pixels a blob's flank may
+  // reach.
   window_rim_.clear();
-  const uint8_t* top_row = roi.ptr<uint8_t>(top);
-  const uint8_t* bottom_row = roi.ptr<uint8_t>(bottom);
-  window_rim_.insert(window_rim_.end(), top_row + left, top_row + right + 1);
-  window_rim_.insert(window_rim_.end(), bottom_row + left, bottom_row + right + 1);
-  for (int y = top + 1; y < bottom; ++y) {
-    window_rim_.push_back(roi.ptr<uint8_t>(y)[left]);
-    window_rim_.push_back(roi.ptr<uint8_t>(y)[right]);
+  if (!disc) {
+    const uint8_t* top_row = roi.ptr<uint8_t>(top);
+    const uint8_t* bottom_row = roi.ptr<uint8_t>(bottom);
+    window_rim_.insert(window_rim_.end(), top_row + left, top_row + right + 1);
+    window_rim_.insert(window_rim_.end(), bottom_row + left, bottom_row + right + 1);
+    for (int y = top + 1; y < bottom; ++y) {
+      window_rim_.push_back(roi.ptr<uint8_t>(y)[left]);
+      window_rim_.push_back(roi.ptr<uint8_t>(y)[right]);
+    }
+  } else {
+    // Pixels of the window within a pixel inside the disc's edge.
+    const double inner = std::max(0.0, window.radius - 1);
+    for (int y = top; y <= bottom; ++y) {
+      const uint8_t* row = roi.ptr<uint8_t>(y);
+      for (int x = left; x <= right; ++x) {
+        const double dx = x - window.centre_x, dy = y - window.centre_y;
+        const double squared = dx * dx + dy * dy;
+        if (squared <= radius_squared && squared > inner * inner) window_rim_.push_back(row[x]);
+      }
+    }
+    if (window_rim_.size() < 4) return false;
   }
   auto middle = window_rim_.begin() + static_cast<std::ptrdiff_t>(window_rim_.size() / 2);
   std::nth_element(window_rim_.begin(), middle, window_rim_.end());
@@ -284,7 +347,7 @@ bool FiducialDetector::window_centroid(const cv::Mat& roi, const Region& region,
     const uint8_t* row = roi.ptr<uint8_t>(y);
     int64_t row_n = 0, row_i = 0, row_ix = 0, row_x = 0, row_xx = 0;
     for (int x = left; x <= right; ++x) {
-      const int used = row[x] >= first_used ? 1 : 0;
+      const int used = row[x] >= first_used && (!disc || inside(x, y)) ? 1 : 0;
       const int intensity = used * row[x];
       row_n += used;
       row_i += intensity;
@@ -303,7 +366,7 @@ bool FiducialDetector::window_centroid(const cv::Mat& roi, const Region& region,
   }
   const auto count = static_cast<double>(n);
   const double weight = static_cast<double>(sum_i) - level * count;
-  // The region's own pixels are above the threshold, hence above the level.
+  if (weight <= 0) return false;
   out.x = (static_cast<double>(sum_ix) - level * static_cast<double>(sum_x)) / weight;
   out.y = (static_cast<double>(sum_iy) - level * static_cast<double>(sum_y)) / weight;
   out.sigma = centroid_sigma(options_.pixel_noise, weight, count, out.x, static_cast<double>(sum_x),
@@ -419,15 +482,21 @@ void FiducialDetector::collect_regions() {
 // would overlap. Regions come in order of their top row, so for each region only those that
 // start above its bottom (plus the reach) need a look.
 void FiducialDetector::mark_crowded_regions() {
+  crowding_.clear();
   const int reach = 2 * options_.centroid_margin_px;
   const int count = static_cast<int>(regions_.size());
   for (int i = 0; i < count; ++i) {
     Region& a = regions_[i];
     for (int j = i + 1; j < count && regions_[j].y_min <= a.y_max + reach; ++j) {
       Region& b = regions_[j];
-      if (b.x_min <= a.x_max + reach && b.x_max + reach >= a.x_min) a.crowded = b.crowded = true;
+      if (b.x_min <= a.x_max + reach && b.x_max + reach >= a.x_min) {
+        a.crowded = b.crowded = true;
+        crowding_.emplace_back(i, j);
+        crowding_.emplace_back(j, i);
+      }
     }
   }
+  std::sort(crowding_.begin(), crowding_.end());
 }
 
 // Circularity 4πA/P² of the region's iso-line at the threshold: the outline where the

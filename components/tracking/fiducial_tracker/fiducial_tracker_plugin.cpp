@@ -60,8 +60,9 @@ const ParameterList<Settings> kParameters =
              "1-sigma noise of a pixel, grey levels; sets each fiducial's uncertainty",
              &Settings::pixel_noise)
         .min(0)
-        .add("uncertainty_floor_px", "least uncertainty a fiducial reports, pixels",
-             &Settings::uncertainty_floor_px)
+        .add("sampling_error_px",
+             "centroid error of a one-pixel blob without noise; A pixels keep it / sqrt(A)",
+             &Settings::sampling_error_px)
         .min(0)
         .add("reject_border_regions", "reject regions cut by the image or ROI edge (else kept)",
              &Settings::reject_border_regions)
