@@ -77,13 +77,13 @@ TEST(VolumeAccuracy, FusedPosesAreTwiceAsAccurateAsTheBestSingleCamerasOnTheSame
   }
   EXPECT_LE(quantile(errors.fused_deg, 0.95), quantile(errors.camera_deg, 0.95) / 2)
       << "orientation, p95";
-  // The issue asks for 2x at the median too; measured 1.85x here and 1.99x over 20 s
-  // (volume_accuracy_bench). A single camera's orientation, unlike its depth, is nearly as good
-  // as the fusion's: both rest on the same markers' detection errors, so four cameras bring the
-  // square root of four at best, and the best camera is better than the average. Weighing each
-  // point by the detector's uncertainty took it from 1.5x (1.6x over 20 s). Eight cameras reach
-  // it (the next test).
-  EXPECT_LE(quantile(errors.fused_deg, 0.5), quantile(errors.camera_deg, 0.5) / 1.7)
+  // The issue asks for 2x at the median too: measured 2.01x on these 5 s, 2.04x to 2.14x over
+  // 10 to 30 s (volume_accuracy_bench). A single camera's orientation, unlike its depth, is
+  // nearly as good as the fusion's: both rest on the same markers' detection errors, so four
+  // cameras bring the square root of four at best, and the best camera is better than the
+  // average. The bound leaves room for the few hundredths that a build's rounding moves a
+  // median by; eight cameras hold 2x with room (the next test).
+  EXPECT_LE(quantile(errors.fused_deg, 0.5), quantile(errors.camera_deg, 0.5) / 1.9)
       << "orientation, median";
 }
 
@@ -128,7 +128,7 @@ TEST(VolumeAccuracy, NoFusedPoseIsTiltedByAStrayPoint) {
 // cut by an occluder from a side of its own (left, right, top, bottom, 40 %), as
 // VolumeDemo.BoardsNoCameraSeesWholeAreTracked does live; no camera sees a board whole, yet
 // from the frame each board is first identified on, it is posed in at least 99.5 % of frames,
-// none far off.
+// none more than 2 mm or a degree off.
 TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
   test::RenderedVolumeOptions options;
   options.frames = 300;
@@ -155,7 +155,7 @@ TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
     if (!body.fused.posed()) continue;
     ++tracked;
     position_m.push_back(body.fused.position_m);
-    if (body.fused.position_m > 0.05 || body.fused.rotation_deg > 5) ++far_off;
+    if (body.fused.position_m > 2e-3 || body.fused.rotation_deg > 1) ++far_off;
   }
   std::printf(
       "first posed at frames %d, %d, %d, %d; then %d of %d body-frames posed, %.3f mm "

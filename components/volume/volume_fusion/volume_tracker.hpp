@@ -101,6 +101,9 @@ class VolumeTracker {
   const std::vector<CameraHealth>& camera_health() const { return health_; }
   // Bodies identified from triangulated markers (tracks started), over the tracker's life.
   int64_t identifications() const { return identifications_; }
+  // Fits from a track's prediction set aside as unusually poor, the body then looked for
+  // afresh, over the tracker's life.
+  int64_t unusual_fits() const { return unusual_fits_; }
 
  private:
   struct Track {
@@ -111,6 +114,9 @@ class VolumeTracker {
     bool velocity_known = false;
     Eigen::Matrix<double, 6, 6> velocity_covariance = Eigen::Matrix<double, 6, 6>::Zero();
     std::deque<std::pair<int64_t, Eigen::Isometry3d>> history;  // recent poses by stamp
+    // The RMS its poses fused from several cameras usually have (a running average); 0 until
+    // the first.
+    double usual_rms_px = 0;
   };
 
   struct Fused {
@@ -138,6 +144,7 @@ class VolumeTracker {
   std::vector<std::optional<Track>> tracks_;  // per body
   std::vector<CameraHealth> health_;
   int64_t identifications_ = 0;
+  int64_t unusual_fits_ = 0;
 };
 
 }  // namespace mocap::volume
