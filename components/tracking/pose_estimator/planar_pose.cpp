@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 #include <Eigen/SVD>
-#include <opencv2/calib3d.hpp>
 
+#include "ippe.hpp"
 #include "pose_refinement.hpp"
 
 namespace mocap::pose {
@@ -48,7 +48,7 @@ Refined refine(const calibration::CameraModel& camera, const Eigen::Isometry3d& 
 struct UsablePoints {
   std::vector<Eigen::Vector3d> object;
   std::vector<Eigen::Vector2d> image;
-  std::vector<cv::Point2d> rays;
+  std::vector<Eigen::Vector2d> rays;  // normalised: x/z, y/z
 };
 
 UsablePoints usable_points(const calibration::CameraModel& camera,
@@ -61,7 +61,7 @@ UsablePoints usable_points(const calibration::CameraModel& camera,
     if (!ray) continue;
     usable.object.push_back(object_points[i]);
     usable.image.push_back(pixels[i]);
-    usable.rays.emplace_back(ray->x(), ray->y());
+    usable.rays.push_back(ray->head<2>());
   }
   return usable;
 }
@@ -123,32 +123,19 @@ PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
   Eigen::Isometry3d plane_from_object = Eigen::Isometry3d::Identity();
   plane_from_object.linear() = plane_axes.transpose();
   plane_from_object.translation() = -plane_axes.transpose() * origin;
-  std::vector<cv::Point3d> plane_points;
-  for (const auto& p : object) {
-    Eigen::Vector3d q = plane_from_object * p;
-    plane_points.emplace_back(q.x(), q.y(), 0.0);
-  }
+  std::vector<Eigen::Vector2d> plane_points;
+  for (const auto& p : object) plane_points.push_back((plane_from_object * p).head<2>());
 
-  std::vector<cv::Mat> rotations, translations;
-  try {
-    cv::solvePnPGeneric(plane_points, rays, cv::Mat::eye(3, 3, CV_64F), cv::Mat(), rotations,
-                        translations, false, cv::SOLVEPNP_IPPE);
-  } catch (const cv::Exception& e) {
-    result.rejection = fmt::format("IPPE failed: {}", e.what());
+  const auto camera_from_plane = plane_poses(plane_points, rays);
+  if (!camera_from_plane) {
+    result.rejection = "no homography maps the points onto their pixels";
     return result;
   }
   // IPPE's two poses, best first by their pixel error; the second is refined too only when
   // it is nearly as good (a distant or fronto-parallel plane), since refinement may swap them.
   std::vector<std::pair<double, Eigen::Isometry3d>> starts;
-  for (size_t s = 0; s < rotations.size(); ++s) {
-    cv::Mat r;
-    cv::Rodrigues(rotations[s], r);
-    Eigen::Isometry3d camera_from_plane = Eigen::Isometry3d::Identity();
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) camera_from_plane.linear()(i, j) = r.at<double>(i, j);
-      camera_from_plane.translation()(i) = translations[s].at<double>(i);
-    }
-    Eigen::Isometry3d start = camera_from_plane * plane_from_object;
+  for (const Eigen::Isometry3d& pose : *camera_from_plane) {
+    const Eigen::Isometry3d start = pose * plane_from_object;
     if (auto r0 = residuals(camera, start, object, image)) starts.emplace_back(r0->norm(), start);
   }
   std::sort(starts.begin(), starts.end(),

@@ -1,9 +1,9 @@
 // The 6-DoF pose of a planar constellation from its identified image points (seed 000 §5.10),
 // with the seed's proposed false-positive check (§7.3.2): reproject and reject.
 //
-// IPPE (OpenCV's planar PnP) on the undistorted rays gives the two poses a plane can have;
-// each is refined by Gauss–Newton on the pixel reprojection error through the camera model,
-// and the better one is kept. Any CameraModel works, so calibrated EUCM cameras plug in.
+// IPPE (ippe.hpp) on the undistorted rays gives the two poses a plane can have; each is
+// refined by Gauss–Newton on the pixel reprojection error through the camera model, and the
+// better one is kept. Any CameraModel works, so calibrated EUCM cameras plug in.
 #pragma once
 
 #include <string>

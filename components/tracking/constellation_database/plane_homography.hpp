@@ -1,5 +1,5 @@
 // The homography between a constellation's plane and the image: how the identifier checks
-// that lines found separately belong to one flat board.
+// that lines found separately belong to one flat board, and where a planar pose starts.
 #pragma once
 
 #include <optional>
