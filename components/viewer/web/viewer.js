@@ -268,7 +268,9 @@ function drawVolumeCameras() {
       context.arc(f.x * scale, f.y * scale, 5, 0, 2 * Math.PI);
       context.stroke();
     }
-    c.caption.textContent = `${name}: ${fiducials.length} fiducials`;
+    c.caption.textContent = c.fiducials.has(c.frameStamp)
+      ? `${name}: ${fiducials.length} fiducials`
+      : `${name}: its fiducials not yet here`;
     state.volumeImagesDrawn[name] = (state.volumeImagesDrawn[name] ?? 0) + 1;
     state.volumeCirclesDrawn[name] = fiducials.length;
   }
