@@ -195,9 +195,10 @@ class VolumeFusion final : public Component {
     }
     log().info(
         "{} frames fused ({} incomplete, {} skipped while behind), {} body poses ({} from one "
-        "camera), {} identifications, {} late messages dropped{}",
+        "camera), {} identifications, {} fits set aside as unusually poor, {} late messages "
+        "dropped{}",
         fused_frames_, incomplete_frames_, skipped_frames_, body_poses_, single_camera_poses_,
-        tracker_.identifications(), frames_.late_drops(), health);
+        tracker_.identifications(), tracker_.unusual_fits(), frames_.late_drops(), health);
   }
 
  private:
