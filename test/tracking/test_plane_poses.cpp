@@ -31,24 +31,31 @@ struct View {
 View random_view(std::mt19937& random, double noise) {
   std::uniform_real_distribution<double> unit(-1, 1), distance(0.5, 4);
   std::normal_distribution<double> jitter(0, noise);
+  // One draw per statement: the arguments of one call are evaluated in an order the compiler
+  // chooses, which would make the views depend on the build.
+  auto pair = [&](auto& distribution, double sx, double sy) {
+    const double x = sx * distribution(random);
+    return Eigen::Vector2d(x, sy * distribution(random));
+  };
   View view;
-  for (int i = 0; i < 8; ++i) view.plane.emplace_back(0.15 * unit(random), 0.1 * unit(random));
+  for (int i = 0; i < 8; ++i) view.plane.push_back(pair(unit, 0.15, 0.1));
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const auto& p : view.plane) mean += p;
   for (auto& p : view.plane) p -= mean / 8.0;
-  const Eigen::Vector3d tilt_axis(unit(random), unit(random), 0);
+  const Eigen::Vector2d tilt_axis = pair(unit, 1, 1);
+  const double turn = 3.14159265358979 * unit(random);
+  const double tilt = 1.05 * std::abs(unit(random));
   view.truth = Eigen::Isometry3d::Identity();
   view.truth.linear() =
-      (Eigen::AngleAxisd(3.14159265358979 * unit(random), Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(1.05 * std::abs(unit(random)), tilt_axis.normalized()))
+      (Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()) *
+       Eigen::AngleAxisd(tilt, Eigen::Vector3d(tilt_axis.x(), tilt_axis.y(), 0).normalized()))
           .toRotationMatrix();
   const double depth = distance(random);
-  view.truth.translation() =
-      Eigen::Vector3d(0.3 * depth * unit(random), 0.2 * depth * unit(random), depth);
+  const Eigen::Vector2d across = pair(unit, 0.3 * depth, 0.2 * depth);
+  view.truth.translation() = Eigen::Vector3d(across.x(), across.y(), depth);
   for (const auto& p : view.plane) {
     const Eigen::Vector3d seen = view.truth * Eigen::Vector3d(p.x(), p.y(), 0);
-    view.rays.push_back(seen.head<2>() / seen.z() +
-                        Eigen::Vector2d(jitter(random), jitter(random)));
+    view.rays.push_back(seen.head<2>() / seen.z() + pair(jitter, 1, 1));
   }
   return view;
 }

@@ -101,8 +101,9 @@ class VolumeTracker {
   const std::vector<CameraHealth>& camera_health() const { return health_; }
   // Bodies identified from triangulated markers (tracks started), over the tracker's life.
   int64_t identifications() const { return identifications_; }
-  // Fits from a track's prediction set aside as unusually poor, the body then looked for
-  // afresh, over the tracker's life.
+  // Fits from a track's prediction set aside as unusually poor (more than five times the
+  // track's usual RMS), the body then fitted from its last pose or identified afresh, over the
+  // tracker's life.
   int64_t unusual_fits() const { return unusual_fits_; }
 
  private:
