@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -18,7 +19,7 @@ namespace mocap::pose {
 namespace {
 
 double angle_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180 / 3.14159265358979;
+  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180 / std::numbers::pi;
 }
 
 struct View {
@@ -43,7 +44,7 @@ View random_view(std::mt19937& random, double noise) {
   for (const auto& p : view.plane) mean += p;
   for (auto& p : view.plane) p -= mean / 8.0;
   const Eigen::Vector2d tilt_axis = pair(unit, 1, 1);
-  const double turn = 3.14159265358979 * unit(random);
+  const double turn = std::numbers::pi * unit(random);
   const double tilt = 1.05 * std::abs(unit(random));
   view.truth = Eigen::Isometry3d::Identity();
   view.truth.linear() =
