@@ -7,8 +7,8 @@
 # IMAGE: test that image instead of building one (kept at the end).
 # Starts a Docker engine if none answers (and stops only that one at the end), makes the
 # debian:bookworm and debian:bookworm-slim base images with debootstrap if they are missing (no
-# registry is needed), builds the image (docker/Dockerfile; from build/'s package where the
-# tree is built, compiling in the container where it is not) and checks it as a user would: at
+# registry is needed), builds the image (docker/Dockerfile, from the package its build stage
+# would make, made here in build-image/ with the compiler cache) and checks it as a user would: at
 # most 400 MB, runs as the user mocap, `mocap_launch launch_yaml/mobile_mocap_demo.yaml` in it
 # publishes poses. Then starts docker/compose.yaml's four hosts and runs the phases:
 #   start         poses reach the checker container; `mocap_topic list` in another container
@@ -88,23 +88,16 @@ done
 if [ $# -eq 0 ]; then
   build_start=$SECONDS
   built_image=$image
-  build_args=()
-  how="compiled in the container"
-  # A built tree (scripts/test.sh's build/): its package goes into the image as it is, the
-  # binaries the tests ran, instead of a second compilation in the container.
-  # The package the install test made from the same build (test/install/debian_package.sh)
-  # serves when it is newer than the build's last step; otherwise cpack makes it.
-  if [ -f build/CMakeCache.txt ]; then
-    deb=$(ls build/mocap-graph_*_amd64.deb 2> /dev/null | head -1)
-    if [ -z "$deb" ] || [ ! "$deb" -nt build/.ninja_log ]; then
-      rm -f build/mocap-graph_*_amd64.deb
-      (cd build && cpack -G DEB -D CPACK_COMPONENTS_ALL=runtime) > "$work/cpack.log" 2>&1 ||
-        { tail -20 "$work/cpack.log"; fail "cpack in build/"; }
-      deb=$(ls build/mocap-graph_*_amd64.deb)
-    fi
-    build_args=(--build-arg "MOCAP_DEB=$deb")
-    how="from $deb"
-  fi
+  # The image's package is made as the Dockerfile's build stage makes it (scripts/package.sh
+  # --runtime-only, warnings as errors), in a build folder of its own made afresh, so that what
+  # that path builds is checked here; on this machine rather than in the container, so that
+  # the compiler cache serves it. The Dockerfile takes it as MOCAP_DEB.
+  rm -rf build-image
+  MOCAP_PACKAGE_DIR=build-image scripts/package.sh --runtime-only -DMOCAP_WERROR=ON \
+    > "$work/package.log" 2>&1 || { tail -40 "$work/package.log"; fail "scripts/package.sh --runtime-only"; }
+  deb=$(ls build-image/mocap-graph_*_amd64.deb)
+  build_args=(--build-arg "MOCAP_DEB=$deb")
+  how="from $deb (scripts/package.sh --runtime-only, $((SECONDS - build_start)) s)"
   docker build -f docker/Dockerfile "${build_args[@]}" -t "$image" . > "$work/build.log" 2>&1 ||
     { tail -40 "$work/build.log"; fail "docker build"; }
   echo "image: $image built $how in $((SECONDS - build_start)) s"

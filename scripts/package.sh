@@ -9,8 +9,11 @@
 #
 # --runtime-only: compiles what mocap-graph holds and makes that package alone (the container
 # image's build stage). Install with: sudo apt install ./build-package/mocap-graph_*_amd64.deb
+# MOCAP_PACKAGE_DIR: another build folder than build-package/ (scripts/docker_test.sh builds
+# the image's package in a fresh one).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+dir=${MOCAP_PACKAGE_DIR:-build-package}
 target=all
 components=()
 if [ "${1:-}" = "--runtime-only" ]; then
@@ -18,10 +21,10 @@ if [ "${1:-}" = "--runtime-only" ]; then
   target=mocap_runtime_package
   components=(-D CPACK_COMPONENTS_ALL=runtime)
 fi
-cmake -S . -B build-package -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOCAP_BUILD_TESTS=OFF \
+cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMOCAP_BUILD_TESTS=OFF \
   -DMOCAP_BUILD_BENCHMARKS=OFF "$@" > /dev/null
-cmake --build build-package --parallel "$(nproc)" --target "$target"
-cd build-package
+cmake --build "$dir" --parallel "$(nproc)" --target "$target"
+cd "$dir"
 rm -f mocap-graph*_amd64.deb
 cpack -G DEB "${components[@]}" > cpack.log 2>&1 || { cat cpack.log; exit 1; }
 ls "$PWD"/mocap-graph*_amd64.deb

@@ -508,7 +508,8 @@ TEST(Launcher, AGroupThatFailsToStartStopsTheOthers) {
                         "/dev/ttyUSB9"),
             std::string::npos)
       << output;
-  EXPECT_NE(output.find("[launch] group 'broken' exited with code 1; stopping the others"),
+  EXPECT_NE(output.find("[launch] group 'broken' exited with code 1 while starting; stopping the "
+                        "others"),
             std::string::npos)
       << output;
 }

@@ -336,6 +336,41 @@ groups:
   EXPECT_EQ(list[5], "launch.yaml:7: component name 'sink!' must use letters, digits, '_' and '-'");
 }
 
+// What the launcher does when a group's process dies: restarted unless the group says otherwise
+// (group_supervisor.hpp).
+TEST_F(LaunchFileTest, RespawnAndRequiredPerGroup) {
+  LaunchFile file = load(R"(groups:
+  - name: camera
+    components: [{plugin: sequence_source, name: source}]
+  - name: recorder
+    respawn: false
+    components: [{plugin: sequence_sink, name: sink}]
+  - name: compute
+    required: true
+    components: [{plugin: sequence_sink, name: sink2}]
+)");
+  ASSERT_EQ(file.groups.size(), 3u);
+  EXPECT_TRUE(file.groups[0].respawn);
+  EXPECT_FALSE(file.groups[0].required);
+  EXPECT_FALSE(file.groups[1].respawn);
+  EXPECT_FALSE(file.groups[1].required);
+  EXPECT_TRUE(file.groups[2].required);
+  auto list = problems(R"(groups:
+  - name: a
+    respawn: sometimes
+    components: [{plugin: sequence_source, name: source}]
+  - name: b
+    respawn: true
+    required: true
+    components: [{plugin: sequence_sink, name: sink}]
+)");
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0], "launch.yaml:3: 'respawn' must be true or false");
+  EXPECT_EQ(list[1],
+            "launch.yaml:7: group 'b': 'required' ends the deployment when it dies, 'respawn' "
+            "restarts it: choose one");
+}
+
 // The DDS implementation: the file's, a group's own (which wins), and MOCAP_DDS_IMPLEMENTATION
 // when neither says; an unknown name, or what an implementation cannot do, is a problem at its
 // line.

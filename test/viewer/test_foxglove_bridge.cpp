@@ -704,5 +704,74 @@ TEST(FoxgloveBridgeSecurity, TokenAndTlsLetInOnlyWhoShouldComeIn) {
       << page;
 }
 
+// Pages in a browser on this machine: only the bridge's own page opens a WebSocket, another
+// page's request is refused (HTTP 403) unless the launch file lists its origin, and a request
+// naming another host (a page whose name was made to point here) is refused whatever its origin.
+// Programs, which send no Origin, connect as before.
+TEST(FoxgloveBridgeSecurity, OnlyTheBridgesOwnPageAndListedOriginsConnect) {
+  test::TempDir dir;
+  const std::map<std::string, std::string> environment = {
+      {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(36))}};
+  const int port = free_port(), page_port = free_port();
+  const std::string bridge = fmt::format("ws://127.0.0.1:{}/", port);
+  const std::string other_page = fmt::format("http://127.0.0.1:{}", page_port);
+  auto pages = [&] {
+    auto [code, output] = test::run_command({"node", (viewer_tests() / "origin_check.mjs").string(),
+                                             std::to_string(port), std::to_string(page_port)},
+                                            {}, std::chrono::seconds(90));
+    EXPECT_EQ(code, 0) << output;
+    return output;
+  };
+  {
+    test::ChildProcess graph(
+        {(test::bin_dir() / "mocap_launch").string(), bridge_launch_file(dir, port).string()},
+        environment, dir / "default.log");
+    ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+        << graph.output();
+    const std::string said = pages();
+    EXPECT_NE(said.find(R"({"page":")" + other_page + R"(","opened":false})"), std::string::npos)
+        << said << graph.output();
+    EXPECT_NE(said.find(fmt::format(R"({{"page":"http://127.0.0.1:{}","opened":true}})", port)),
+              std::string::npos)
+        << said;
+    EXPECT_NE(said.find(fmt::format(R"({{"host":"attacker.example:{}","status":403}})", port)),
+              std::string::npos)
+        << said;
+    const json refused = {{"opened", false}, {"status", 403}};
+    EXPECT_EQ(secure_client({bridge})["op"], "serverInfo");  // a program: no Origin
+    EXPECT_EQ(secure_client({bridge, "--origin", fmt::format("http://localhost:{}", port)})["op"],
+              "serverInfo");
+    EXPECT_EQ(secure_client({bridge, "--origin", "null"}), refused);
+    EXPECT_EQ(secure_client({bridge, "--origin", "https://app.foxglove.dev"}), refused);
+    EXPECT_EQ(secure_client({bridge, "--host", fmt::format("attacker.example:{}", port), "--origin",
+                             fmt::format("http://attacker.example:{}", port)}),
+              refused);
+    EXPECT_EQ(secure_client({bridge, "--host", fmt::format("attacker.example:{}", port)}), refused);
+    graph.signal(SIGINT);
+    ASSERT_EQ(graph.wait(std::chrono::seconds(30)), 0) << graph.output();
+    const std::string log = graph.output();
+    EXPECT_NE(log.find("refused a request: Origin 'null' is not this bridge's page"),
+              std::string::npos)
+        << log;
+    EXPECT_NE(log.find("refused a request: Host 'attacker.example:"), std::string::npos) << log;
+  }
+  test::ChildProcess graph(
+      {(test::bin_dir() / "mocap_launch").string(),
+       bridge_launch_file(dir, port,
+                          fmt::format("allowed_origins: [\"{}\", \"https://app.foxglove.dev\"], "
+                                      "allowed_hosts: [attacker.example]",
+                                      other_page))
+           .string()},
+      environment, dir / "listed.log");
+  ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+      << graph.output();
+  const std::string said = pages();
+  EXPECT_NE(said.find(R"({"page":")" + other_page + R"(","opened":true})"), std::string::npos)
+      << said << graph.output();
+  EXPECT_EQ(secure_client({bridge, "--origin", "https://app.foxglove.dev"})["op"], "serverInfo");
+  EXPECT_EQ(secure_client({bridge, "--host", fmt::format("attacker.example:{}", port)})["op"],
+            "serverInfo");
+}
+
 }  // namespace
 }  // namespace mocap

@@ -138,6 +138,43 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
 }
 
+// The one-machine form as the README runs it: cam_1's process killed (SIGKILL), as a crash ends
+// it. The launcher starts it again while the compute process fuses the other three, a pose
+// array for every frame; the camera is fused again soon after its death.
+TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
+  test::TempDir dir;
+  const auto summary = dir / "summary.yaml";
+  test::ChildProcess launch(
+      {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "20", "--set",
+       "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+      environment(22), dir / "launch.log");
+  ASSERT_TRUE(launch.wait_for_output("camera cam_1: first fiducials", std::chrono::seconds(30)))
+      << launch.output();
+  std::this_thread::sleep_for(std::chrono::seconds(4));
+  std::smatch pid;
+  const std::string started = launch.output();
+  ASSERT_TRUE(std::regex_search(started, pid, std::regex(R"(group 'cam_1' started \(pid (\d+)\))")))
+      << started;
+  const auto killed = std::chrono::steady_clock::now();
+  ASSERT_EQ(::kill(std::stoi(pid[1]), SIGKILL), 0);
+  ASSERT_TRUE(
+      launch.wait_for_output("camera cam_1: fiducials again after", std::chrono::seconds(20)))
+      << launch.output();
+  const double back_after_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  std::printf("cam_1 fused again %.2f s after its process was killed\n", back_after_s);
+  ASSERT_EQ(launch.wait(std::chrono::seconds(60)), 0) << launch.output();
+  const std::string output = launch.output();
+  EXPECT_NE(output.find("group 'cam_1' was killed by signal 9"), std::string::npos) << output;
+  EXPECT_NE(output.find("group 'cam_1' is running again"), std::string::npos) << output;
+  EXPECT_LE(back_after_s, 2.0) << output;
+  const Figures figures = read_figures(summary);
+  std::printf("%s", test::read_file(summary).c_str());
+  EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << output;
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_EQ(figures.node["false_identifications"].as<int>(), 0) << output;
+}
+
 // cam_1 knocked by half a degree after calibration: the simulator renders it from where it now
 // points, the fusion still has its calibrated pose. It is named as moved, and poses stay right.
 TEST(VolumeDemo, ABumpedCameraIsNamed) {

@@ -39,6 +39,8 @@ const Qos kForwardQos{Reliability::BestEffort, Durability::Volatile, History::Ke
 constexpr std::chrono::seconds kDiscoveryPeriod{1};
 // Client-published messages waiting for the bridge's next turn; beyond, the oldest go.
 constexpr size_t kInboxLimit = 1000;
+// Distinct reasons for refusing a request that are logged; the rest are counted.
+constexpr size_t kRefusalsLogged = 20;
 
 uint64_t nanoseconds(Clock::time_point time) {
   return static_cast<uint64_t>(
@@ -70,6 +72,18 @@ const ParameterList<Settings> kParameters =
              &Settings::server, &WebSocketServerOptions::certificate_file)
         .add("key_file", "the PEM private key of certificate_file", &Settings::server,
              &WebSocketServerOptions::key_file)
+        .add("allowed_origins",
+             "WebSocket clients are taken when their Origin header is absent (programs), is "
+             "this bridge's own page, or is listed here exactly as the browser sends it: "
+             "https://app.foxglove.dev (Foxglove's web app), file:// (Foxglove's and "
+             "Lichtblick's desktop apps), a self-hosted Lichtblick's own, e.g. "
+             "http://localhost:8080; 'null' (a file opened in a browser) only when listed",
+             &Settings::server, &WebSocketServerOptions::allowed_origins)
+        .add("allowed_hosts",
+             "names the bridge answers to beyond localhost, its addresses and this machine's "
+             "host name (a DNS name of the machine, a proxy's): any other Host header is "
+             "refused, so that a page whose name was made to point here cannot read it",
+             &Settings::server, &WebSocketServerOptions::allowed_hosts)
         .add("port", "the TCP port (0: any free port, logged)", &Settings::server,
              &WebSocketServerOptions::port)
         .range(0, 65535)
@@ -139,6 +153,7 @@ class FoxgloveBridge final : public Component {
       closed(client);
     };
     handlers.on_http = [](const std::string& resource) { return serve(resource); };
+    handlers.on_refused = [this](const std::string& why) { refused(why); };
     try {
       server_ = std::make_unique<WebSocketServer>(options, handlers);
     } catch (const std::runtime_error& e) {
@@ -175,8 +190,9 @@ class FoxgloveBridge final : public Component {
     server_.reset();  // joins the server's thread: no handler runs after this
     log().info(
         "foxglove bridge: {} client(s) served, {} message(s) sent, {} dropped; {} received "
-        "from clients, {} dropped",
-        clients_served_, sent_, dropped_, client_messages_, client_messages_dropped_);
+        "from clients, {} dropped; {} request(s) refused for their Host or Origin",
+        clients_served_, sent_, dropped_, client_messages_, client_messages_dropped_,
+        refused_requests_);
   }
 
  private:
@@ -226,6 +242,15 @@ class FoxgloveBridge final : public Component {
       }
     }
     return {};
+  }
+
+  // On the server's thread. Each reason is logged once (a page may retry without end).
+  void refused(const std::string& why) {
+    std::lock_guard lock(refused_mutex_);
+    ++refused_requests_;
+    if (refused_reasons_.size() < kRefusalsLogged && refused_reasons_.insert(why).second) {
+      log().warn("refused a request: {}", why);
+    }
   }
 
   bool offered(const KnownTopic& topic) const {
@@ -645,6 +670,9 @@ class FoxgloveBridge final : public Component {
   uint64_t dropped_ = 0;
   uint64_t client_messages_ = 0;
   uint64_t client_messages_dropped_ = 0;
+  std::mutex refused_mutex_;  // guards what follows
+  std::set<std::string> refused_reasons_;
+  uint64_t refused_requests_ = 0;
   std::unique_ptr<WebSocketServer> server_;  // last: stopped first
 };
 

@@ -3,8 +3,11 @@
 #define ASIO_STANDALONE
 #include "websocket_server.hpp"
 
+#include "origin_policy.hpp"
+
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string_view>
@@ -108,7 +111,12 @@ class Server final : public detail::WebSocketBackend {
     endpoint_.set_http_handler([this](Handle handle) {
       auto con = endpoint_.get_con_from_hdl(handle);
       HttpResponse response;
-      if (handlers_.on_http) response = handlers_.on_http(con->get_resource());
+      if (auto why = policy_->refuse_host(con->get_request_header("Host"))) {
+        refused(*why);
+        response = {403, "text/plain; charset=utf-8", "forbidden: " + *why + "\n"};
+      } else if (handlers_.on_http) {
+        response = handlers_.on_http(con->get_resource());
+      }
       con->set_status(static_cast<websocketpp::http::status_code::value>(response.status));
       con->append_header("Content-Type", response.content_type);
       con->append_header("Cache-Control", "no-cache");
@@ -157,6 +165,11 @@ class Server final : public detail::WebSocketBackend {
     }
     asio::error_code local_error;
     port_ = endpoint_.get_local_endpoint(local_error).port();
+    OriginPolicyOptions policy{port_, std::is_same_v<Config, Tls>, own_host_names(options_.address),
+                               options_.allowed_origins};
+    policy.hosts.insert(policy.hosts.end(), options_.allowed_hosts.begin(),
+                        options_.allowed_hosts.end());
+    policy_ = std::make_unique<OriginPolicy>(std::move(policy));
     thread_ = std::thread([this] { endpoint_.run(); });
   }
 
@@ -229,6 +242,12 @@ class Server final : public detail::WebSocketBackend {
 
   bool validate(Handle handle) {
     auto con = endpoint_.get_con_from_hdl(handle);
+    if (auto why =
+            policy_->refuse(con->get_request_header("Host"), con->get_request_header("Origin"))) {
+      refused(*why);
+      con->set_status(websocketpp::http::status_code::forbidden);
+      return false;
+    }
     if (!options_.token.empty() &&
         !same_secret(presented_token(con->get_request_header("Authorization"), con->get_resource()),
                      options_.token)) {
@@ -246,6 +265,10 @@ class Server final : public detail::WebSocketBackend {
     }
     con->set_status(websocketpp::http::status_code::bad_request);
     return false;
+  }
+
+  void refused(const std::string& why) {
+    if (handlers_.on_refused) handlers_.on_refused(why);
   }
 
   void closed(Handle handle) {
@@ -294,6 +317,7 @@ class Server final : public detail::WebSocketBackend {
 
   WebSocketServerOptions options_;
   WebSocketHandlers handlers_;
+  std::unique_ptr<OriginPolicy> policy_;  // made once the port is known
   // Mutable: websocketpp's lookups are not const, though they change nothing.
   mutable Endpoint endpoint_;
   std::thread thread_;

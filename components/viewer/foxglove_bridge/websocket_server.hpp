@@ -34,6 +34,11 @@ struct WebSocketServerOptions {
   std::vector<std::string> subprotocols;
   // Largest message a client may send; a larger one closes its connection.
   size_t max_incoming_message_bytes = 1 << 20;
+  // Beyond the server's own names and page (origin_policy.hpp): Host names and Origins to
+  // accept. A request with another Host is refused with HTTP 403, as is a WebSocket request
+  // from another page.
+  std::vector<std::string> allowed_hosts;
+  std::vector<std::string> allowed_origins;
 };
 
 // Called on the server's thread. A ClientId is never reused within one server.
@@ -47,6 +52,8 @@ struct WebSocketHandlers {
   std::function<void(ClientId, const std::string& protocol_error)> on_close;
   // GET requests that are not WebSocket upgrades: the resource ("/index.html?x") -> response.
   std::function<HttpResponse(const std::string& resource)> on_http;
+  // A request refused for its Host or Origin header: why, in one line.
+  std::function<void(const std::string& why)> on_refused;
 };
 
 class WebSocketServer {

@@ -40,6 +40,8 @@ using tf2_msgs::msg::TFMessage;
 
 constexpr std::chrono::milliseconds kSingleCameraAlert{500};
 constexpr size_t kMaxBacklog = 2;  // frames fused at once; older ready ones are skipped
+// A camera that misses this many frames in a row is said to be back when it returns.
+constexpr int kGapFramesLogged = 3;
 
 std::chrono::nanoseconds seconds(double s) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
@@ -164,6 +166,7 @@ class VolumeFusion final : public Component {
                  seconds(settings_.silent_after_s)}),
         heard_(tracker_.cameras().size(), false),
         silent_(tracker_.cameras().size(), false),
+        gaps_(tracker_.cameras().size()),
         drifted_(tracker_.cameras().size(), false) {
     poses_ = create_publisher<ConstellationPoseArray>(topics::kPoses);
     alerts_ = create_publisher<Alert>(topics::kAlerts);
@@ -285,6 +288,18 @@ class VolumeFusion final : public Component {
         heard_[c] = true;
         log().info("camera {}: first fiducials", name);
       }
+      // A camera back after a gap too short to call it silent (a restarted process, a busy
+      // host): said, so that a user sees the frames fused without it.
+      Gap& gap = gaps_[c];
+      if (!frame.messages[c]) {
+        if (heard_[c] && gap.frames++ == 0) gap.since_ns = frame.stamp_ns;
+      } else if (gap.frames > 0) {
+        if (gap.frames >= kGapFramesLogged) {
+          log().info("camera {}: fiducials again after {:.2f} s ({} frame(s) fused without it)",
+                     name, static_cast<double>(frame.stamp_ns - gap.since_ns) * 1e-9, gap.frames);
+        }
+        gap = {};
+      }
       if (frame.silent[c] == silent_[c] || !heard_[c]) continue;
       silent_[c] = frame.silent[c];
       if (silent_[c]) {
@@ -341,8 +356,13 @@ class VolumeFusion final : public Component {
 
   VolumeTracker tracker_;
   FrameAssembler<FiducialArray> frames_;
-  std::vector<bool> heard_;    // per camera
-  std::vector<bool> silent_;   // per camera, as last reported
+  std::vector<bool> heard_;   // per camera
+  std::vector<bool> silent_;  // per camera, as last reported
+  struct Gap {
+    int64_t since_ns = 0;  // the first frame without the camera
+    int frames = 0;        // frames without it since
+  };
+  std::vector<Gap> gaps_;      // per camera
   std::vector<bool> drifted_;  // per camera, as last reported
   struct SingleCamera {
     int64_t since_ns = 0;

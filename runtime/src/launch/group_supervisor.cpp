@@ -8,16 +8,30 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include <fmt/format.h>
 
 #include "core/shutdown_signal.hpp"
 
+extern char** environ;
+
 namespace mocap {
 namespace {
 
 constexpr auto kStopGrace = std::chrono::seconds(10);
+// Groups stop themselves at the deployment's end; this long after it, they are stopped.
+constexpr auto kDurationGrace = std::chrono::seconds(15);
+constexpr const char* kReadyFdVariable = "MOCAP_READY_FD";
+// The child's end of its ready pipe.
+constexpr int kReadyFd = 3;
+
+using Time = std::chrono::steady_clock::time_point;
+Time now() { return std::chrono::steady_clock::now(); }
+double seconds(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double>(d).count();
+}
 
 void write_all(int fd, std::string_view text) {
   while (!text.empty()) {
@@ -38,12 +52,25 @@ struct Stream {
 };
 
 struct Child {
+  // Starting: not yet told us it runs. Waiting: dead, to be started again at `restart_at`.
+  // Ended: for good (finished, failed, given up, stopped).
+  enum class State { Starting, Running, Waiting, Ended };
+
   const ChildProcess* spec;
+  RestartPolicy restarts;
+  State state = State::Ended;
   pid_t pid = -1;
   Stream out, err;
-  bool running = false;
-  int exit_code = 0;
+  int ready_fd = -1;  // read end of its ready pipe, while Starting
+  int starts = 0;
+  Time started_at{}, restart_at{};
+  bool alive() const { return state == State::Starting || state == State::Running; }
 };
+
+void close_fd(int& fd) {
+  if (fd >= 0) ::close(fd);
+  fd = -1;
+}
 
 void forward(Child& child, Stream& stream, bool flush_partial) {
   char buffer[4096];
@@ -59,11 +86,8 @@ void forward(Child& child, Stream& stream, bool flush_partial) {
       }
       continue;
     }
-    if (n == 0 && stream.fd >= 0) {  // end of file
-      ::close(stream.fd);
-      stream.fd = -1;
-    }
-    break;  // EAGAIN or closed
+    if (n == 0 && stream.fd >= 0) close_fd(stream.fd);  // end of file
+    break;                                              // EAGAIN or closed
   }
   if ((flush_partial || stream.fd < 0) && !stream.partial.empty()) {
     write_all(stream.target, fmt::format("[{}] {}\n", child.spec->name, stream.partial));
@@ -71,23 +95,42 @@ void forward(Child& child, Stream& stream, bool flush_partial) {
   }
 }
 
-bool start(Child& child) {
-  int out[2], err[2];
+// Starts the child's program with `extra` arguments; false (errno set) when it cannot.
+bool start(Child& child, const std::vector<std::string>& extra) {
+  int out[2], err[2], ready[2];
   if (pipe2(out, O_CLOEXEC) != 0) return false;
   if (pipe2(err, O_CLOEXEC) != 0) {
     close(out[0]);
     close(out[1]);
     return false;
   }
+  if (pipe2(ready, O_CLOEXEC) != 0) {
+    for (int fd : {out[0], out[1], err[0], err[1]}) close(fd);
+    return false;
+  }
   // Everything the child needs is made before fork(): between fork() and exec() only
   // async-signal-safe calls are allowed, since other threads may hold the allocator's locks.
+  std::vector<std::string> args = child.spec->argv;
+  args.insert(args.end(), extra.begin(), extra.end());
   std::vector<char*> argv;
-  for (const std::string& arg : child.spec->argv) argv.push_back(const_cast<char*>(arg.c_str()));
+  for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
-  std::string exec_failed = fmt::format("cannot run {}\n", child.spec->argv.front());
+  const std::string ready_variable = fmt::format("{}={}", kReadyFdVariable, kReadyFd);
+  std::vector<char*> envp;
+  for (char** variable = environ; *variable; ++variable) {
+    if (std::strncmp(*variable, kReadyFdVariable, std::strlen(kReadyFdVariable)) != 0) {
+      envp.push_back(*variable);
+    }
+  }
+  envp.push_back(const_cast<char*>(ready_variable.c_str()));
+  envp.push_back(nullptr);
+  std::string exec_failed = fmt::format("cannot run {}\n", args.front());
   pid_t parent = getpid();
   pid_t pid = fork();
-  if (pid < 0) return false;
+  if (pid < 0) {
+    for (int fd : {out[0], out[1], err[0], err[1], ready[0], ready[1]}) close(fd);
+    return false;
+  }
   if (pid == 0) {
     // Own process group: a terminal's Ctrl-C reaches only the supervisor, which then stops
     // each child exactly once. Die with the supervisor if it is killed.
@@ -96,30 +139,49 @@ bool start(Child& child) {
     if (getppid() != parent) _exit(127);
     dup2(out[1], STDOUT_FILENO);
     dup2(err[1], STDERR_FILENO);
-    execv(argv[0], argv.data());
+    if (ready[1] == kReadyFd) {
+      fcntl(kReadyFd, F_SETFD, 0);  // dup2 onto itself would keep close-on-exec
+    } else {
+      dup2(ready[1], kReadyFd);
+    }
+    execve(argv[0], argv.data(), envp.data());
     [[maybe_unused]] ssize_t ignored =
         ::write(STDERR_FILENO, exec_failed.data(), exec_failed.size());
     _exit(127);
   }
   close(out[1]);
   close(err[1]);
+  close(ready[1]);
   fcntl(out[0], F_SETFL, O_NONBLOCK);
   fcntl(err[0], F_SETFL, O_NONBLOCK);
+  fcntl(ready[0], F_SETFL, O_NONBLOCK);
   child.pid = pid;
-  child.running = true;
+  child.state = Child::State::Starting;
   child.out = {out[0], STDOUT_FILENO, {}};
   child.err = {err[0], STDERR_FILENO, {}};
+  child.ready_fd = ready[0];
+  child.started_at = now();
+  ++child.starts;
   return true;
 }
 
-// The supervision of one set of children: their output, their ends, the stop and its
-// escalation.
+// How a child ended, for messages: "exited with code 3", "was killed by signal 9".
+std::string how_it_ended(int status) {
+  return WIFSIGNALED(status) ? fmt::format("was killed by signal {}", WTERMSIG(status))
+                             : fmt::format("exited with code {}", WEXITSTATUS(status));
+}
+
+// The supervision of one set of children: their output, their ends and restarts, the stop
+// and its escalation.
 class Supervisor {
  public:
-  explicit Supervisor(const std::vector<ChildProcess>& specs) : children_(specs.size()) {
+  Supervisor(const std::vector<ChildProcess>& specs, const SupervisionOptions& options)
+      : options_(options), children_(specs.size()) {
+    if (options_.duration) end_ = now() + *options_.duration;
     for (size_t i = 0; i < specs.size(); ++i) {
       children_[i].spec = &specs[i];
-      if (!start(children_[i])) {
+      children_[i].restarts = RestartPolicy(options_.restarts);
+      if (!start_child(children_[i])) {
         say(fmt::format("cannot start group '{}': {}", specs[i].name, std::strerror(errno)));
         result_ = 1;
         stop_all("");
@@ -129,20 +191,23 @@ class Supervisor {
   }
   ~Supervisor() {
     for (Child& child : children_) {
-      for (Stream* s : {&child.out, &child.err}) {
-        if (s->fd >= 0) close(s->fd);
-      }
+      close_fd(child.out.fd);
+      close_fd(child.err.fd);
+      close_fd(child.ready_fd);
     }
   }
 
-  // Until every child has ended; the exit code (0, or the first failing child's).
-  int run(std::optional<std::chrono::steady_clock::duration> timeout) {
-    const auto deadline = timeout ? now() + *timeout : Time::max();
+  // Until every child has ended; the exit code.
+  int run() {
+    const Time deadline = end_ ? *end_ + kDurationGrace : Time::max();
     for (;;) {
       forward_output();
+      take_ready_notices();
       reap();
-      if (std::none_of(children_.begin(), children_.end(),
-                       [](const Child& child) { return child.running; })) {
+      restart_due();
+      if (std::none_of(children_.begin(), children_.end(), [](const Child& child) {
+            return child.alive() || child.state == Child::State::Waiting;
+          })) {
         return result_;
       }
       if (ShutdownSignal::received()) stop_all("stopping all groups");
@@ -152,58 +217,151 @@ class Supervisor {
   }
 
  private:
-  using Time = std::chrono::steady_clock::time_point;
-  static Time now() { return std::chrono::steady_clock::now(); }
+  bool start_child(Child& child) {
+    std::vector<std::string> extra;
+    if (end_) {
+      extra = {"--duration", fmt::format("{:.3f}", std::max(0.001, seconds(*end_ - now())))};
+    }
+    if (!start(child, extra)) return false;
+    say(fmt::format("group '{}' started (pid {})", child.spec->name, child.pid));
+    return true;
+  }
+
+  void event(int level, std::string text) {
+    say(text);
+    if (options_.on_event) options_.on_event({level, std::move(text)});
+  }
 
   void stop_all(std::string_view why) {
     if (stopping_) return;
     stopping_ = true;
     if (!why.empty()) say(why);
     for (Child& child : children_) {
-      if (child.running) kill(child.pid, SIGTERM);
+      if (child.alive()) kill(child.pid, SIGTERM);
+      if (child.state == Child::State::Waiting) child.state = Child::State::Ended;
     }
     kill_deadline_ = now() + kStopGrace;
   }
 
-  // Waits up to 100 ms for output, and passes on what there is.
+  // Waits up to 100 ms (less when a restart is due) for output or a ready notice, and passes
+  // on the output there is.
   void forward_output() {
     std::vector<pollfd> fds;
+    Time wake = now() + std::chrono::milliseconds(100);
     for (Child& child : children_) {
-      for (Stream* s : {&child.out, &child.err}) {
-        if (s->fd >= 0) fds.push_back({s->fd, POLLIN, 0});
+      for (int fd : {child.out.fd, child.err.fd, child.ready_fd}) {
+        if (fd >= 0) fds.push_back({fd, POLLIN, 0});
       }
+      if (child.state == Child::State::Waiting) wake = std::min(wake, child.restart_at);
     }
-    poll(fds.data(), fds.size(), 100);
+    const auto wait_ms = std::chrono::ceil<std::chrono::milliseconds>(wake - now()).count();
+    poll(fds.data(), fds.size(), static_cast<int>(std::max<int64_t>(0, wait_ms)));
     for (Child& child : children_) {
       forward(child, child.out, false);
       forward(child, child.err, false);
     }
   }
 
-  // Children that have ended: their last output, their exit code; the first to end stops the
-  // others.
-  void reap() {
+  void take_ready_notices() {
     for (Child& child : children_) {
-      if (!child.running) continue;
-      int status = 0;
-      if (waitpid(child.pid, &status, WNOHANG) != child.pid) continue;
-      child.running = false;
-      child.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      forward(child, child.out, true);
-      forward(child, child.err, true);
-      // A group stopped on request by a signal of ours has not failed.
-      bool stopped_by_us = stopping_ && WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM;
-      if (child.exit_code != 0 && !stopped_by_us && result_ == 0) result_ = child.exit_code;
-      if (!stopping_) {
-        stop_all(child.exit_code == 0
-                     ? fmt::format("group '{}' finished; stopping the others", child.spec->name)
-                 : WIFSIGNALED(status)
-                     ? fmt::format("group '{}' was killed by signal {}; stopping the others",
-                                   child.spec->name, WTERMSIG(status))
-                     : fmt::format("group '{}' exited with code {}; stopping the others",
-                                   child.spec->name, child.exit_code));
+      if (child.ready_fd < 0) continue;
+      char byte;
+      const ssize_t n = ::read(child.ready_fd, &byte, 1);
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) continue;
+      close_fd(child.ready_fd);  // told, or its end closed without telling
+      if (n == 1 && child.state == Child::State::Starting) {
+        child.state = Child::State::Running;
+        if (child.starts > 1) {
+          say(fmt::format("group '{}' is running again, {:.2f} s after its start", child.spec->name,
+                          seconds(now() - child.started_at)));
+        }
       }
     }
+  }
+
+  // Children that have ended: their last output, then what their end means.
+  void reap() {
+    for (Child& child : children_) {
+      if (!child.alive()) continue;
+      int status = 0;
+      if (waitpid(child.pid, &status, WNOHANG) != child.pid) continue;
+      take_ready_notices();  // a notice sent just before it died counts
+      const bool had_started = child.state == Child::State::Running;
+      child.state = Child::State::Ended;
+      close_fd(child.ready_fd);
+      forward(child, child.out, true);
+      forward(child, child.err, true);
+      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      if (stopping_) {
+        // A group stopped on request by a signal of ours has not failed.
+        const bool stopped_by_us = WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM;
+        if (code != 0 && !stopped_by_us) fail(code);
+        continue;
+      }
+      ended(child, status, code, had_started);
+    }
+  }
+
+  void ended(Child& child, int status, int code, bool had_started) {
+    const std::string& name = child.spec->name;
+    if (code == 0) {
+      stop_all(fmt::format("group '{}' finished; stopping the others", name));
+      return;
+    }
+    if (!had_started && child.starts == 1) {
+      fail(code);
+      stop_all(fmt::format("group '{}' {} while starting; stopping the others", name,
+                           how_it_ended(status)));
+      return;
+    }
+    const std::string died = fmt::format("group '{}' {} {:.1f} s after its start", name,
+                                         how_it_ended(status), seconds(now() - child.started_at));
+    if (child.spec->required) {
+      fail(code);
+      event(2, died + "; it is required: stopping the others");
+      stop_all("");
+      return;
+    }
+    if (!child.spec->respawn) {
+      fail(code);
+      event(2, died + "; not restarted (respawn: false), the others go on");
+      return;
+    }
+    const std::optional<RestartPolicy::Duration> delay = child.restarts.on_death(now());
+    const RestartPolicyOptions& policy = child.restarts.options();
+    if (!delay) {
+      fail(code);
+      event(2, fmt::format("{}; it died {} times within {} s: given up, the others go on", died,
+                           policy.max_deaths, policy.window.count()));
+      return;
+    }
+    if (end_ && now() + *delay >= *end_) {
+      event(1, died + "; not restarted: the deployment ends first");
+      return;
+    }
+    child.state = Child::State::Waiting;
+    child.restart_at = now() + *delay;
+    event(1, fmt::format("{}; restarting it in {:.2f} s (death {} of {} within {} s before it is "
+                         "given up)",
+                         died, seconds(*delay), child.restarts.deaths_within_window(now()),
+                         policy.max_deaths, policy.window.count()));
+  }
+
+  void restart_due() {
+    for (Child& child : children_) {
+      if (child.state != Child::State::Waiting || now() < child.restart_at) continue;
+      if (!start_child(child)) {
+        fail(1);
+        child.state = Child::State::Ended;
+        event(2, fmt::format("cannot start group '{}' again: {}", child.spec->name,
+                             std::strerror(errno)));
+      }
+    }
+  }
+
+  // The exit code: the first failure's.
+  void fail(int code) {
+    if (result_ == 0) result_ = code;
   }
 
   // A group still running kStopGrace after the request gets a second one, which forces its
@@ -211,7 +369,7 @@ class Supervisor {
   // had their time is killed.
   void escalate() {
     for (Child& child : children_) {
-      if (!child.running) continue;
+      if (!child.alive()) continue;
       if (!forcing_) {
         say(fmt::format("group '{}' did not stop within {} s; forcing its exit", child.spec->name,
                         kStopGrace.count()));
@@ -227,7 +385,9 @@ class Supervisor {
     forcing_ = true;
   }
 
+  const SupervisionOptions& options_;
   std::vector<Child> children_;
+  std::optional<Time> end_;  // of the deployment's duration
   int result_ = 0;
   bool stopping_ = false, forcing_ = false;
   Time kill_deadline_ = Time::max();
@@ -235,10 +395,32 @@ class Supervisor {
 
 }  // namespace
 
-int supervise(const std::vector<ChildProcess>& specs,
-              std::optional<std::chrono::steady_clock::duration> timeout) {
+int supervise(const std::vector<ChildProcess>& specs, const SupervisionOptions& options) {
   ShutdownSignal::install();
-  return Supervisor(specs).run(timeout);
+  return Supervisor(specs, options).run();
+}
+
+SupervisorReadyNotice::SupervisorReadyNotice() {
+  const char* text = std::getenv(kReadyFdVariable);
+  if (text == nullptr) return;
+  const int fd = std::atoi(text);
+  unsetenv(kReadyFdVariable);
+  // Only a pipe's write end is ours to write to.
+  if (fd > STDERR_FILENO && fcntl(fd, F_GETFL) != -1) {
+    fcntl(fd, F_SETFD, FD_CLOEXEC);
+    fd_ = fd;
+  }
+}
+
+SupervisorReadyNotice::~SupervisorReadyNotice() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void SupervisorReadyNotice::started() {
+  if (fd_ < 0) return;
+  write_all(fd_, "1");
+  ::close(fd_);
+  fd_ = -1;
 }
 
 }  // namespace mocap

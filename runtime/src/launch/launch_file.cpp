@@ -390,8 +390,10 @@ class Reader {
     }
     LaunchGroup group;
     group.line = line_of(node);
-    check_keys(node, std::vector<std::string>{"name", "threads", "dds", "components"}, "a group",
-               problems_);
+    check_keys(
+        node,
+        std::vector<std::string>{"name", "threads", "dds", "respawn", "required", "components"},
+        "a group", problems_);
     if (YAML::Node dds = node["dds"]) {
       if (!dds.IsMap()) {
         problems_.record(dds, "a group's 'dds' must be a map with 'implementation'");
@@ -419,6 +421,17 @@ class Reader {
     if (YAML::Node threads = node["threads"]) {
       group.threads =
           static_cast<int>(int_value(threads, "threads", 1, 256, problems_).value_or(0));
+    }
+    if (YAML::Node respawn = node["respawn"]) {
+      group.respawn = bool_value(respawn, "respawn", problems_).value_or(true);
+    }
+    if (YAML::Node required = node["required"]) {
+      group.required = bool_value(required, "required", problems_).value_or(false);
+      if (group.required && node["respawn"] && group.respawn) {
+        problems_.record(required, fmt::format("group '{}': 'required' ends the deployment when "
+                                               "it dies, 'respawn' restarts it: choose one",
+                                               group.name));
+      }
     }
     YAML::Node components = node["components"];
     bool has_components = components && components.IsSequence() && components.size() > 0;

@@ -29,6 +29,10 @@ struct LaunchGroup {
   int threads = 0;
   // The group's own `dds: {implementation: ...}`; empty: the file's.
   std::string dds_implementation;
+  // When its process dies after it has started: started again (respawn), or the deployment
+  // ends (required); neither: it stays down and the others go on (group_supervisor.hpp).
+  bool respawn = true;
+  bool required = false;
   std::vector<LaunchComponent> components;
   int line = 0;
 };

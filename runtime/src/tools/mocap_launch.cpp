@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "core/plugin_loader.hpp"
 #include "launch/group_supervisor.hpp"
 #include "launch/launch_file.hpp"
+#include "tools/launch_alerts.hpp"
 
 namespace {
 
@@ -26,8 +28,8 @@ constexpr const char* kUsage = R"(usage:
   mocap_launch --plugins
 
 Runs the components of a launch file (launch_yaml/README.md describes the format).
-  FILE             every group runs as its own child process, output prefixed with [group];
-                   a single-group file runs in this process
+  FILE             every group runs as its own child process, output prefixed with [group],
+                   restarted when it dies (below); a single-group file runs in this process
   --group NAME     run only this group, in this process (one host's share of a deployment)
   --set C.P=V      set parameter P of component C to V (YAML: 3, 0.5, true, [1, 2], text)
   --duration S     stop after S seconds (default, or 0: run until Ctrl-C)
@@ -38,6 +40,16 @@ Runs the components of a launch file (launch_yaml/README.md describes the format
   --plugins        list the plugins on the search path (MOCAP_PLUGIN_PATH, then
                    lib/mocap_graph/plugins beside bin/)
 Environment: MOCAP_DOMAIN_ID overrides the DDS domain, MOCAP_LOG_LEVEL=debug|info|warn|error.
+
+A group whose process dies after it has started (a signal, a non-zero exit) is started again
+after 0.25 s, the wait doubling with each death within 60 s, for what is left of --duration;
+the others go on. Its launch-file keys change that: `respawn: false` leaves it down,
+`required: true` ends the deployment. One that dies 5 times within 60 s is given up on. A
+group that exits with code 0 ends the deployment, as does one that fails while starting.
+Restarts and give-ups are logged and published on /alerts (mocap_msgs/Alert) by this process's
+DDS participant "launch".
+Exit code: 0, or that of the first group that failed for good (128 + N for signal N): it
+failed to start, a required group died, or one was given up on or not restarted.
 )";
 
 [[noreturn]] void usage_error(std::string_view message) {
@@ -69,7 +81,8 @@ std::string describe(const mocap::LoadedPlugin& plugin) {
 }
 
 int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
-              std::optional<double> duration, const std::string& health_file) {
+              std::optional<double> duration, const std::string& health_file,
+              mocap::SupervisorReadyNotice& ready) {
   try {
     mocap::ComponentHost host(
         {group.name, group.threads, file.dds_of(group), mocap::known_topics(file), health_file});
@@ -81,6 +94,8 @@ int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
         return 1;
       }
     }
+    host.start();
+    ready.started();
     std::optional<std::chrono::duration<double>> run_for;
     if (duration) run_for = std::chrono::duration<double>(*duration);
     return host.run(run_for);
@@ -161,14 +176,11 @@ int run_groups(const mocap::LaunchFile& launch, const Options& options) {
   std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
   std::vector<mocap::ChildProcess> children;
   for (const mocap::LaunchGroup& g : launch.groups) {
-    mocap::ChildProcess child{g.name, {self, *options.file, "--group", g.name}};
+    mocap::ChildProcess child{
+        g.name, {self, *options.file, "--group", g.name}, g.respawn, g.required};
     for (const std::string& text : options.set_texts) {
       child.argv.push_back("--set");
       child.argv.push_back(text);
-    }
-    if (options.duration) {
-      child.argv.push_back("--duration");
-      child.argv.push_back(fmt::format("{}", *options.duration));
     }
     if (!options.health_file.empty()) {
       child.argv.push_back("--health-file");
@@ -176,18 +188,30 @@ int run_groups(const mocap::LaunchFile& launch, const Options& options) {
     }
     children.push_back(std::move(child));
   }
-  std::optional<std::chrono::steady_clock::duration> timeout;
+  mocap::SupervisionOptions supervision;
   if (options.duration) {
-    // The groups stop themselves; this is for a group that does not.
-    timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(*options.duration + 15.0));
+    supervision.duration = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(*options.duration));
   }
-  return mocap::supervise(children, timeout);
+  std::unique_ptr<mocap::LaunchAlerts> alerts;
+  if (launch.dds.enabled) {
+    try {
+      alerts = std::make_unique<mocap::LaunchAlerts>(launch.dds);
+      supervision.on_event = [&alerts](const mocap::SupervisorEvent& event) {
+        alerts->publish(event);
+      };
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "[launch] restarts will not be published on /alerts: {}\n", e.what());
+    }
+  }
+  return mocap::supervise(children, supervision);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before anything else runs: the variable is not for the programs this one starts.
+  mocap::SupervisorReadyNotice ready;
   const Options options = parse_arguments({argv + 1, argv + argc});
   if (options.help) {
     fmt::print("{}", kUsage);
@@ -236,6 +260,6 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!group && launch.groups.size() == 1) group = &launch.groups.front();
-  if (group) return run_group(launch, *group, options.duration, options.health_file);
+  if (group) return run_group(launch, *group, options.duration, options.health_file, ready);
   return run_groups(launch, options);
 }
