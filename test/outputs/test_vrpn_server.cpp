@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -306,6 +307,44 @@ TEST(VrpnServer, ListensOnThisMachineOnlyUnlessTheLaunchFileOpensIt) {
   const std::string warning = "Open to the network: any host that reaches port 3883 may connect";
   EXPECT_NE(log.find(warning), std::string::npos) << log;
   EXPECT_EQ(log.find(warning), log.rfind(warning)) << log;
+}
+
+// A request from host B naming host A (the server's own host, where a service listens that
+// only A should reach): the server connects back to B, whose datagram it was, and only once
+// however often B asks while that connection is under way; A's service sees nothing.
+TEST(VrpnServer, ConnectsBackOnlyToTheRequestsSource) {
+  test::TwoHosts hosts;
+  if (!hosts.error().empty()) GTEST_SKIP() << "cannot make network namespaces: " << hosts.error();
+  test::TempDir dir;
+  const std::string probe =
+      (test::source_dir() / "test" / "outputs" / "connect_back_probe.mjs").string();
+  const std::filesystem::path file = dir / "open.yaml";
+  test::write_file(file,
+                   "groups:\n  - name: g\n    components:\n      - plugin: vrpn_server\n"
+                   "        name: vrpn\n        parameters: {address: 0.0.0.0}\n");
+  test::ChildProcess graph(hosts.on_a({(test::bin_dir() / "mocap_launch").string(), file.string()}),
+                           {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(37))}},
+                           dir / "graph.log");
+  ASSERT_TRUE(graph.wait_for_output("VRPN trackers", std::chrono::seconds(30))) << graph.output();
+  test::ChildProcess on_a(hosts.on_a({"node", probe, "listen", "4500", "4"}), {}, dir / "a.log");
+  test::ChildProcess on_b(hosts.on_b({"node", probe, "listen", "4500", "4"}), {}, dir / "b.log");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // both listening
+  const auto [code, output] =
+      test::run_command(hosts.on_b({"node", probe, "lob", hosts.address_a(), "3883",
+                                    hosts.address_a() + " 4500", "5"}),
+                        {}, std::chrono::seconds(30));
+  ASSERT_EQ(code, 0) << output;
+  ASSERT_EQ(on_a.wait(std::chrono::seconds(20)), 0) << on_a.output();
+  ASSERT_EQ(on_b.wait(std::chrono::seconds(20)), 0) << on_b.output();
+  EXPECT_EQ(json::parse(on_a.output()), (json{{"connections", 0}, {"from", json::array()}}));
+  EXPECT_EQ(json::parse(on_b.output()),
+            (json{{"connections", 1}, {"from", json::array({hosts.address_a()})}}));
+  graph.signal(SIGINT);
+  ASSERT_EQ(graph.wait(std::chrono::seconds(30)), 0) << graph.output();
+  EXPECT_NE(graph.output().find("5 connection requests (0 malformed, 5 naming another host than "
+                                "their source, 4 not followed)"),
+            std::string::npos)
+      << graph.output();
 }
 
 TEST(VrpnServer, BadAddressesAreNamed) {

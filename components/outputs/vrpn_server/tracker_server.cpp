@@ -9,10 +9,12 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -30,6 +32,9 @@ constexpr int32_t kVelocity = 1;
 constexpr int32_t kPong = 2;
 
 constexpr std::chrono::milliseconds kPollPeriod{200};
+// Connections made back to one UDP request source within the window, at most.
+constexpr size_t kMaxConnectBacksPerSource = 4;
+constexpr std::chrono::seconds kConnectBackWindow{10};
 
 std::string errno_text() { return std::strerror(errno); }
 
@@ -79,6 +84,8 @@ struct Client {
   MessageReader reader;
   std::map<int32_t, std::string> their_types, their_senders;
   bool closing = false;
+  // A connection this server made back to a UDP request's source (that address), or 0.
+  in_addr_t connected_back_to = 0;
 
   size_t queued() const { return out.size() - sent; }
 };
@@ -98,6 +105,8 @@ struct TrackerServer::Impl {
   std::map<int32_t, std::string> latest_report;  // id -> its last Pos_Quat and Velocity
   uint32_t sequence = 0;
   TrackerServerStats stats;
+  // Connections made back to each UDP request source within kConnectBackWindow.
+  std::map<in_addr_t, std::deque<std::chrono::steady_clock::time_point>> connect_backs;
 
   std::atomic<bool> stopping{false};
   std::thread thread;
@@ -287,23 +296,58 @@ struct TrackerServer::Impl {
     }
   }
 
+  // A UDP request names an address and a port; the connection goes to that port on the address
+  // the datagram came from, whatever it names, so that nobody can make this server open
+  // connections to a third host. A datagram's source can be forged, so each source gets at most
+  // one connection under way and kMaxConnectBacksPerSource within kConnectBackWindow (VRPN's
+  // client asks again every 2 s until it is connected).
   void connect_back(char* buffer, size_t size) {
-    for (ssize_t n; (n = ::recv(udp_fd, buffer, size, 0)) >= 0;) {
-      auto address = parse_request(std::string_view(buffer, static_cast<size_t>(n)));
-      if (!address) {
+    for (;;) {
+      sockaddr_in source{};
+      socklen_t length = sizeof source;
+      const ssize_t n =
+          ::recvfrom(udp_fd, buffer, size, 0, reinterpret_cast<sockaddr*>(&source), &length);
+      if (n < 0) return;
+      auto request = parse_request(std::string_view(buffer, static_cast<size_t>(n)));
+      if (!request || source.sin_family != AF_INET) {
         ++stats.bad_requests;
         continue;
       }
       ++stats.connection_requests;
-      if (!room_for_one_more()) continue;
+      if (request->sin_addr.s_addr != source.sin_addr.s_addr) ++stats.requests_naming_another_host;
+      if (!may_connect_back_to(source.sin_addr.s_addr) || !room_for_one_more()) continue;
+      sockaddr_in address = source;
+      address.sin_port = request->sin_port;
       const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-      if (::connect(fd, reinterpret_cast<const sockaddr*>(&*address), sizeof *address) != 0 &&
+      if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0 &&
           errno != EINPROGRESS) {
         ::close(fd);
         continue;
       }
       add_client(fd, Client::State::Connecting);
+      clients.back()->connected_back_to = source.sin_addr.s_addr;
+      connect_backs[source.sin_addr.s_addr].push_back(std::chrono::steady_clock::now());
     }
+  }
+
+  bool may_connect_back_to(in_addr_t source) {
+    const auto now = std::chrono::steady_clock::now();
+    for (auto entry = connect_backs.begin(); entry != connect_backs.end();) {
+      auto& times = entry->second;
+      while (!times.empty() && now - times.front() >= kConnectBackWindow) times.pop_front();
+      entry = times.empty() ? connect_backs.erase(entry) : std::next(entry);
+    }
+    const bool under_way = std::any_of(clients.begin(), clients.end(), [&](const auto& client) {
+      return client->connected_back_to == source && client->state != Client::State::Connected &&
+             !client->closing;
+    });
+    auto made = connect_backs.find(source);
+    if (under_way ||
+        (made != connect_backs.end() && made->second.size() >= kMaxConnectBacksPerSource)) {
+      ++stats.connect_backs_limited;
+      return false;
+    }
+    return true;
   }
 
   void serve(Client& client, short revents, char* buffer, size_t size) {

@@ -3,7 +3,10 @@
 //
 // A VRPN client reaches it either way VRPN's own client library does: "Tracker0@host" lobs a
 // UDP datagram "ADDRESS PORT" to the server's port and waits for the server to connect back to
-// that TCP port; "Tracker0@tcp://host" connects to the server's TCP port directly. Both ends
+// that TCP port; "Tracker0@tcp://host" connects to the server's TCP port directly. The server
+// connects back to the port on the datagram's source address, never to another host the
+// datagram names (VRPN's client names the address it sends from), at most 4 times in 10 s per
+// source. Both ends
 // then send their cookie; once the client's has come, the server describes its types and
 // trackers, sends each tracker's latest report, and from then on every report. Everything goes
 // over TCP (the server announces no UDP port, as a VRPN server behind a firewall does).
@@ -37,7 +40,12 @@ struct TrackerServerStats {
   uint64_t clients_refused = 0;      // not VRPN, or over max_clients
   uint64_t connection_requests = 0;  // UDP requests to connect back
   uint64_t bad_requests = 0;         // UDP datagrams that were no such request
-  uint64_t reports = 0;              // report() calls
+  // Requests naming another address than their datagram's source (the connection still goes
+  // to the source), and requests not followed: a connection to that source under way already,
+  // or its limit reached.
+  uint64_t requests_naming_another_host = 0;
+  uint64_t connect_backs_limited = 0;
+  uint64_t reports = 0;  // report() calls
   uint64_t pongs = 0;
 };
 

@@ -97,9 +97,11 @@ class VrpnServer final : public Component {
     const TrackerServerStats s = server_->stats();
     log().info(
         "VRPN: {} reports; {} clients served, {} left, {} dropped too slow, {} refused; "
-        "{} connection requests ({} malformed), {} pongs",
+        "{} connection requests ({} malformed, {} naming another host than their source, {} not "
+        "followed), {} pongs",
         s.reports, s.clients_connected, s.clients_closed, s.clients_too_slow, s.clients_refused,
-        s.connection_requests, s.bad_requests, s.pongs);
+        s.connection_requests, s.bad_requests, s.requests_naming_another_host,
+        s.connect_backs_limited, s.pongs);
   }
 
  private:
