@@ -3,7 +3,9 @@
 # through the volume (launch_yaml/volume_calibration.yaml, config/volume/calibration_wave.yaml)
 # and then lying on the floor at each mark (config/volume/calibration_floor.yaml, moved there),
 # each into a bag, and solves them with mocap_volume_calibrate, which writes the four camera
-# files with their calibrated poses into OUTPUT/cameras.
+# files with their calibrated poses into OUTPUT/cameras. In OUTPUT it writes (and replaces)
+# waved/ and floor_X_Y[_turned]/ (the bags), their .log and .yaml files and cameras/, nothing
+# else.
 #
 #   scripts/calibrate_volume.sh OUTPUT [--wave SECONDS] [--floor SECONDS] [--marks "X,Y ..."]
 #
@@ -19,7 +21,7 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin_dir="${MOCAP_BIN_DIR:-$root/build/bin}"
 usage() {
-  sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d; s/^# \{0,1\}//'
   exit 2
 }
 [ $# -ge 1 ] || usage
@@ -36,7 +38,8 @@ while [ $# -gt 0 ]; do
 done
 launch="$root/launch_yaml/volume_calibration.yaml"
 mkdir -p "$out"
-rm -rf "$out"/waved "$out"/floor*
+# Each bag goes into a folder of its own name, written afresh; nothing else in OUTPUT is touched.
+rm -rf "$out/waved"
 echo "calibrate_volume: recording ${wave_s} s of the board carried through the volume"
 "$bin_dir/mocap_launch" "$launch" --duration "$wave_s" --set "recorder.output=$out/waved" \
   > "$out/waved.log" 2>&1 || { tail -n 20 "$out/waved.log"; exit 1; }
@@ -61,6 +64,7 @@ for mark in $marks; do
       "turned ${turn} deg"
     on_floor=()
     for c in 0 1 2 3; do on_floor+=(--set "cam_$c.scene=$out/$name.yaml"); done
+    rm -rf "${out:?}/$name"
     "$bin_dir/mocap_launch" "$launch" --duration "$floor_s" --set "recorder.output=$out/$name" \
       "${on_floor[@]}" > "$out/$name.log" 2>&1 || { tail -n 20 "$out/$name.log"; exit 1; }
     floors+=(--floor "$out/$name:$x,$y")

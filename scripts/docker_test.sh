@@ -57,7 +57,7 @@ cleanup() {
     kill "$dockerd_pid" 2>/dev/null || true
     wait "$dockerd_pid" 2>/dev/null || true
   fi
-  rm -rf "$work"
+  "$root/scripts/remove_tree.sh" "$work"
   exit $status
 }
 trap cleanup EXIT
@@ -81,7 +81,7 @@ for tag in bookworm bookworm-slim; do
   scripts/make_debian_root.sh $option "$work/rootfs" || fail "no Debian 12 root for debian:$tag"
   rm -rf "$work/rootfs/var/lib/apt/lists/"*
   tar -C "$work/rootfs" -c . | docker import - "debian:$tag" > /dev/null
-  rm -rf "$work/rootfs"
+  scripts/remove_tree.sh "$work/rootfs"
 done
 
 # --- image

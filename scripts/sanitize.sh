@@ -2,9 +2,9 @@
 # Builds the tests under sanitizers with clang and runs them; any report fails the run.
 #
 #   scripts/sanitize.sh address [CTEST ARGS]  AddressSanitizer, LeakSanitizer and
-#       UndefinedBehaviorSanitizer in build-asan/: every test but the few only the plain
-#       build runs (scripts/test_lists.sh), and the fuzzers (scripts/fuzz.sh runs them from
-#       this build).
+#       UndefinedBehaviorSanitizer in build-asan/: the tests of the part `address` (all but the
+#       few only the plain build runs: test/CMakeLists.txt), and the fuzzers (scripts/fuzz.sh
+#       runs them from this build).
 #   scripts/sanitize.sh thread [CTEST ARGS]   ThreadSanitizer in build-tsan/: the threaded
 #       parts (below) and their tests, and only those.
 #   scripts/sanitize.sh MODE --build-only     builds, runs nothing.
@@ -54,9 +54,8 @@ cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=
   -DMOCAP_WERROR=ON -DMOCAP_BUILD_TESTS=ON -DMOCAP_BUILD_BENCHMARKS=OFF > /dev/null
 if [ "$mode" = address ]; then
   cmake --build "$build" --parallel "$(nproc)"
-  # Every test but those only the plain build runs (scripts/test_lists.sh).
-  source scripts/test_lists.sh
-  filter=(-E "^($plain_only_tests)\$")
+  # Every test but those only the plain build runs (test/CMakeLists.txt: the parts of CI).
+  filter=(-L '^address$')
 else
   # The threaded parts and their tests (above), and only those.
   cmake --build "$build" --parallel "$(nproc)" --target mocap_unit_tests \
@@ -66,12 +65,12 @@ else
     mocap_test_foxglove_bridge mocap_test_pixart_bridge mocap_test_pixart_box_sim \
     mocap_test_can_io mocap_test_ax12_sim mocap_test_dynamixel_bus mocap_test_turret_follower \
     mocap_test_camera_source
-  # Not the tests only the plain build runs (scripts/test_lists.sh: real-time speed, slow
+  # Not the tests only the plain build runs (test/CMakeLists.txt: real-time speed, slow
   # subscribers, packaging).
-  source scripts/test_lists.sh
-  filter=(-R "$tsan_tests")
+  filter=(-R "$tsan_tests" -L '^address$')
 fi
 $build_only && exit 0
+cmake -DBUILD="$build" -P scripts/check_test_parts.cmake
 # The tests' independent clients and readers (pinned in test/package-lock.json).
 npm ci --prefix test --no-audit --no-fund --loglevel=error
 # Two tests per core: they wait on processes, discovery and the network much of the time (one
@@ -87,7 +86,7 @@ fi
 # its last sample (cyclonedds ARestartedSubscriberProcessReceivesAgain/BusyCoresAndSlowSubscriber).
 busy_cores='(cyclonedds\.)?Dds/ReliableUnderLoad\..*/BusyCores.*'
 MOCAP_TEST_PARALLEL=$parallel scripts/run_tests.sh "$build" "$mode sanitizer" "${filter[@]}" \
-  -E "^($plain_only_tests|$busy_cores)\$" "$@"
+  -E "^($busy_cores)\$" "$@"
 # (All of them DDS tests, which the threaded parts include.)
 MOCAP_TEST_PARALLEL=${MOCAP_TEST_PARALLEL:-$(nproc)} scripts/run_tests.sh "$build" \
-  "$mode sanitizer, busy cores" -R "^($busy_cores)\$" -E "^($plain_only_tests)\$" "$@"
+  "$mode sanitizer, busy cores" -R "^($busy_cores)\$" -L '^address$' "$@"

@@ -4,10 +4,11 @@
 #   scripts/test.sh [plain] [address]   (both by default)
 #
 # plain: builds with g++ and warnings as errors what the package, the Docker image, the
-#   benchmarks and the soak use, and the tests the sanitizer build cannot run (scripts/
-#   test_lists.sh says which and why; the other tests are configured in build/ but compiled only
-#   in the sanitizer build: `cmake --build build --target <test>` builds one here), checks
-#   formatting, and runs those tests.
+#   benchmarks and the soak use, and the tests the sanitizer build cannot run (the parts plain,
+#   realtime and busy_cores: test/CMakeLists.txt says which and why; the other tests are
+#   configured in build/ but compiled only in the sanitizer build: `cmake --build build --target
+#   <test>` builds one here), checks formatting and that every test is in one part, and runs
+#   those tests.
 # address: every other test under AddressSanitizer and UndefinedBehaviorSanitizer
 #   (scripts/sanitize.sh address).
 set -euo pipefail
@@ -15,10 +16,21 @@ cd "$(dirname "$0")/.."
 parts=("$@")
 [ ${#parts[@]} -gt 0 ] || parts=(plain address)
 scripts/install_deps.sh all
-source scripts/test_lists.sh
-# Pauses (STOP) or resumes (CONT) the process group MOCAP_BACKGROUND_PGID names, if any.
+# Pauses (STOP) or resumes (CONT) what MOCAP_BACKGROUND_PGID names, if anything: that process
+# group and every process below it (the compilers ninja starts have process groups of their
+# own). On resuming, says how much processor time it took while paused.
+paused_at_cpu=""
 background() {
-  [ -z "${MOCAP_BACKGROUND_PGID:-}" ] || kill -"$1" -- "-$MOCAP_BACKGROUND_PGID" 2> /dev/null || true
+  [ -n "${MOCAP_BACKGROUND_PGID:-}" ] || return 0
+  if [ "$1" = STOP ]; then
+    scripts/process_tree.sh STOP "$MOCAP_BACKGROUND_PGID"
+    paused_at_cpu=$(scripts/process_tree.sh cpu "$MOCAP_BACKGROUND_PGID")
+  else
+    [ -z "$paused_at_cpu" ] ||
+      echo "test.sh: the background took $(awk -v a="$paused_at_cpu" -v b="$(scripts/process_tree.sh cpu "$MOCAP_BACKGROUND_PGID")" 'BEGIN { printf "%.1f", b - a }') s of processor time while paused"
+    paused_at_cpu=""
+    scripts/process_tree.sh CONT "$MOCAP_BACKGROUND_PGID"
+  fi
 }
 trap 'background CONT' EXIT
 for part in "${parts[@]}"; do
@@ -28,17 +40,17 @@ for part in "${parts[@]}"; do
         -DMOCAP_BUILD_TESTS_IN_ALL=OFF
       cmake --build build --parallel "$(nproc)" --target mocap_plain_tests
       scripts/check_format.sh
+      cmake -DBUILD=build -P scripts/check_test_parts.cmake
       # The tests' independent clients and readers (pinned in test/package-lock.json).
       npm ci --prefix test --no-audit --no-fund --loglevel=error
       # Nothing beside them: what CI runs in the background (.ci/run) is paused meanwhile.
       background STOP
-      MOCAP_TEST_PARALLEL=1 scripts/run_tests.sh build "plain, real time" -R "^($realtime_tests)\$"
+      MOCAP_TEST_PARALLEL=1 scripts/run_tests.sh build "plain, real time" -L '^realtime$'
       background CONT
       # Side by side: the slow-subscriber loads are paced by their subscribers and the package
       # tests wait on dpkg and a compiler; then the loads that keep every core busy.
-      MOCAP_TEST_PARALLEL=4 scripts/run_tests.sh build plain -R "^($plain_only_tests)\$" \
-        -E "^($realtime_tests|$busy_core_tests)\$"
-      scripts/run_tests.sh build "plain, busy cores" -R "^($busy_core_tests)\$"
+      MOCAP_TEST_PARALLEL=4 scripts/run_tests.sh build plain -L '^plain$'
+      scripts/run_tests.sh build "plain, busy cores" -L '^busy_cores$'
       ;;
     address) scripts/sanitize.sh address ;;
     *)

@@ -10,10 +10,8 @@ set -euo pipefail
 build_dir=$(realpath "$1")
 scripts=$(realpath "$(dirname "$0")/../../scripts")
 root=$(mktemp -d /var/tmp/mocap_deb_root.XXXXXX)
-cleanup() {
-  umount "$root/proc" "$root/dev" 2>/dev/null || true
-  rm -rf "$root"
-}
+# Never through a mount: the root has the host's /dev bound into it (scripts/remove_tree.sh).
+cleanup() { "$scripts/remove_tree.sh" "$root"; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 

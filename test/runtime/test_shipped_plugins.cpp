@@ -1,5 +1,8 @@
-// The shipped plugins' declarations, as mocap_launch --describe shows them.
+// The shipped plugins' declarations, as mocap_launch --describe shows them, and the shipped
+// launch files that use them.
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include <mocap/component_host.hpp>
 
@@ -37,6 +40,24 @@ TEST(ShippedPlugins, EveryDefaultPassesItsOwnChecks) {
     EXPECT_TRUE(check_component_config(plugin.spec, {.name = name}).empty()) << name;
   }
   EXPECT_GT(parameters, 150u);
+}
+
+// Every launch file shipped under launch_yaml/, found here rather than listed (a new one is
+// checked the day it lands), is valid as `mocap_launch --check` reads it: plugins, parameters,
+// topics and QoS, with the shipped plugins. The camera package's camera_source is built here as
+// in the plain build, so follower_robot.yaml and mobile_mocap_camera.yaml are checked too.
+TEST(ShippedLaunchFiles, EveryOneIsValid) {
+  int checked = 0;
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(test::source_dir() / "launch_yaml")) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++checked;
+    auto [code, output] = test::run_command(
+        {(test::bin_dir() / "mocap_launch").string(), entry.path().string(), "--check"});
+    EXPECT_EQ(code, 0) << output;
+    EXPECT_NE(output.find(": valid ("), std::string::npos) << output;
+  }
+  EXPECT_GE(checked, 14);
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 // The volume demo (config/volume/) without processes: its scene rendered through each of its
 // cameras by the simulator's renderer and detected by the fiducial detector, frame by frame,
 // as its camera processes do; each body's fused pose (VolumeTracker: identified by its
-// markers' distances, tracked) beside each camera's own pose of it (planar PnP on that
-// camera's detections of the body's markers, matched to them through the renderer's truth:
-// the best a single camera could do, with no identification to get wrong), both against the
-// truth. What the volume accuracy test and bench measure.
+// markers' distances, tracked) beside each camera's own pose of it (that camera's detections
+// of the body's markers, matched to them through the renderer's truth: the best a single
+// camera could do, with no identification to get wrong; from the planar pose, refined as the
+// fusion refines, each pixel weighed by its fiducial's uncertainty), both against the truth.
+// What the volume accuracy test and bench measure.
 #pragma once
 
 #include <algorithm>
@@ -37,18 +38,24 @@ inline double quantile(std::vector<double> values, double q) {
   return values[static_cast<size_t>(q * static_cast<double>(values.size() - 1))];
 }
 
-// The detection nearest a marker's true pixel, if one lies within 1.5 px: how a marker is
-// paired with what the detector found in a rendered frame.
-inline std::optional<Eigen::Vector2d> detection_of(const std::vector<Eigen::Vector2d>& detections,
-                                                   const Eigen::Vector2d& true_pixel) {
-  std::optional<Eigen::Vector2d> nearest;
-  for (const Eigen::Vector2d& pixel : detections) {
-    if ((pixel - true_pixel).norm() < 1.5 &&
-        (!nearest || (pixel - true_pixel).norm() < (*nearest - true_pixel).norm())) {
-      nearest = pixel;
+// The index of the detection nearest a marker's true pixel, if one lies within 1.5 px: how a
+// marker is paired with what the detector found in a rendered frame.
+inline std::optional<size_t> nearest_detection(const std::vector<Eigen::Vector2d>& detections,
+                                               const Eigen::Vector2d& true_pixel) {
+  std::optional<size_t> nearest;
+  for (size_t i = 0; i < detections.size(); ++i) {
+    const double distance = (detections[i] - true_pixel).norm();
+    if (distance < 1.5 && (!nearest || distance < (detections[*nearest] - true_pixel).norm())) {
+      nearest = i;
     }
   }
   return nearest;
+}
+
+inline std::optional<Eigen::Vector2d> detection_of(const std::vector<Eigen::Vector2d>& detections,
+                                                   const Eigen::Vector2d& true_pixel) {
+  const std::optional<size_t> nearest = nearest_detection(detections, true_pixel);
+  return nearest ? std::optional(detections[*nearest]) : std::nullopt;
 }
 
 struct PoseError {
@@ -157,25 +164,27 @@ inline RenderedVolume render_volume(const std::string& config_dir,
       }
       for (size_t c = 0; c < cameras.size(); ++c) {
         // Each marker the camera sees, paired with its nearest detection within 1.5 px.
-        std::vector<Eigen::Vector3d> markers;
-        std::vector<Eigen::Vector2d> pixels;
+        CameraView view{cameras[c].model.get(), cameras[c].camera_from_world, {}, {}, {}};
         const synthetic::ObjectTruth& object = rendered[c].objects[b];
         body.most_markers_seen = std::max(body.most_markers_seen, object.visible_markers());
         for (size_t m = 0; m < object.markers.size(); ++m) {
           if (!object.markers[m].visible) continue;
-          const std::optional<Eigen::Vector2d> nearest =
-              detection_of(detections[c].pixels, object.markers[m].pixel);
+          const std::optional<size_t> nearest =
+              nearest_detection(detections[c].pixels, object.markers[m].pixel);
           if (!nearest) continue;
-          markers.push_back(scene.objects[b].markers[m]);
-          pixels.push_back(*nearest);
+          view.body_points.push_back(scene.objects[b].markers[m]);
+          view.pixels.push_back(detections[c].pixels[*nearest]);
+          view.pixel_sigma_px.push_back(detections[c].pixel_sigma_px[*nearest]);
         }
         PoseError error;
-        if (markers.size() >= 4) {
-          const pose::PlanarPose pose =
-              pose::estimate_planar_pose(*cameras[c].model, markers, pixels);
-          if (pose.valid) {
-            error =
-                pose_error(cameras[c].camera_from_world.inverse() * pose.camera_from_object, truth);
+        if (view.body_points.size() >= 4) {
+          const pose::PlanarPose planar =
+              pose::estimate_planar_pose(*cameras[c].model, view.body_points, view.pixels);
+          if (planar.valid) {
+            const MultiCameraPose refined = estimate_multi_camera_pose(
+                {view}, cameras[c].camera_from_world.inverse() * planar.camera_from_object,
+                options.fusion);
+            if (refined.valid) error = pose_error(refined.world_from_body, truth);
           }
         }
         body.by_camera.push_back(error);
@@ -184,6 +193,39 @@ inline RenderedVolume render_volume(const std::string& config_dir,
     }
   }
   return out;
+}
+
+// One figure of the fused poses against the camera best at that figure: over the body-frames
+// both the fusion and that camera posed (each camera must pose 100 or more), the quantile `q`
+// of the position (mm) or orientation (degrees) errors.
+enum class Figure { Position, Orientation };
+struct AgainstBestCamera {
+  std::string camera;
+  size_t body_frames = 0;
+  double camera_value = std::numeric_limits<double>::quiet_NaN();
+  double fused_value = std::numeric_limits<double>::quiet_NaN();
+  double ratio() const { return camera_value / fused_value; }  // how many times better fused
+};
+
+inline AgainstBestCamera against_best_camera(const RenderedVolume& volume, Figure figure,
+                                             double q) {
+  auto value = [&](const PoseError& e) {
+    return figure == Figure::Position ? e.position_m * 1e3 : e.rotation_deg;
+  };
+  AgainstBestCamera best;
+  for (size_t c = 0; c < volume.cameras.size(); ++c) {
+    std::vector<double> own, fused;
+    for (const BodyFrame& body : volume.body_frames) {
+      if (!body.fused.posed() || !body.by_camera[c].posed()) continue;
+      own.push_back(value(body.by_camera[c]));
+      fused.push_back(value(body.fused));
+    }
+    if (own.size() < 100) continue;
+    if (!(quantile(own, q) >= best.camera_value)) {
+      best = {volume.cameras[c], own.size(), quantile(own, q), quantile(fused, q)};
+    }
+  }
+  return best;
 }
 
 }  // namespace mocap::volume::test
