@@ -74,7 +74,12 @@ struct BodyFrame {
   std::string body;
   int frame = 0;
   PoseError fused;
-  int cameras_used = 0;              // of the fused pose
+  int cameras_used = 0;            // of the fused pose
+  double normalized_rms = 0;       // of the fused pose
+  double reprojection_rms_px = 0;  // of the fused pose
+  // The fused pose's error in position and orientation over its covariance's (x^T C^-1 x, each
+  // 3 by 3): chi-square with 3 degrees of freedom when the covariance is right.
+  double position_nees = 0, orientation_nees = 0;
   std::vector<PoseError> by_camera;  // each camera's own pose; not posed where it had none
   int most_markers_seen = 0;         // by any one camera (the renderer's visible markers)
 };
@@ -90,6 +95,9 @@ struct RenderedVolumeOptions {
   // Each camera's view of the scene changed before rendering (occluders of its own); none:
   // every camera renders the demo's scene as it is.
   std::function<void(size_t camera, synthetic::Scene& scene)> per_camera;
+  // The frames whose message from a camera never reaches the fusion (a camera process down, a
+  // message late past the fusion's wait on a busy machine); none: every camera, every frame.
+  std::function<bool(size_t camera, int frame)> missing;
 };
 
 struct RenderedVolume {
@@ -152,15 +160,30 @@ inline RenderedVolume render_volume(const std::string& config_dir,
         detections[c].pixel_sigma_px.push_back(fiducial.uncertainty_px);
       }
     }
-    const std::vector<TrackedBodyPose> fused = tracker.track(stamp_ns, detections);
+    std::vector<CameraFrame> received = detections;
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      if (rendering.missing && rendering.missing(c, f)) received[c] = {};
+    }
+    const std::vector<TrackedBodyPose> fused = tracker.track(stamp_ns, received);
     for (size_t b = 0; b < scene.objects.size(); ++b) {
-      BodyFrame body{scene.objects[b].constellation, f, {}, 0, {}};
+      BodyFrame body;
+      body.body = scene.objects[b].constellation;
+      body.frame = f;
       const Eigen::Isometry3d truth =
           cameras[0].camera_from_world.inverse() * rendered[0].objects[b].pose;
       for (const TrackedBodyPose& pose : fused) {
         if (pose.name != body.body) continue;
         body.fused = pose_error(pose.world_from_body, truth);
         body.cameras_used = pose.cameras_used;
+        body.normalized_rms = pose.normalized_rms;
+        body.reprojection_rms_px = pose.reprojection_rms_px;
+        const Eigen::Vector3d position = pose.world_from_body.translation() - truth.translation();
+        const Eigen::AngleAxisd turn(pose.world_from_body.linear() * truth.linear().transpose());
+        const Eigen::Vector3d rotation = turn.axis() * turn.angle();
+        body.position_nees =
+            position.dot(pose.covariance.topLeftCorner<3, 3>().ldlt().solve(position));
+        body.orientation_nees =
+            rotation.dot(pose.covariance.bottomRightCorner<3, 3>().ldlt().solve(rotation));
       }
       for (size_t c = 0; c < cameras.size(); ++c) {
         // Each marker the camera sees, paired with its nearest detection within 1.5 px.

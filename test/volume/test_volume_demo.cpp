@@ -1,10 +1,11 @@
 // The tracking volume as launch_yaml/volume_demo.yaml ships it: four camera processes (synthetic
 // camera and fiducial tracker each, capturing together) and the compute process fusing them,
 // evaluated against the simulator's truth; then the faults: a camera process killed and
-// started again, and a camera bumped after calibration. Real time on a shared machine: the
-// bounds leave room for frames a busy machine delivers late (a camera missing from a frame);
-// CI runs these beside a compiling sanitizer tree, where the figures fall by a few percent
-// from those of a quiet machine (the issue's targets, measured apart).
+// started again, and a camera bumped after calibration. Every run is held to the design's
+// figures: no false identification ever (a pose more than 5 cm or 5 degrees off is a wrong
+// answer handed to a robot: a frame the fusion cannot pose goes without), and 99.5 % of the
+// body-frames tracked. Real time: CI runs these one at a time with what it runs in the
+// background paused (test/CMakeLists.txt, the realtime part).
 #include <gtest/gtest.h>
 
 #include <yaml-cpp/yaml.h>
@@ -39,11 +40,8 @@ struct Figures {
   double tracked_share() const {
     return node["tracked"].as<double>() / std::max(1.0, node["expected"].as<double>());
   }
-  // Poses more than 5 cm or 5 degrees off: a body seen by one camera only for a while.
-  double false_share() const {
-    return node["false_identifications"].as<double>() /
-           std::max(1.0, node["expected"].as<double>());
-  }
+  // Poses more than 5 cm or 5 degrees off: a wrong answer handed to a robot.
+  int false_identifications() const { return node["false_identifications"].as<int>(); }
 };
 
 Figures read_figures(const std::filesystem::path& summary) {
@@ -78,10 +76,10 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
   EXPECT_GT(figures.node["frames"].as<int>(), 450) << output;  // 30 Hz, less the start
-  EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
-  EXPECT_LE(figures.false_share(), 0.05) << output;
+  EXPECT_EQ(figures.false_identifications(), 0) << output;
   EXPECT_GT(figures.node["velocity_errors"].as<int>(), 1000);
   EXPECT_LT(figures.node["velocity_error_median_mps"].as<double>(), 0.05);
   EXPECT_EQ(output.find("DRIFTED"), std::string::npos) << output;
@@ -133,7 +131,8 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   std::printf("%s", test::read_file(summary).c_str());
   // A pose array for every frame of the truth camera (cam_0), through the kill and the return.
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << compute->output();
-  EXPECT_GE(figures.tracked_share(), 0.93) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_EQ(figures.false_identifications(), 0) << compute->output();
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
 }
@@ -172,11 +171,16 @@ TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
   std::printf("%s", test::read_file(summary).c_str());
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << output;
   EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
-  EXPECT_EQ(figures.node["false_identifications"].as<int>(), 0) << output;
+  EXPECT_EQ(figures.false_identifications(), 0) << output;
 }
 
 // cam_1 knocked by half a degree after calibration: the simulator renders it from where it now
 // points, the fusion still has its calibrated pose. It is named as moved, and poses stay right.
+// Tracked: 98 %, the figure of a camera away (VolumeAccuracy.CamerasMissingFromFrames...:
+// 98.4 % to 99.97 % on rendered images), which cam_1 is once named; before, for the first two
+// or three seconds, a board only cam_1 and one other camera see is not posed (their views
+// disagree by 4 px and each agrees with itself) until cam_1's residuals mark it out (93 % to
+// 96 % tracked in those seconds, 99.2 % to 99.7 % over the run, three runs measured).
 TEST(VolumeDemo, ABumpedCameraIsNamed) {
   test::TempDir dir;
   calibration::CameraFile bumped = calibration::load_camera_file(
@@ -198,7 +202,9 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
         << output;
   }
   const Figures figures = read_figures(summary);
-  EXPECT_GE(figures.tracked_share(), 0.85) << test::read_file(summary);
+  std::printf("%s", test::read_file(summary).c_str());
+  EXPECT_GE(figures.tracked_share(), 0.98) << test::read_file(summary) << output;
+  EXPECT_EQ(figures.false_identifications(), 0) << output;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
 }
 
@@ -233,9 +239,9 @@ TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
   ASSERT_EQ(code, 0) << output;
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
-  EXPECT_GE(figures.tracked_share(), 0.95) << test::read_file(summary) << output;
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary) << output;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
-  EXPECT_LE(figures.false_share(), 0.05) << output;
+  EXPECT_EQ(figures.false_identifications(), 0) << output;
 }
 
 // The multi-host form: each camera on a network-namespace host of its own, the fusion on a
@@ -254,14 +260,17 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
                             "phase measure: PASS", "result: PASS 4 of 4 phases"}) {
     EXPECT_NE(output.find(phase), std::string::npos) << phase << "\n" << output;
   }
-  // The evaluator's row: | frames | lost | tracked % | ...
+  // The evaluator's row: | frames | lost | tracked % | position | orientation | velocity |
+  // false ids | latency |
   std::smatch row;
-  ASSERT_TRUE(
-      std::regex_search(output, row, std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) %)")))
+  ASSERT_TRUE(std::regex_search(
+      output, row,
+      std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) % \|[^|]*\|[^|]*\|[^|]*\| (\d+) \|)")))
       << output;
   EXPECT_GT(std::stoi(row[1]), 400) << output;
   EXPECT_EQ(std::stoi(row[2]), 0) << output;
-  EXPECT_GE(std::stod(row[3]), 93.0) << output;
+  EXPECT_GE(std::stod(row[3]), 99.5) << output;
+  EXPECT_EQ(std::stoi(row[4]), 0) << output;
 }
 
 // Calibrated from data (scripts/calibrate_volume.sh): the board carried through the volume for
@@ -317,7 +326,8 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   ASSERT_EQ(demo_code, 0) << demo;
   const Figures figures = read_figures(summary);
   std::printf("on the calibrated cameras:\n%s", test::read_file(summary).c_str());
-  EXPECT_GE(figures.tracked_share(), 0.9) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_EQ(figures.false_identifications(), 0) << demo;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 0.15e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
 }

@@ -1,6 +1,6 @@
 // The volume's frame-by-frame tracker (volume_tracker.hpp) on a synthetic volume: two rigid
 // bodies of no particular shape moving through it, seen through occluders, with a camera that
-// stops, a camera that is bumped and a body that only one camera keeps seeing.
+// stops, a camera that is bumped, and bodies that only one camera keeps seeing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -162,37 +162,84 @@ TEST(VolumeTracker, ABumpedCameraIsFoundAndLeftOut) {
   EXPECT_LT(*std::max_element(errors_after.begin(), errors_after.end()), 5e-3);
 }
 
-// After 1 s every camera but one loses sight of the drone: its track goes on from that camera
-// alone, flagged by cameras_used 1, within a few centimetres (depth from one view).
+// The board of eight markers circling as the helmet does, every camera seeing it for 1 s, then
+// camera 0 alone for 2 s: its track goes on from that camera, flagged by cameras_used 1, within
+// a few centimetres (depth from one view) and within what each pose's covariance says.
 TEST(VolumeTracker, OneCameraAloneKeepsATrackFlaggedAsSuch) {
-  Sequence sequence;
-  VolumeTracker tracker(sequence.cameras(), sequence.bodies);
-  int single = 0;
+  const test::Volume volume;
+  RigidBodyDatabase bodies;
+  bodies.bodies.push_back({"board", test::kBoard});
+  std::vector<VolumeCamera> cameras;
+  for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
+    cameras.push_back({"cam_" + std::to_string(c), volume.camera, volume.extrinsics[c], "optical"});
+  }
+  VolumeTracker tracker(cameras, bodies);
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0, 0.1);
+  int single = 0, beyond_three_sigma = 0;
   std::vector<double> errors;
   for (int f = 0; f < 360; ++f) {
+    const Eigen::Isometry3d truth = truth_at(f / kRate_hz)[0];
+    std::vector<CameraFrame> frame(cameras.size());
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      frame[c] = {true, stamp_of(f), {}, {}};
+      if (f >= 120 && c != 0) continue;
+      for (const Eigen::Vector3d& marker : test::kBoard) {
+        const Eigen::Vector3d in_camera = volume.extrinsics[c] * truth * marker;
+        const auto pixel = volume.camera->project(in_camera);
+        if (in_camera.z() <= 0 || !pixel || !volume.camera->in_image(*pixel)) continue;
+        frame[c].pixels.push_back(*pixel + test::draws<2>(noise, random));
+        frame[c].pixel_sigma_px.push_back(0.1);
+      }
+    }
+    for (const TrackedBodyPose& pose : tracker.track(stamp_of(f), frame)) {
+      if (f < 120) continue;
+      EXPECT_EQ(pose.cameras_used, 1) << "frame " << f;
+      ++single;
+      const Eigen::Vector3d error = pose.world_from_body.translation() - truth.translation();
+      errors.push_back(error.norm());
+      const double nees = error.dot(pose.covariance.topLeftCorner<3, 3>().ldlt().solve(error));
+      beyond_three_sigma += nees > 14.16 ? 1 : 0;
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  ASSERT_FALSE(errors.empty());
+  std::printf(
+      "board posed from one camera in %d of 240 frames, position error median %.1f mm, max %.1f "
+      "mm; %d beyond their covariance's 3 sigma\n",
+      single, errors[errors.size() / 2] * 1e3, errors.back() * 1e3, beyond_three_sigma);
+  EXPECT_GE(single, 235);
+  EXPECT_LT(errors[errors.size() / 2], 0.03);
+  EXPECT_LE(beyond_three_sigma, single / 100);
+}
+
+// The drone seen by one camera alone, four or five of its markers (one hidden at random): that
+// fixes its six unknowns with nothing to check them, so it is not posed rather than posed
+// centimetres off; seen by several cameras again, it is found again.
+TEST(VolumeTracker, ABodyOneCameraSeesByFewerThanSixMarkersIsNotPosed) {
+  Sequence sequence;
+  VolumeTracker tracker(sequence.cameras(), sequence.bodies);
+  int drone_alone = 0, drone_again = 0;
+  for (int f = 0; f < 480; ++f) {
     const std::vector<Eigen::Isometry3d> truth = truth_at(f / kRate_hz);
     std::vector<CameraFrame> frame = sequence.frame(stamp_of(f), truth, sequence.volume.extrinsics);
-    if (f >= 120) {
+    if (f >= 120 && f < 360) {
       // Cameras 1..3 see the helmet only.
       const std::vector<CameraFrame> helmet_only =
           sequence.frame(stamp_of(f), {truth[0]}, sequence.volume.extrinsics);
       for (size_t c = 1; c < 4; ++c) frame[c] = helmet_only[c];
     }
     for (const TrackedBodyPose& pose : tracker.track(stamp_of(f), frame)) {
-      if (pose.name != "drone" || f < 120) continue;
-      EXPECT_EQ(pose.cameras_used, 1) << "frame " << f;
-      ++single;
-      errors.push_back(position_error(pose, truth));
+      if (pose.name != "drone") continue;
+      if (f >= 130 && f < 360) ++drone_alone;
+      if (f >= 370) {
+        ++drone_again;
+        EXPECT_LT(position_error(pose, truth), 5e-3) << "frame " << f;
+      }
     }
   }
-  std::sort(errors.begin(), errors.end());
-  ASSERT_FALSE(errors.empty());
-  std::printf(
-      "drone posed from one camera in %d of 240 frames, position error median %.1f mm, "
-      "max %.1f mm\n",
-      single, errors[errors.size() / 2] * 1e3, errors.back() * 1e3);
-  EXPECT_GE(single, 235);
-  EXPECT_LT(errors[errors.size() / 2], 0.03);
+  EXPECT_EQ(drone_alone, 0);
+  EXPECT_EQ(drone_again, 110);
 }
 
 // A body of close markers (3 to 9 cm apart, 8 to 25 px in the cameras) flown to and fro at

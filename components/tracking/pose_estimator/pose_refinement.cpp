@@ -80,9 +80,9 @@ RefinedPose refine_pose(const PoseResiduals& residuals, const Eigen::Isometry3d&
   return out;
 }
 
-Matrix6d pose_covariance(const RefinedPose& refined, int residual_count) {
+Matrix6d pose_covariance(const RefinedPose& refined, int residual_count, double min_variance) {
   const int dof = residual_count - 6;
-  const double sigma2 = dof > 0 ? refined.squared_error / dof : 0;
+  const double sigma2 = std::max(min_variance, dof > 0 ? refined.squared_error / dof : 0);
   Eigen::FullPivLU<Matrix6d> lu(refined.information);
   return lu.isInvertible() ? Matrix6d(sigma2 * lu.inverse()) : Matrix6d::Zero();
 }

@@ -32,8 +32,9 @@ RefinedPose refine_pose(const PoseResiduals& residuals, const Eigen::Isometry3d&
                         int max_iterations);
 
 // The pose's covariance over perturbed()'s delta: the residuals' variance per coordinate (with
-// the 6 pose parameters taken out of `residual_count`) times the inverse information; zero
-// when the information is singular.
-Matrix6d pose_covariance(const RefinedPose& refined, int residual_count);
+// the 6 pose parameters taken out of `residual_count`), at least `min_variance`, times the
+// inverse information; zero when the information is singular. Residuals already divided by
+// their sigmas take min_variance 1: the sigmas are a floor that lucky residuals do not lower.
+Matrix6d pose_covariance(const RefinedPose& refined, int residual_count, double min_variance = 0);
 
 }  // namespace mocap::pose

@@ -115,7 +115,8 @@ MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
     return result;
   }
   result.world_from_body = refined.pose;
-  result.covariance = pose::pose_covariance(refined, 2 * result.points_used);
+  result.covariance = pose::pose_covariance(refined, 2 * result.points_used, /*min_variance=*/1);
+  result.normalized_rms = std::sqrt(refined.squared_error / (2 * result.points_used));
   const Eigen::VectorXd final_residuals =
       *residuals(views, result.points_used, refined.pose, /*weighted=*/false);
   result.reprojection_rms_px = std::sqrt(final_residuals.squaredNorm() / result.points_used);

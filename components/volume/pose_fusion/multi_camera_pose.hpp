@@ -49,7 +49,11 @@ struct MultiCameraPose {
   std::string rejection;  // why not valid
   Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
   double reprojection_rms_px = 0;  // over every point of every view used
-  int cameras_used = 0;            // views with at least one point; 1: a single camera's pose
+  // The residuals' RMS in units of each pixel's sigma (pixel_sigma_px; 1 px where none is
+  // given): about 1 when the points are the body's markers and the sigmas say how the
+  // detector errs, far above when a point is something else.
+  double normalized_rms = 0;
+  int cameras_used = 0;  // views with at least one point; 1: a single camera's pose
   int points_used = 0;
   // Row-major 6x6 over (x, y, z, rx, ry, rz) of the body's origin in the world frame (m, rad;
   // rotation as a small angle vector in the world frame), from the residual scatter.

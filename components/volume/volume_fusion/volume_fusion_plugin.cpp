@@ -8,6 +8,7 @@
 // on /alerts, and taken back, also reported, at its next message; so is a camera found drifted
 // (its extrinsics moved: its residuals against the others' poses), and a body seen by one
 // camera only (its pose then rests on that camera alone).
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -39,6 +40,7 @@ using mocap_msgs::msg::FiducialArray;
 using tf2_msgs::msg::TFMessage;
 
 constexpr std::chrono::milliseconds kSingleCameraAlert{500};
+constexpr std::chrono::milliseconds kUnposedAlert{500};
 constexpr size_t kMaxBacklog = 2;  // frames fused at once; older ready ones are skipped
 // A camera that misses this many frames in a row is said to be back when it returns.
 constexpr int kGapFramesLogged = 3;
@@ -277,7 +279,32 @@ class VolumeFusion final : public Component {
     }
     body_poses_ += poses.size();
     poses_.publish(std::move(message));
+    report_unposed(poses, assembled.stamp_ns);
     report_drift();
+  }
+
+  // A body posed before and not for kUnposedAlert is said to be seen too poorly to pose: too
+  // few of its markers in view, or views that disagree; a wrong pose is not handed out instead.
+  void report_unposed(const std::vector<TrackedBodyPose>& poses, int64_t stamp_ns) {
+    for (const RigidBody& body : tracker_.bodies().bodies) {
+      Unposed& state = unposed_[body.name];
+      const bool posed = std::any_of(poses.begin(), poses.end(),
+                                     [&](const TrackedBodyPose& p) { return p.name == body.name; });
+      if (posed) {
+        if (state.reported) log().info("{} is posed again", body.name);
+        state = {stamp_ns, false};
+        continue;
+      }
+      if (state.last_posed_ns == 0 || state.reported ||
+          stamp_ns - state.last_posed_ns < std::chrono::nanoseconds(kUnposedAlert).count()) {
+        continue;
+      }
+      state.reported = true;
+      alert(1,
+            fmt::format("{} has not been posed for {} s: seen too poorly to pose (too few of its "
+                        "markers, or cameras that disagree)",
+                        body.name, std::chrono::duration<double>(kUnposedAlert).count()));
+    }
   }
 
   // A camera not heard yet is left out as a silent one, but is not news until it was heard.
@@ -369,6 +396,11 @@ class VolumeFusion final : public Component {
     bool reported = false;
   };
   std::map<std::string, std::optional<SingleCamera>> single_camera_;  // by body
+  struct Unposed {
+    int64_t last_posed_ns = 0;  // 0: never posed
+    bool reported = false;
+  };
+  std::map<std::string, Unposed> unposed_;  // by body
   uint64_t single_camera_poses_ = 0;
   Publisher<ConstellationPoseArray> poses_;
   Publisher<Alert> alerts_;

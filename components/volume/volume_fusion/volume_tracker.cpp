@@ -13,6 +13,9 @@ namespace {
 // takes before the average can call the camera drifted.
 constexpr double kResidualSmoothing = 0.02;
 constexpr int64_t kViewsBeforeDriftCall = 50;
+// A camera whose average residual has passed this fraction of drift_px, its partner's staying
+// below half of that, is the one left out when the two alone see a body and disagree.
+constexpr double kSuspectFraction = 0.25;
 // Views of fewer points say little of a camera: one marker taken for another is half of two.
 constexpr size_t kMinPointsForResidual = 3;
 // The residual of a camera is measured with detections up to this many times the matching
@@ -24,17 +27,43 @@ constexpr double kRetryRadiusFactor = 3;
 // again without it.
 constexpr double kOutlierFactor = 2;
 // In a pose that holds, a point further off than this many times the points' median error,
-// and than kStrayFloorPx, is a stray: left out, and the pose fitted again.
+// each in units of its pixel's sigma, and than kStrayFloorSigmas, is a stray: left out, and
+// the pose fitted again. In sigmas, not pixels: a neighbour's marker taken for one of the
+// body's lies 0.1 to 0.3 px off where the body's own lie 0.02 to 0.05 px off, which a floor in
+// pixels kept, and two cameras' fit then stood 6 to 15 mm off.
 constexpr double kStrayFactor = 5;
-constexpr double kStrayFloorPx = 0.3;
-// How quickly a track's usual RMS follows its latest poses, and how many times that RMS a fit
-// from its prediction may have before it is not trusted. On the demo's rendered images the
-// fits centimetres off came at 12 to 50 times, the mismatches that tilt a pose by a millimetre
-// at 5 to 18; sound fits reach 7 at most, and for those identification fuses the same pose.
+constexpr double kStrayFloorSigmas = 3;
+// The sigma of a pixel whose detections state none, for the tests above.
+constexpr double kUnstatedSigmaPx = 0.1;
+// A fit is set aside as unusually poor when its residuals (in sigmas: normalized RMS) exceed
+// this many times what the body's track usually has (its running average), or, for a body not
+// tracked, what the volume's fits usually have. On the demo's rendered images sound fits lie at
+// 0.75 to 1.5 (3 at most), fits from a neighbour's markers centimetres off at 16 to 48: such a
+// fit is not handed out; the body is looked for afresh, or left unposed.
 constexpr double kUsualRmsSmoothing = 0.1;
 constexpr double kUnusualRmsFactor = 5;
+// A fit whose residuals exceed this many times the usual is looked at point by point, then
+// camera by camera: where leaving its worst point out, or else one camera's points, brings the
+// rest back to the usual, those points were not the body's markers (one far-off point pulls a
+// whole fit, so that its median error hides it from trim_strays). A camera that sees one or two of
+// a body's markers, one of them a blob merged with a neighbour's, bends the depth the camera that
+// sees the whole body fixes poorly: 10 to 15 mm off on the demo's images, with residuals 3 to 4
+// times the usual.
+constexpr double kElevatedRmsFactor = 2;
+// A camera's points disagree with the others' when they add this many sigmas (squared, per
+// residual, in units of the usual) to the fit's chi-square: 3, where agreeing points add about
+// 1. Points cut by an occluder's edge raise a fit's residuals too, in every camera, and by
+// less: leaving a camera out for them left a single camera's poorer depth.
+constexpr double kDisagreeingSigmas = 3;
 // A track's velocity is measured over its poses of this long (seconds).
 constexpr double kVelocityWindow_s = 0.05;
+
+// What a fit's normalized RMS is compared with: what the fits usually have, or, before any, the
+// 1 that detections whose sigmas are right give. Relative, so that cameras erring more (or
+// less) than their sigmas say are judged by their own usual.
+double expected_rms(double usual_normalized_rms) {
+  return usual_normalized_rms > 0 ? usual_normalized_rms : 1.0;
+}
 
 int cameras_seeing(const std::vector<CameraView>& views) {
   return static_cast<int>(std::count_if(views.begin(), views.end(),
@@ -71,6 +100,14 @@ double view_median_error_px(const CameraView& view, const Eigen::Isometry3d& wor
   return errors[errors.size() / 2];
 }
 
+// point_errors_px, each in units of its pixel's sigma.
+std::vector<double> point_errors_sigmas(const CameraView& view,
+                                        const Eigen::Isometry3d& world_from_body) {
+  std::vector<double> errors = point_errors_px(view, world_from_body);
+  for (size_t i = 0; i < errors.size(); ++i) errors[i] /= view.pixel_sigma_px[i];
+  return errors;
+}
+
 // A view with no points left: the camera is left out of the fit. Its pixels' sigmas go with
 // them, so the lists stay index by index.
 void empty_view(CameraView& view) {
@@ -79,19 +116,24 @@ void empty_view(CameraView& view) {
   view.pixel_sigma_px.clear();
 }
 
-// The views without their points further than `limit_px` from where the pose puts them.
+enum class Units { Pixels, Sigmas };
+
+// The views without their points further than `limit` (pixels, or each point's sigmas) from
+// where the pose puts them.
 std::vector<CameraView> without_outliers(const std::vector<CameraView>& views,
-                                         const Eigen::Isometry3d& world_from_body,
-                                         double limit_px) {
+                                         const Eigen::Isometry3d& world_from_body, double limit,
+                                         Units units) {
   std::vector<CameraView> kept;
   for (const CameraView& view : views) {
-    const std::vector<double> errors = point_errors_px(view, world_from_body);
+    const std::vector<double> errors = units == Units::Pixels
+                                           ? point_errors_px(view, world_from_body)
+                                           : point_errors_sigmas(view, world_from_body);
     CameraView close{view.camera, view.camera_from_world, {}, {}, {}};
     for (size_t i = 0; i < errors.size(); ++i) {
-      if (errors[i] > limit_px) continue;
+      if (errors[i] > limit) continue;
       close.body_points.push_back(view.body_points[i]);
       close.pixels.push_back(view.pixels[i]);
-      if (!view.pixel_sigma_px.empty()) close.pixel_sigma_px.push_back(view.pixel_sigma_px[i]);
+      close.pixel_sigma_px.push_back(view.pixel_sigma_px[i]);
     }
     kept.push_back(std::move(close));
   }
@@ -146,6 +188,8 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
     if (frame[c].received && !health_[c].drifted) {
       camera.pixels = frame[c].pixels;
       camera.pixel_sigma_px = frame[c].pixel_sigma_px;
+      if (camera.pixel_sigma_px.empty())
+        camera.pixel_sigma_px.assign(camera.pixels.size(), kUnstatedSigmaPx);
     }
     detections.push_back(std::move(camera));
   }
@@ -180,28 +224,36 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
                                                     track->angular_velocity, dt_s)
                                         : track->world_from_body;
     const std::vector<CameraDetections> cameras = for_body(*track);
-    std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px);
+    const double usual =
+        track->usual_normalized_rms > 0 ? track->usual_normalized_rms : usual_normalized_rms_;
+    std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px, usual);
     if (fused && fused->pose.cameras_used == 1) {
       // The other cameras' detections may lie beyond the radius from a prediction that one
       // camera's poor depth put off: from that camera's pose, a wider net, which the fusion's
-      // RMS limit keeps from taking wrong detections.
+      // RMS limit and the check of its residuals keep from taking wrong detections.
       std::optional<Fused> wider = fuse(b, fused->pose.world_from_body, cameras,
-                                        kRetryRadiusFactor * options_.match_radius_px);
-      if (wider && wider->pose.cameras_used >= 2) fused = std::move(wider);
+                                        kRetryRadiusFactor * options_.match_radius_px, usual);
+      if (wider && wider->pose.cameras_used >= 2 && !unusually_poor(*wider, usual)) {
+        fused = std::move(wider);
+      }
+    } else if (!fused && track->cameras_used == 1) {
+      // Posed by one camera last, the body passes into another's view where the prediction,
+      // off in the first camera's depth, misses its markers: the same wider net.
+      fused = fuse(b, start, cameras, kRetryRadiusFactor * options_.match_radius_px, usual);
     }
     // Markers taken for their neighbours, as when a body turns back and its prediction runs on,
-    // give a fit under the RMS limit yet centimetres off, far above the track's usual RMS.
+    // or when one camera's poor depth puts the prediction off, give a fit under the RMS limit
+    // yet centimetres off, far above the track's usual residuals.
     auto unusual = [&](const std::optional<Fused>& fit) {
-      return fit && fit->pose.cameras_used >= 2 && track->usual_rms_px > 0 &&
-             fit->pose.reprojection_rms_px > kUnusualRmsFactor * track->usual_rms_px;
+      return fit && unusually_poor(*fit, usual);
     };
     if (unusual(fused)) {
       ++unusual_fits_;
       // A body that turned back is nearer its last pose than its prediction; failing that, it
       // is looked for afresh below, among the markers triangulated from every camera.
       std::optional<Fused> from_last =
-          fuse(b, track->world_from_body, cameras, options_.match_radius_px);
-      if (!from_last || from_last->pose.cameras_used < 2 || unusual(from_last)) continue;
+          fuse(b, track->world_from_body, cameras, options_.match_radius_px, usual);
+      if (!from_last || unusual(from_last)) continue;
       fused = std::move(from_last);
     }
     if (fused) {
@@ -236,8 +288,13 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
           std::find_if(untracked.bodies.begin(), untracked.bodies.end(),
                        [&](const RigidBody& body) { return body.name == found.name; }) -
           untracked.bodies.begin())];
-      if (std::optional<Fused> fused =
-              fuse(b, found.world_from_body, detections, options_.match_radius_px)) {
+      std::optional<Fused> fused = fuse(b, found.world_from_body, detections,
+                                        options_.match_radius_px, usual_normalized_rms_);
+      if (fused && unusually_poor(*fused, usual_normalized_rms_)) {
+        ++unusual_fits_;
+        continue;
+      }
+      if (fused) {
         ++identifications_;
         take(fused->used, detections);
         posed[b] = update_track(b, stamp_ns, fused->pose);
@@ -259,7 +316,7 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
 
 std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     size_t body, const Eigen::Isometry3d& start, const std::vector<CameraDetections>& detections,
-    double radius_px) {
+    double radius_px, double usual_normalized_rms) {
   const std::vector<Eigen::Vector3d>& markers = bodies_.bodies[body].markers;
   std::vector<CameraView> views = views_near(detections, markers, start, radius_px);
   if (points_in(views) < options_.fusion.min_points) return std::nullopt;
@@ -267,8 +324,9 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   if (!fused.valid && fused.reprojection_rms_px > 0) {
     // Points far off the least-squares pose: a marker an occluder cut in half (its centre
     // moved) or one merged with a neighbour's. Without them the others may agree.
-    std::vector<CameraView> kept = without_outliers(
-        views, fused.world_from_body, kOutlierFactor * options_.fusion.max_reprojection_rms_px);
+    std::vector<CameraView> kept =
+        without_outliers(views, fused.world_from_body,
+                         kOutlierFactor * options_.fusion.max_reprojection_rms_px, Units::Pixels);
     const int points = points_in(kept);
     if (points >= options_.fusion.min_points && points < points_in(views)) {
       MultiCameraPose again =
@@ -280,13 +338,16 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     }
   }
   std::optional<size_t> left_out;
-  if (!fused.valid && cameras_seeing(views) >= 3) {
-    // One camera that disagrees with the rest: the one whose removal lets them agree.
+  if (!fused.valid && cameras_seeing(views) >= 2) {
+    // One camera that disagrees with the rest: the one whose removal lets them agree. Of two
+    // cameras, each agrees with itself: the one whose residuals against other cameras' poses
+    // are on their way to calling it drifted is the one left out.
     const std::vector<double> without = rms_without_each_view_px(views, start, options_.fusion);
     size_t best = views.size();
     for (size_t c = 0; c < without.size(); ++c) {
       if (!std::isnan(without[c]) && (best == views.size() || without[c] < without[best])) best = c;
     }
+    if (cameras_seeing(views) == 2) best = suspect_of_two(views);
     if (best < views.size() && without[best] <= options_.fusion.max_reprojection_rms_px) {
       std::vector<CameraView> others = views;
       empty_view(others[best]);
@@ -301,6 +362,15 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   if (!fused.valid) return std::nullopt;
   const std::vector<CameraView> untrimmed = views;
   trim_strays(views, fused);
+  if (!left_out && fused.normalized_rms > kElevatedRmsFactor * expected_rms(usual_normalized_rms)) {
+    if (!without_worst_point(views, fused, usual_normalized_rms)) {
+      if (std::optional<size_t> other = disagreeing_view(views, fused, usual_normalized_rms)) {
+        left_out = *other;
+        ++health_[*other].left_out;
+        empty_view(views[*other]);
+      }
+    }
+  }
 
   // Each camera's residual where two other cameras or more hold the pose: a camera in the
   // fusion by its own points, strays included (a moved camera's points are all strays: its
@@ -329,22 +399,101 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   return result;
 }
 
+size_t VolumeTracker::suspect_of_two(const std::vector<CameraView>& views) const {
+  std::vector<size_t> seeing;
+  for (size_t c = 0; c < views.size(); ++c) {
+    if (!views[c].pixels.empty()) seeing.push_back(c);
+  }
+  const CameraHealth& a = health_[seeing[0]];
+  const CameraHealth& b = health_[seeing[1]];
+  const double suspicious = kSuspectFraction * options_.drift_px;
+  if (a.average_error_px > suspicious && b.average_error_px < suspicious / 2) return seeing[0];
+  if (b.average_error_px > suspicious && a.average_error_px < suspicious / 2) return seeing[1];
+  return views.size();
+}
+
+bool VolumeTracker::without_worst_point(std::vector<CameraView>& views, MultiCameraPose& fused,
+                                        double usual_normalized_rms) const {
+  size_t worst_view = 0, worst_point = 0;
+  double worst = -1;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const std::vector<double> errors = point_errors_sigmas(views[v], fused.world_from_body);
+    for (size_t i = 0; i < errors.size(); ++i) {
+      if (errors[i] > worst) {
+        worst = errors[i];
+        worst_view = v;
+        worst_point = i;
+      }
+    }
+  }
+  if (worst < 0 || points_in(views) <= options_.fusion.min_points) return false;
+  std::vector<CameraView> kept = views;
+  CameraView& view = kept[worst_view];
+  view.body_points.erase(view.body_points.begin() + static_cast<long>(worst_point));
+  view.pixels.erase(view.pixels.begin() + static_cast<long>(worst_point));
+  view.pixel_sigma_px.erase(view.pixel_sigma_px.begin() + static_cast<long>(worst_point));
+  MultiCameraPose again = estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
+  if (!again.valid ||
+      again.normalized_rms > kElevatedRmsFactor * expected_rms(usual_normalized_rms)) {
+    return false;
+  }
+  views = std::move(kept);
+  fused = std::move(again);
+  return true;
+}
+
+std::optional<size_t> VolumeTracker::disagreeing_view(const std::vector<CameraView>& views,
+                                                      MultiCameraPose& fused,
+                                                      double usual_normalized_rms) const {
+  // What each view adds to the fit's chi-square, per residual of its own: about one for a view
+  // that agrees with the others (in units of the usual), far more for one that does not.
+  const double usual = expected_rms(usual_normalized_rms);
+  const double chi_square = fused.normalized_rms * fused.normalized_rms * 2 * fused.points_used;
+  std::optional<size_t> worst;
+  MultiCameraPose worst_fit;
+  double worst_added = kDisagreeingSigmas * kDisagreeingSigmas * usual * usual;
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (views[v].pixels.empty()) continue;
+    std::vector<CameraView> others = views;
+    empty_view(others[v]);
+    if (points_in(others) < options_.fusion.min_points) continue;
+    MultiCameraPose fit =
+        estimate_multi_camera_pose(others, fused.world_from_body, options_.fusion);
+    if (!fit.valid || fit.normalized_rms > kElevatedRmsFactor * usual) continue;
+    const double added =
+        (chi_square - fit.normalized_rms * fit.normalized_rms * 2 * fit.points_used) /
+        (2 * static_cast<double>(views[v].pixels.size()));
+    if (added > worst_added) {
+      worst = v;
+      worst_fit = std::move(fit);
+      worst_added = added;
+    }
+  }
+  if (worst) fused = std::move(worst_fit);
+  return worst;
+}
+
 void VolumeTracker::trim_strays(std::vector<CameraView>& views, MultiCameraPose& fused) const {
   std::vector<double> errors;
   for (const CameraView& view : views) {
-    const std::vector<double> view_errors = point_errors_px(view, fused.world_from_body);
+    const std::vector<double> view_errors = point_errors_sigmas(view, fused.world_from_body);
     errors.insert(errors.end(), view_errors.begin(), view_errors.end());
   }
   if (errors.empty()) return;
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  const double limit = std::max(kStrayFloorPx, kStrayFactor * errors[errors.size() / 2]);
-  std::vector<CameraView> kept = without_outliers(views, fused.world_from_body, limit);
+  const double limit = std::max(kStrayFloorSigmas, kStrayFactor * errors[errors.size() / 2]);
+  std::vector<CameraView> kept =
+      without_outliers(views, fused.world_from_body, limit, Units::Sigmas);
   const int points = points_in(kept);
   if (points == points_in(views) || points < options_.fusion.min_points) return;
   MultiCameraPose again = estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
   if (!again.valid) return;
   views = std::move(kept);
   fused = std::move(again);
+}
+
+bool VolumeTracker::unusually_poor(const Fused& fit, double usual_normalized_rms) {
+  return fit.pose.normalized_rms > kUnusualRmsFactor * expected_rms(usual_normalized_rms);
 }
 
 void VolumeTracker::take(const std::vector<std::vector<Eigen::Vector2d>>& used,
@@ -382,11 +531,14 @@ TrackedBodyPose VolumeTracker::update_track(size_t body, int64_t stamp_ns,
   Track& next = *track;
   next.world_from_body = fused.world_from_body;
   next.stamp_ns = stamp_ns;
-  if (fused.cameras_used >= 2) {
-    next.usual_rms_px = next.usual_rms_px == 0 ? fused.reprojection_rms_px
-                                               : (1 - kUsualRmsSmoothing) * next.usual_rms_px +
-                                                     kUsualRmsSmoothing * fused.reprojection_rms_px;
-  }
+  next.cameras_used = fused.cameras_used;
+  auto follow = [&](double& usual) {
+    usual = usual == 0
+                ? fused.normalized_rms
+                : (1 - kUsualRmsSmoothing) * usual + kUsualRmsSmoothing * fused.normalized_rms;
+  };
+  follow(next.usual_normalized_rms);
+  follow(usual_normalized_rms_);
   next.history.emplace_back(stamp_ns, fused.world_from_body);
   while (next.history.size() > 2 &&
          static_cast<double>(stamp_ns - next.history[1].first) * 1e-9 >= kVelocityWindow_s) {
@@ -413,6 +565,7 @@ TrackedBodyPose VolumeTracker::update_track(size_t body, int64_t stamp_ns,
   pose.velocity_known = next.velocity_known;
   pose.velocity_covariance = next.velocity_covariance;
   pose.reprojection_rms_px = fused.reprojection_rms_px;
+  pose.normalized_rms = fused.normalized_rms;
   pose.cameras_used = fused.cameras_used;
   pose.points_used = fused.points_used;
   return pose;

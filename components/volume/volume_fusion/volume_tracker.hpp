@@ -45,7 +45,10 @@ struct VolumeCamera {
 struct VolumeTrackerOptions {
   MarkerTriangulationOptions triangulation;
   RigidBodyIdentificationOptions identification;
-  MultiCameraPoseOptions fusion;
+  // A pose rests on six points at least: four or five (one camera seeing a corner of a board,
+  // two cameras two markers each) fix six unknowns with nothing left over to check them, and on
+  // the demo's images such fits stood centimetres off with residuals as small as any.
+  MultiCameraPoseOptions fusion = {.min_points = 6};
   // How far a camera's detection may be from where the predicted pose puts a marker (pixels).
   double match_radius_px = 8;
   // A track not fused for this long is dropped; the body must then be identified again.
@@ -75,7 +78,8 @@ struct TrackedBodyPose {
   // Over (vx, vy, vz, wx, wy, wz), from the poses' covariance over the velocity's time span.
   Eigen::Matrix<double, 6, 6> velocity_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   double reprojection_rms_px = 0;
-  int cameras_used = 0;  // 1: the single-camera pose
+  double normalized_rms = 0;  // MultiCameraPose::normalized_rms
+  int cameras_used = 0;       // 1: the single-camera pose
   int points_used = 0;
 };
 
@@ -101,9 +105,9 @@ class VolumeTracker {
   const std::vector<CameraHealth>& camera_health() const { return health_; }
   // Bodies identified from triangulated markers (tracks started), over the tracker's life.
   int64_t identifications() const { return identifications_; }
-  // Fits from a track's prediction set aside as unusually poor (more than five times the
-  // track's usual RMS), the body then fitted from its last pose or identified afresh, over the
-  // tracker's life.
+  // Fits set aside as unusually poor (residuals more than five times what the track, or the
+  // volume, usually has): from a track's prediction, the body then fitted from its last pose or
+  // identified afresh; from identification, the body left unposed. Over the tracker's life.
   int64_t unusual_fits() const { return unusual_fits_; }
 
  private:
@@ -115,9 +119,9 @@ class VolumeTracker {
     bool velocity_known = false;
     Eigen::Matrix<double, 6, 6> velocity_covariance = Eigen::Matrix<double, 6, 6>::Zero();
     std::deque<std::pair<int64_t, Eigen::Isometry3d>> history;  // recent poses by stamp
-    // The RMS its poses fused from several cameras usually have (a running average); 0 until
-    // the first.
-    double usual_rms_px = 0;
+    // The normalized RMS its fits usually have (a running average); 0 until the first.
+    double usual_normalized_rms = 0;
+    int cameras_used = 0;  // of its last pose
   };
 
   struct Fused {
@@ -125,14 +129,32 @@ class VolumeTracker {
     std::vector<std::vector<Eigen::Vector2d>> used;  // per camera, the detections it rests on
   };
   // The body's pose fused over the cameras' detections within `radius_px` of where `start`
-  // puts its markers, with a disagreeing camera left out when the others agree without it.
+  // puts its markers, with a disagreeing camera left out when the others agree without it:
+  // one whose points make the fit fail, or one whose points raise the fit's residuals well
+  // above `usual_normalized_rms` (what the body's fits usually have) where the others' alone
+  // are as usual.
   std::optional<Fused> fuse(size_t body, const Eigen::Isometry3d& start,
-                            const std::vector<CameraDetections>& detections, double radius_px);
+                            const std::vector<CameraDetections>& detections, double radius_px,
+                            double usual_normalized_rms);
+  // Of the two views with points, the camera whose residuals say it is on its way to being
+  // called drifted while the other's do not; views.size() when neither stands out.
+  size_t suspect_of_two(const std::vector<CameraView>& views) const;
+  // Leaves the point furthest off out of `views` and refits `fused`, when that brings the fit's
+  // residuals back to the usual; false (nothing changed) otherwise.
+  bool without_worst_point(std::vector<CameraView>& views, MultiCameraPose& fused,
+                           double usual_normalized_rms) const;
+  // The view whose points disagree with the others' (disagreeing above), `fused` refitted
+  // without it; nullopt when leaving no one view out brings the residuals back to the usual.
+  std::optional<size_t> disagreeing_view(const std::vector<CameraView>& views,
+                                         MultiCameraPose& fused, double usual_normalized_rms) const;
   // A marker merged with a neighbour's, half hidden by another board, or another body's taken
   // for one of this body's moves its pixel by a pixel or more where the rest agree within a
   // tenth: a few such points stay under the RMS limit yet tilt the pose. The points far above
   // the fit's typical error are left out of `views` and `fused` fitted again without them.
   void trim_strays(std::vector<CameraView>& views, MultiCameraPose& fused) const;
+  // A fit whose residuals are far beyond what `usual_normalized_rms` and the detections'
+  // sigmas explain: not a pose of the body (its points are something else).
+  static bool unusually_poor(const Fused& fit, double usual_normalized_rms);
   // Removes the detections `used` from `detections`: one detection belongs to one body.
   static void take(const std::vector<std::vector<Eigen::Vector2d>>& used,
                    std::vector<CameraDetections>& detections);
@@ -146,6 +168,7 @@ class VolumeTracker {
   std::vector<CameraHealth> health_;
   int64_t identifications_ = 0;
   int64_t unusual_fits_ = 0;
+  double usual_normalized_rms_ = 0;  // of every body's fits, a running average
 };
 
 }  // namespace mocap::volume
