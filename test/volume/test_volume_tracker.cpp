@@ -40,19 +40,22 @@ std::vector<Eigen::Isometry3d> truth_at(double t) {
   return {helmet, drone};
 }
 
+// The synthetic volume's cameras, cam_0 .. cam_3.
+std::vector<VolumeCamera> cameras_of(const test::Volume& volume) {
+  std::vector<VolumeCamera> cameras;
+  for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
+    const std::string name = "cam_" + std::to_string(c);
+    cameras.push_back({name, volume.camera, volume.extrinsics[c], name + "_optical"});
+  }
+  return cameras;
+}
+
 struct Sequence {
   const test::Volume volume;
   const RigidBodyDatabase bodies = parse_rigid_bodies(kBodies, "bodies.yaml", 0.004, 3);
   std::mt19937 random{5};
 
-  std::vector<VolumeCamera> cameras() const {
-    std::vector<VolumeCamera> cameras;
-    for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
-      const std::string name = "cam_" + std::to_string(c);
-      cameras.push_back({name, volume.camera, volume.extrinsics[c], name + "_optical"});
-    }
-    return cameras;
-  }
+  std::vector<VolumeCamera> cameras() const { return cameras_of(volume); }
 
   // Each camera's detections of the bodies at `poses`, through `extrinsics` (the cameras' true
   // places), each camera missing one marker of each body at random (an occluder), shuffled.
@@ -169,10 +172,7 @@ TEST(VolumeTracker, OneCameraAloneKeepsATrackFlaggedAsSuch) {
   const test::Volume volume;
   RigidBodyDatabase bodies;
   bodies.bodies.push_back({"board", test::kBoard});
-  std::vector<VolumeCamera> cameras;
-  for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
-    cameras.push_back({"cam_" + std::to_string(c), volume.camera, volume.extrinsics[c], "optical"});
-  }
+  const std::vector<VolumeCamera> cameras = cameras_of(volume);
   VolumeTracker tracker(cameras, bodies);
   std::mt19937 random(7);
   std::normal_distribution<double> noise(0, 0.1);
@@ -255,10 +255,7 @@ TEST(VolumeTracker, ABodyThatTurnsBackIsNotFittedToItsMarkersNeighbours) {
               [0.018, 0.052, 0.006], [0.095, 0.066, 0.024], [0.047, 0.105, 0.003]]
 )",
                                                       "bodies.yaml", 0.001, 4);
-  std::vector<VolumeCamera> cameras;
-  for (size_t c = 0; c < volume.extrinsics.size(); ++c) {
-    cameras.push_back({"cam_" + std::to_string(c), volume.camera, volume.extrinsics[c], "optical"});
-  }
+  const std::vector<VolumeCamera> cameras = cameras_of(volume);
   VolumeTracker tracker(cameras, bodies);
   std::mt19937 random(3);
   std::normal_distribution<double> noise(0, 0.03);

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -116,11 +117,10 @@ bool start(Child& child, const std::vector<std::string>& extra) {
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
   const std::string ready_variable = fmt::format("{}={}", kReadyFdVariable, kReadyFd);
+  const std::string_view ready_name(ready_variable.data(), ready_variable.find('=') + 1);
   std::vector<char*> envp;
   for (char** variable = environ; *variable; ++variable) {
-    if (std::strncmp(*variable, kReadyFdVariable, std::strlen(kReadyFdVariable)) != 0) {
-      envp.push_back(*variable);
-    }
+    if (!std::string_view(*variable).starts_with(ready_name)) envp.push_back(*variable);
   }
   envp.push_back(const_cast<char*>(ready_variable.c_str()));
   envp.push_back(nullptr);
