@@ -124,9 +124,10 @@ TEST(VolumeAccuracy, NoFusedPoseIsTiltedByAStrayPoint) {
 // cut by an occluder from a side of its own (left, right, top, bottom, 40 %), as
 // VolumeDemo.BoardsNoCameraSeesWholeAreTracked does live; no camera sees a board whole, yet
 // from the frame each board is first identified on, it is posed in at least 99.5 % of frames,
-// none a false identification and at most 1 % beyond its covariance's 3 sigma. (Where one
-// camera's markers are cut by the occluder's edge, 6 to 34 sigmas off, the pose rests on the
-// other camera alone: a few such poses are 2 to 6 mm off, as their covariance says.)
+// none more than 2 mm or a degree off and at most 1 % beyond its covariance's 3 sigma. (Where
+// one camera's markers are cut by the occluder's edge, 6 to 34 sigmas off, the worst of them
+// are left out: leaving that camera out instead put the pose on the other camera alone, 2 to
+// 6 mm off.)
 TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
   test::RenderedVolumeOptions options;
   options.frames = 300;
@@ -145,7 +146,7 @@ TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
     if (body.fused.posed() && !first_posed.contains(body.body)) first_posed[body.body] = body.frame;
   }
   ASSERT_EQ(first_posed.size(), 4u);
-  int expected = 0, tracked = 0, wrong = 0, beyond = 0, over_2mm = 0;
+  int expected = 0, tracked = 0, beyond = 0, over_2mm = 0;
   std::vector<double> position_m;
   for (const test::BodyFrame& body : volume.body_frames) {
     if (body.frame < first_posed[body.body]) continue;
@@ -153,7 +154,6 @@ TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
     if (!body.fused.posed()) continue;
     ++tracked;
     position_m.push_back(body.fused.position_m);
-    wrong += false_identification(body) ? 1 : 0;
     beyond += beyond_three_sigma(body) ? 1 : 0;
     over_2mm += body.fused.position_m > 2e-3 || body.fused.rotation_deg > 1 ? 1 : 0;
   }
@@ -163,7 +163,7 @@ TEST(VolumeAccuracy, BoardsNoCameraSeesWholeAreTrackedInNearlyEveryFrame) {
       first_posed["board_1"], first_posed["board_2"], first_posed["board_3"],
       first_posed["board_4"], tracked, expected, quantile(position_m, 0.5) * 1e3, over_2mm, beyond);
   EXPECT_GE(tracked, expected * 995 / 1000);
-  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(over_2mm, 0);
   EXPECT_LE(beyond, tracked / 100);
   EXPECT_LT(quantile(position_m, 0.5), 0.5e-3);
 }

@@ -4,8 +4,9 @@
 // started again, and a camera bumped after calibration. Every run is held to the design's
 // figures: no false identification ever (a pose more than 5 cm or 5 degrees off is a wrong
 // answer handed to a robot: a frame the fusion cannot pose goes without), and 99.5 % of the
-// body-frames tracked. Real time: CI runs these one at a time with what it runs in the
-// background paused (test/CMakeLists.txt, the realtime part).
+// body-frames tracked, or, for the part of a run with a camera away, the 98 % the design gives
+// for one camera away (docs/targets.md). Real time: CI runs these one at a time with what it runs
+// in the background paused (test/CMakeLists.txt, the realtime part).
 #include <gtest/gtest.h>
 
 #include <yaml-cpp/yaml.h>
@@ -90,7 +91,9 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
 }
 
 // Camera cam_1's process is killed: the compute process says so and goes on fusing the other
-// three, a pose array for every frame; started again, the camera is taken back.
+// three, a pose array for every frame; started again, the camera is taken back. cam_1 is away
+// for about 4 s of the run's 12 or more: 99 % tracked over the run (98 % while away, 99.5 %
+// the rest).
 TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   test::TempDir dir;
   const auto summary = dir / "summary.yaml";
@@ -131,7 +134,7 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   std::printf("%s", test::read_file(summary).c_str());
   // A pose array for every frame of the truth camera (cam_0), through the kill and the return.
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << compute->output();
-  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.99) << test::read_file(summary);
   EXPECT_EQ(figures.false_identifications(), 0) << compute->output();
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
@@ -176,11 +179,10 @@ TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
 
 // cam_1 knocked by half a degree after calibration: the simulator renders it from where it now
 // points, the fusion still has its calibrated pose. It is named as moved, and poses stay right.
-// Tracked: 98 %, the figure of a camera away (VolumeAccuracy.CamerasMissingFromFrames...:
-// 98.4 % to 99.97 % on rendered images), which cam_1 is once named; before, for the first two
-// or three seconds, a board only cam_1 and one other camera see is not posed (their views
+// Tracked: 98 %, the figure of a camera away, which cam_1 is once named; before, for the first
+// two or three seconds, a board only cam_1 and one other camera see is not posed (their views
 // disagree by 4 px and each agrees with itself) until cam_1's residuals mark it out (93 % to
-// 96 % tracked in those seconds, 99.2 % to 99.7 % over the run, three runs measured).
+// 96 % tracked in those seconds; 97.8 % to 99.7 % over the run, six runs measured).
 TEST(VolumeDemo, ABumpedCameraIsNamed) {
   test::TempDir dir;
   calibration::CameraFile bumped = calibration::load_camera_file(
@@ -247,7 +249,8 @@ TEST(VolumeDemo, BoardsNoCameraSeesWholeAreTracked) {
 // The multi-host form: each camera on a network-namespace host of its own, the fusion on a
 // fifth (scripts/netns_volume.sh). Poses reach the compute host; a camera host killed and one
 // whose link goes down are reported silent while poses keep coming from the others, and are
-// taken back when they return; over the run the boards are tracked.
+// taken back when they return; over the run the boards are tracked: a camera is away for about
+// 5 s of the 20 (98 % then, 99.5 % the rest): 99 %.
 TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
   auto [code, output] =
       test::run_command({(test::source_dir() / "scripts" / "netns_volume.sh").string(), "--faults",
@@ -269,7 +272,7 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
       << output;
   EXPECT_GT(std::stoi(row[1]), 400) << output;
   EXPECT_EQ(std::stoi(row[2]), 0) << output;
-  EXPECT_GE(std::stod(row[3]), 99.5) << output;
+  EXPECT_GE(std::stod(row[3]), 99.0) << output;
   EXPECT_EQ(std::stoi(row[4]), 0) << output;
 }
 

@@ -245,8 +245,9 @@ TEST(VolumeTracker, ABodyOneCameraSeesByFewerThanSixMarkersIsNotPosed) {
 // A body of close markers (3 to 9 cm apart, 8 to 25 px in the cameras) flown to and fro at
 // 1.5 m/s, turning back at once every half second: at each turn its prediction runs on by 2.5 cm
 // (7 px), where a marker's neighbour lies nearer than the marker. Fitted to those, the fit was
-// up to a centimetre off and still under the RMS limit; far above the track's usual RMS, it is set
-// aside and the body fitted from its last pose: every pose within a millimetre.
+// up to a centimetre off and still under the RMS limit; far above the track's usual residuals,
+// the neighbours' points are left out, or the fit is set aside and the body fitted from its
+// last pose: every pose within a millimetre.
 TEST(VolumeTracker, ABodyThatTurnsBackIsNotFittedToItsMarkersNeighbours) {
   const test::Volume volume;
   const RigidBodyDatabase bodies = parse_rigid_bodies(R"(bodies:
@@ -285,7 +286,6 @@ TEST(VolumeTracker, ABodyThatTurnsBackIsNotFittedToItsMarkersNeighbours) {
               worst * 1e3, static_cast<long long>(tracker.unusual_fits()));
   EXPECT_EQ(posed, frames);
   EXPECT_LT(worst, 1e-3);
-  EXPECT_GT(tracker.unusual_fits(), 0);
 }
 
 TEST(VolumeTracker, BadInputThrows) {

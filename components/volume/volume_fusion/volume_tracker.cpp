@@ -42,14 +42,19 @@ constexpr double kUnstatedSigmaPx = 0.1;
 // fit is not handed out; the body is looked for afresh, or left unposed.
 constexpr double kUsualRmsSmoothing = 0.1;
 constexpr double kUnusualRmsFactor = 5;
-// A fit whose residuals exceed this many times the usual is looked at point by point, then
-// camera by camera: where leaving its worst point out, or else one camera's points, brings the
+// A fit whose residuals exceed this many times the usual is looked at camera by camera and
+// point by point: where leaving one camera's points out, or its few worst points, brings the
 // rest back to the usual, those points were not the body's markers (one far-off point pulls a
-// whole fit, so that its median error hides it from trim_strays). A camera that sees one or two of
-// a body's markers, one of them a blob merged with a neighbour's, bends the depth the camera that
-// sees the whole body fixes poorly: 10 to 15 mm off on the demo's images, with residuals 3 to 4
-// times the usual.
+// whole fit, so that its median error hides it from trim_strays). Whichever keeps more points:
+// a camera's one or two points bending the others' fit leave the others' points the furthest
+// off, where one far-off point in a camera that sees the body well is the one to leave out. A
+// camera that sees one or two of a body's markers, one of them a blob merged with a neighbour's,
+// bends the depth the camera that sees the whole body fixes poorly: 10 to 15 mm off on the demo's
+// images, with residuals 3 to 4 times the usual.
 constexpr double kElevatedRmsFactor = 2;
+// At most this many of a fit's worst points are left out, one by one, to bring it back to the
+// usual: markers cut by an occluder's edge in one camera come several at a time.
+constexpr int kMostWorstPoints = 3;
 // A camera's points disagree with the others' when they add this many sigmas (squared, per
 // residual, in units of the usual) to the fit's chi-square: 3, where agreeing points add about
 // 1. Points cut by an occluder's edge raise a fit's residuals too, in every camera, and by
@@ -236,10 +241,14 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
       if (wider && wider->pose.cameras_used >= 2 && !unusually_poor(*wider, usual)) {
         fused = std::move(wider);
       }
-    } else if (!fused && track->cameras_used == 1) {
+    } else if (!fused) {
       // Posed by one camera last, the body passes into another's view where the prediction,
-      // off in the first camera's depth, misses its markers: the same wider net.
-      fused = fuse(b, start, cameras, kRetryRadiusFactor * options_.match_radius_px, usual);
+      // off in the first camera's depth, misses its markers: the same wider net. A body that
+      // turned back is nearer its last pose than its prediction, which runs on.
+      const double radius =
+          (track->cameras_used == 1 ? kRetryRadiusFactor : 1.0) * options_.match_radius_px;
+      if (track->cameras_used == 1) fused = fuse(b, start, cameras, radius, usual);
+      if (!fused) fused = fuse(b, track->world_from_body, cameras, radius, usual);
     }
     // Markers taken for their neighbours, as when a body turns back and its prediction runs on,
     // or when one camera's poor depth puts the prediction off, give a fit under the RMS limit
@@ -363,12 +372,21 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   const std::vector<CameraView> untrimmed = views;
   trim_strays(views, fused);
   if (!left_out && fused.normalized_rms > kElevatedRmsFactor * expected_rms(usual_normalized_rms)) {
-    if (!without_worst_point(views, fused, usual_normalized_rms)) {
-      if (std::optional<size_t> other = disagreeing_view(views, fused, usual_normalized_rms)) {
-        left_out = *other;
-        ++health_[*other].left_out;
-        empty_view(views[*other]);
-      }
+    // A camera's points, or a few worst points: whichever keeps more of the fit's points.
+    MultiCameraPose without_camera = fused, without_points = fused;
+    std::vector<CameraView> fewer_points = views;
+    const std::optional<size_t> other =
+        disagreeing_view(views, without_camera, usual_normalized_rms);
+    const bool points_out =
+        without_worst_points(fewer_points, without_points, usual_normalized_rms);
+    if (other && !(points_out && without_points.points_used > without_camera.points_used)) {
+      left_out = *other;
+      ++health_[*other].left_out;
+      empty_view(views[*other]);
+      fused = std::move(without_camera);
+    } else if (points_out) {
+      views = std::move(fewer_points);
+      fused = std::move(without_points);
     }
   }
 
@@ -412,34 +430,37 @@ size_t VolumeTracker::suspect_of_two(const std::vector<CameraView>& views) const
   return views.size();
 }
 
-bool VolumeTracker::without_worst_point(std::vector<CameraView>& views, MultiCameraPose& fused,
-                                        double usual_normalized_rms) const {
-  size_t worst_view = 0, worst_point = 0;
-  double worst = -1;
-  for (size_t v = 0; v < views.size(); ++v) {
-    const std::vector<double> errors = point_errors_sigmas(views[v], fused.world_from_body);
-    for (size_t i = 0; i < errors.size(); ++i) {
-      if (errors[i] > worst) {
-        worst = errors[i];
-        worst_view = v;
-        worst_point = i;
+bool VolumeTracker::without_worst_points(std::vector<CameraView>& views, MultiCameraPose& fused,
+                                         double usual_normalized_rms) const {
+  std::vector<CameraView> kept = views;
+  MultiCameraPose fit = fused;
+  for (int removed = 0; removed < kMostWorstPoints; ++removed) {
+    size_t worst_view = 0, worst_point = 0;
+    double worst = -1;
+    for (size_t v = 0; v < kept.size(); ++v) {
+      const std::vector<double> errors = point_errors_sigmas(kept[v], fit.world_from_body);
+      for (size_t i = 0; i < errors.size(); ++i) {
+        if (errors[i] > worst) {
+          worst = errors[i];
+          worst_view = v;
+          worst_point = i;
+        }
       }
     }
+    if (worst < 0 || points_in(kept) <= options_.fusion.min_points) return false;
+    CameraView& view = kept[worst_view];
+    view.body_points.erase(view.body_points.begin() + static_cast<long>(worst_point));
+    view.pixels.erase(view.pixels.begin() + static_cast<long>(worst_point));
+    view.pixel_sigma_px.erase(view.pixel_sigma_px.begin() + static_cast<long>(worst_point));
+    fit = estimate_multi_camera_pose(kept, fit.world_from_body, options_.fusion);
+    if (!fit.valid) return false;
+    if (fit.normalized_rms <= kElevatedRmsFactor * expected_rms(usual_normalized_rms)) {
+      views = std::move(kept);
+      fused = std::move(fit);
+      return true;
+    }
   }
-  if (worst < 0 || points_in(views) <= options_.fusion.min_points) return false;
-  std::vector<CameraView> kept = views;
-  CameraView& view = kept[worst_view];
-  view.body_points.erase(view.body_points.begin() + static_cast<long>(worst_point));
-  view.pixels.erase(view.pixels.begin() + static_cast<long>(worst_point));
-  view.pixel_sigma_px.erase(view.pixel_sigma_px.begin() + static_cast<long>(worst_point));
-  MultiCameraPose again = estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
-  if (!again.valid ||
-      again.normalized_rms > kElevatedRmsFactor * expected_rms(usual_normalized_rms)) {
-    return false;
-  }
-  views = std::move(kept);
-  fused = std::move(again);
-  return true;
+  return false;
 }
 
 std::optional<size_t> VolumeTracker::disagreeing_view(const std::vector<CameraView>& views,

@@ -139,10 +139,11 @@ class VolumeTracker {
   // Of the two views with points, the camera whose residuals say it is on its way to being
   // called drifted while the other's do not; views.size() when neither stands out.
   size_t suspect_of_two(const std::vector<CameraView>& views) const;
-  // Leaves the point furthest off out of `views` and refits `fused`, when that brings the fit's
-  // residuals back to the usual; false (nothing changed) otherwise.
-  bool without_worst_point(std::vector<CameraView>& views, MultiCameraPose& fused,
-                           double usual_normalized_rms) const;
+  // Leaves the points furthest off out of `views`, one by one (a few at most), and refits
+  // `fused`, when that brings the fit's residuals back to the usual; false (nothing changed)
+  // otherwise.
+  bool without_worst_points(std::vector<CameraView>& views, MultiCameraPose& fused,
+                            double usual_normalized_rms) const;
   // The view whose points disagree with the others' (disagreeing above), `fused` refitted
   // without it; nullopt when leaving no one view out brings the residuals back to the usual.
   std::optional<size_t> disagreeing_view(const std::vector<CameraView>& views,
