@@ -19,7 +19,7 @@
 #include <mocap/component_host.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace {
 

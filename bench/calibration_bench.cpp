@@ -17,7 +17,7 @@
 #include <mocap/calibration/calibration_problem.hpp>
 #include <mocap/calibration/lens_models.hpp>
 
-#include "synthetic_rig.hpp"
+#include "test/calibration/synthetic_rig.hpp"
 
 namespace {
 

@@ -32,8 +32,8 @@
 #include <mocap/component_host.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "one_hop.hpp"
-#include "test_support.hpp"
+#include "bench/one_hop.hpp"
+#include "test/test_support.hpp"
 
 namespace {
 
@@ -46,7 +46,7 @@ const Size kImage{"Image 1280x720 mono8", true, 1280, 720, kRateHz, 0, 0};
 mocap::HostOptions udp_host(const std::string& name, const std::string& implementation) {
   return {.name = name,
           .threads = 2,
-          .dds = {.implementation = implementation, .fastdds = {.shared_memory = false}}};
+          .dds = {.implementation = implementation, .shared_memory = false}};
 }
 
 // --- the two processes ------------------------------------------------------------------

@@ -10,11 +10,11 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/camera_model.hpp>
 
-#include "constellation_identifier.hpp"
-#include "constellation_tracker.hpp"
-#include "fiducial_detector.hpp"
-#include "planar_pose.hpp"
-#include "scene.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
+#include "tracking/constellation_tracker/constellation_tracker.hpp"
+#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
 
 namespace mocap::bench {
 

@@ -11,9 +11,9 @@
 
 #include <fmt/format.h>
 
-#include "candump_log.hpp"
-#include "pixart_decoder.hpp"
-#include "slcan.hpp"
+#include "common/can_io/candump_log.hpp"
+#include "common/can_io/slcan.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
 
 namespace {
 

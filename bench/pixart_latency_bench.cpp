@@ -25,16 +25,16 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
-#include "camera_samples.hpp"
-#include "core/plugin_loader.hpp"
-#include "pixart_box_simulator.hpp"
-#include "pixart_decoder.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
-#include "robot_localizer.hpp"
-#include "serial_port.hpp"
-#include "simulated_slcan_adaptor.hpp"
-#include "slcan.hpp"
+#include "common/can_io/slcan.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "host/plugin_loader.hpp"
+#include "pixart/pixart_bridge/camera_samples.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
+#include "sim/pixart_box_sim/simulated_slcan_adaptor.hpp"
 
 namespace {
 

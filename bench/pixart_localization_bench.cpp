@@ -13,10 +13,10 @@
 
 #include <fmt/format.h>
 
-#include "pixart_box_simulator.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
-#include "robot_localizer.hpp"
+#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
 
 namespace {
 

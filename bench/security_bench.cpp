@@ -27,7 +27,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "one_hop.hpp"
+#include "bench/one_hop.hpp"
 
 namespace {
 
@@ -38,7 +38,7 @@ using namespace mocap::one_hop;
 mocap::DdsOptions dds_options(const std::string& security, bool shared_memory,
                               const std::string& identity) {
   mocap::DdsOptions options;
-  options.fastdds.shared_memory = shared_memory;
+  options.shared_memory = shared_memory;
   if (!security.empty()) {
     options.security_directory = security;
     options.security_identity = identity;

@@ -11,11 +11,11 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "constellation_tracker.hpp"
-#include "ir_renderer.hpp"
-#include "offline_pipeline.hpp"
-#include "pose_evaluation.hpp"
-#include "sequence_evaluation.hpp"
+#include "bench/offline_pipeline.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "tracking/constellation_tracker/constellation_tracker.hpp"
+#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/pose_evaluator/sequence_evaluation.hpp"
 
 namespace {
 

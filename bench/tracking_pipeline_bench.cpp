@@ -8,9 +8,9 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "constellation_tracker.hpp"
-#include "ir_renderer.hpp"
-#include "offline_pipeline.hpp"
+#include "bench/offline_pipeline.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "tracking/constellation_tracker/constellation_tracker.hpp"
 
 namespace {
 

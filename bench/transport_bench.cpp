@@ -43,8 +43,9 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "one_hop.hpp"
+#include "bench/one_hop.hpp"
 
+#include "dds/cyclonedds/cyclonedds_qos.hpp"
 #include "dds/cyclonedds/cyclonedds_transport.hpp"
 #include "dds/cyclonedds/cyclonedds_type_support.hpp"
 #include "dds/dds_transport.hpp"

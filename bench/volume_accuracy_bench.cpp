@@ -19,7 +19,7 @@
 
 #include <fmt/format.h>
 
-#include "rendered_volume.hpp"
+#include "test/volume/rendered_volume.hpp"
 
 namespace {
 

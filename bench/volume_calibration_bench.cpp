@@ -17,8 +17,8 @@
 
 #include <fmt/format.h>
 
-#include "rendered_calibration.hpp"
-#include "rendered_volume.hpp"
+#include "test/volume/rendered_calibration.hpp"
+#include "test/volume/rendered_volume.hpp"
 
 namespace {
 

@@ -16,11 +16,11 @@
 
 #include <fmt/format.h>
 
-#include "multi_camera_pose.hpp"
-#include "planar_pose.hpp"
-#include "rigid_body_database.hpp"
-#include "synthetic_volume.hpp"
-#include "volume_tracker.hpp"
+#include "test/volume/synthetic_volume.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
+#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
+#include "volume/volume_fusion/volume_tracker.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 #include <mocap/bag/bag_metadata.hpp>
 #include <mocap/bag/bag_reader.hpp>
 
-#include "scratch_files.hpp"
+#include "fuzz/scratch_files.hpp"
 
 namespace {
 

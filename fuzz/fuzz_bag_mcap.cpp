@@ -12,8 +12,8 @@
 #include <mocap/bag/bag_error.hpp>
 #include <mocap/bag/bag_reader.hpp>
 
+#include "fuzz/scratch_files.hpp"
 #include "mcap_reader.hpp"
-#include "scratch_files.hpp"
 
 namespace fs = std::filesystem;
 

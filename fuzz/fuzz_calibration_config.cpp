@@ -13,8 +13,8 @@
 
 #include <mocap/calibration/calibration_config.hpp>
 
-#include "rigid_transform.hpp"
-#include "scratch_files.hpp"
+#include "fuzz/rigid_transform.hpp"
+#include "fuzz/scratch_files.hpp"
 
 namespace {
 

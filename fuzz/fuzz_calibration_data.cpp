@@ -19,7 +19,7 @@
 #include <mocap/calibration/board_recording.hpp>
 #include <mocap/calibration/calibration_config.hpp>
 
-#include "scratch_files.hpp"
+#include "fuzz/scratch_files.hpp"
 
 namespace {
 

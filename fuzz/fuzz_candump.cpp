@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include "candump_log.hpp"
-#include "scratch_files.hpp"
+#include "common/can_io/candump_log.hpp"
+#include "fuzz/scratch_files.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "constellation_database.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 namespace {
 

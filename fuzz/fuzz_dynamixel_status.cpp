@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "protocol.hpp"
+#include "follower/dynamixel/protocol.hpp"
 
 namespace {
 

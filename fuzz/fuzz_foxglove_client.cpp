@@ -7,7 +7,7 @@
 #include <span>
 #include <string_view>
 
-#include "foxglove_protocol.hpp"
+#include "viewer/foxglove_bridge/foxglove_protocol.hpp"
 
 using namespace mocap::foxglove;
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <string_view>
 
-#include "core/plugin_loader.hpp"
+#include "fuzz/scratch_files.hpp"
+#include "host/plugin_loader.hpp"
 #include "launch/launch_file.hpp"
-#include "scratch_files.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

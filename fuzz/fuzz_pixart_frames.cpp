@@ -14,9 +14,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "camera_samples.hpp"
-#include "pixart_decoder.hpp"
-#include "socketcan.hpp"
+#include "common/can_io/socketcan.hpp"
+#include "pixart/pixart_bridge/camera_samples.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
 
 namespace {
 

@@ -12,9 +12,9 @@
 #include <string_view>
 #include <vector>
 
-#include "pixart_rig.hpp"
-#include "rigid_transform.hpp"
-#include "scratch_files.hpp"
+#include "fuzz/rigid_transform.hpp"
+#include "fuzz/scratch_files.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace {
 

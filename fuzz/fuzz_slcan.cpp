@@ -7,8 +7,8 @@
 #include <string_view>
 #include <vector>
 
-#include "can_frame.hpp"
-#include "slcan.hpp"
+#include "common/can_io/can_frame.hpp"
+#include "common/can_io/slcan.hpp"
 
 namespace {
 

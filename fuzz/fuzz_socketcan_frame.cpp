@@ -8,9 +8,9 @@
 #include <cstring>
 #include <string>
 
-#include "can_frame.hpp"
-#include "candump_log.hpp"
-#include "socketcan.hpp"
+#include "common/can_io/can_frame.hpp"
+#include "common/can_io/candump_log.hpp"
+#include "common/can_io/socketcan.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using mocap::can::CanFrame;

@@ -9,8 +9,8 @@
 #include <string>
 #include <string_view>
 
-#include "rigid_transform.hpp"
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
+#include "fuzz/rigid_transform.hpp"
 
 namespace {
 

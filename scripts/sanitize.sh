@@ -39,7 +39,7 @@ case "$mode" in
     # the reports of the pose outputs; the viewer's WebSocket server thread and its client queues,
     # pixart_bridge's serial reader and the simulated PixArt box, the Dynamixel follower's worker
     # and the simulated AX-12 chain, and camera_source's capture thread.
-    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|Lifecycle|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|(cyclonedds\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds(\.|/MixedTracking\.)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
+    tsan_tests='^(CdrFormat|IdlSchema|ComponentHost|Lifecycle|TopicFamilies|Executor|DispatchTest|Timers|SharedMemoryCleanup|IntraProcess|([a-z]+\.)?(Graph|Dds|MocapBag|Playback|Patterns/MocapBagStops|Storages/MocapBagCutShort|DiscoveryServer)|MixedDds(\.|/MixedTracking\.)|Launcher|BagPipeline|BagRecorderComponent|VrpnServer|PoseOutputs|Px4Odometry|ClientQueue|FoxgloveBridge(Test|Network|Security|Pixart)|PixartBridge|PixartBoxSimPlugin|SimulatedSlcanAdaptor|SerialPort|PseudoTerminal|SimulatedAx12(Chain|Faults)|Ax12SimPlugin|DynamixelBus|DynamixelFollowerPlugin|TurretFollower|CameraSourcePlugin|ImageDirectorySource|VideoFileSource)'
     ;;
   *)
     echo "usage: scripts/sanitize.sh address|thread [ctest arguments]" >&2
@@ -84,7 +84,7 @@ fi
 # Under ThreadSanitizer, which slows the DDS stop paths far more, the loads that keep every core
 # busy run after the others, one per core: beside other tests a stopping publisher once dropped
 # its last sample (cyclonedds ARestartedSubscriberProcessReceivesAgain/BusyCoresAndSlowSubscriber).
-busy_cores='(cyclonedds\.)?Dds/ReliableUnderLoad\..*/BusyCores.*'
+busy_cores='([a-z]+\.)?Dds/ReliableUnderLoad\..*/BusyCores.*'
 MOCAP_TEST_PARALLEL=$parallel scripts/run_tests.sh "$build" "$mode sanitizer" "${filter[@]}" \
   -E "^($busy_cores)\$" "$@"
 # (All of them DDS tests, which the threaded parts include.)

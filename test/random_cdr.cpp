@@ -1,4 +1,4 @@
-#include "random_cdr.hpp"
+#include "test/random_cdr.hpp"
 
 #include <cstring>
 #include <stdexcept>

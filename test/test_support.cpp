@@ -1,4 +1,4 @@
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -13,6 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+
+#include "host/dds_implementations.hpp"
 
 namespace mocap::test {
 namespace fs = std::filesystem;
@@ -48,10 +50,14 @@ std::string read_file(const fs::path& path) {
 
 std::string dds_implementation() {
   const char* implementation = std::getenv("MOCAP_DDS_IMPLEMENTATION");
-  return implementation != nullptr && *implementation != '\0' ? implementation : "fastdds";
+  return implementation != nullptr && *implementation != '\0'
+             ? implementation
+             : std::string(dds_implementations().front().name);
 }
 
-int test_domain(int slot) { return (dds_implementation() == "cyclonedds" ? 0 : 100) + slot; }
+int test_domain(int slot) {
+  return (dds_implementation() == dds_implementations().front().name ? 100 : 0) + slot;
+}
 
 int mixed_domain(int index) {
   if (index < 0 || index > 12) throw std::invalid_argument("mixed_domain takes 0..12");

@@ -14,8 +14,8 @@
 #include <mocap/generated_message_types.hpp>
 
 #include "messages/idl_schema.hpp"
-#include "random_cdr.hpp"
-#include "test_support.hpp"
+#include "test/random_cdr.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::bag {
 namespace {

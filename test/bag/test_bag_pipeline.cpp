@@ -15,7 +15,7 @@
 #include <mocap/bag/bag_metadata.hpp>
 #include <mocap/bag/bag_reader.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::bag {
 namespace {

@@ -35,7 +35,7 @@
 #include <mocap/bag/bag_reader.hpp>
 #include <mocap/bag/bag_writer.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace {
 

@@ -26,7 +26,7 @@
 #include <nlohmann/json.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::bag {
 namespace {

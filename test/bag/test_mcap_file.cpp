@@ -15,7 +15,7 @@
 #include "mcap_format.hpp"
 #include "mcap_reader.hpp"
 #include "mcap_writer.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::bag::mcap {
 namespace {

@@ -20,7 +20,7 @@
 #include <mocap/calibration/lens_models.hpp>
 
 #include "../draw_order.hpp"
-#include "pixart_rig.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace mocap::calibration::synthetic {
 

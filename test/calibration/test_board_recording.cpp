@@ -23,12 +23,12 @@
 #include <mocap/calibration/calibration_config.hpp>
 #include <mocap/component_host.hpp>
 
-#include "candump_recording.hpp"
-#include "core/plugin_loader.hpp"
-#include "pixart_box_simulator.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
-#include "test_support.hpp"
+#include "host/plugin_loader.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/candump_recording.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::calibration {
 namespace {

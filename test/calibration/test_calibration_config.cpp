@@ -9,7 +9,7 @@
 
 #include <mocap/calibration/calibration_config.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::calibration {
 namespace {

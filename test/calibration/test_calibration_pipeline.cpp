@@ -33,13 +33,13 @@
 #include <mocap/calibration/calibration_config.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
-#include "candump_recording.hpp"
-#include "draw_order.hpp"
-#include "pixart_box_simulator.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
-#include "robot_localizer.hpp"
-#include "test_support.hpp"
+#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/candump_recording.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
+#include "test/draw_order.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

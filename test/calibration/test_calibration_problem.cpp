@@ -11,7 +11,7 @@
 #include <mocap/calibration/calibration_problem.hpp>
 #include <mocap/calibration/lens_models.hpp>
 
-#include "synthetic_rig.hpp"
+#include "test/calibration/synthetic_rig.hpp"
 
 namespace mocap::calibration {
 namespace {

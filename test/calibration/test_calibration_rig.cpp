@@ -4,7 +4,7 @@
 // solution's covariance predicts, and the prediction to the figures measured.
 #include <gtest/gtest.h>
 
-#include "synthetic_rig.hpp"
+#include "test/calibration/synthetic_rig.hpp"
 
 namespace mocap::calibration::synthetic {
 namespace {

@@ -24,7 +24,7 @@
 #include <mocap/calibration/unified_camera.hpp>
 #include <opencv2/ccalib/omnidir.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::calibration {
 namespace {

@@ -21,7 +21,7 @@
 #include <mocap/calibration/camera_factory.hpp>
 #include <mocap/calibration/camera_file.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::calibration {
 namespace {

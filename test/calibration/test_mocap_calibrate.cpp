@@ -11,8 +11,8 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/lens_models.hpp>
 
-#include "synthetic_rig.hpp"
-#include "test_support.hpp"
+#include "test/calibration/synthetic_rig.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::calibration {
 namespace {

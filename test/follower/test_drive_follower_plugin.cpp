@@ -22,9 +22,9 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "core/plugin_loader.hpp"
-#include "test_support.hpp"
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
+#include "host/plugin_loader.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::drive {
 namespace {

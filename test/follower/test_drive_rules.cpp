@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "acceleration_limiter.hpp"
-#include "drive_follower.hpp"
-#include "drive_rules.hpp"
-#include "object_in_base.hpp"
-#include "test_support.hpp"
-#include "turret_model.hpp"
-#include "unicycle_base.hpp"
+#include "follower/drive_follower/acceleration_limiter.hpp"
+#include "follower/drive_follower/drive_follower.hpp"
+#include "follower/drive_follower/drive_rules.hpp"
+#include "follower/drive_follower/object_in_base.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
+#include "sim/mobile_base_sim/unicycle_base.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::drive {
 namespace {

@@ -15,11 +15,11 @@
 
 #include <mocap/component_host.hpp>
 
-#include "ax12_control_table.hpp"
-#include "core/plugin_loader.hpp"
-#include "dynamixel_bus.hpp"
-#include "protocol.hpp"
-#include "test_support.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
+#include "follower/dynamixel/dynamixel_bus.hpp"
+#include "follower/dynamixel/protocol.hpp"
+#include "host/plugin_loader.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::dynamixel {
 namespace {

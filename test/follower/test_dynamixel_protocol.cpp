@@ -10,8 +10,8 @@
 
 #include <fmt/format.h>
 
-#include "ax12_control_table.hpp"
-#include "protocol.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
+#include "follower/dynamixel/protocol.hpp"
 
 namespace mocap::dynamixel {
 namespace {

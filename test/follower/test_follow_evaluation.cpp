@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "follow_evaluation.hpp"
+#include "follower/follower_monitor/follow_evaluation.hpp"
 
 namespace mocap::evaluation {
 namespace {

@@ -9,7 +9,7 @@
 
 #include <string>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

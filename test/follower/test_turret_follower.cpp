@@ -19,12 +19,12 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "core/plugin_loader.hpp"
-#include "joint_history.hpp"
-#include "servo_mapping.hpp"
-#include "test_support.hpp"
-#include "turret_follower.hpp"
-#include "turret_model.hpp"
+#include "follower/dynamixel_follower/servo_mapping.hpp"
+#include "follower/dynamixel_follower/turret_follower.hpp"
+#include "follower/turret_kinematics/joint_history.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
+#include "host/plugin_loader.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::turret {
 namespace {

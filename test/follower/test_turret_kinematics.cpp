@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "test_support.hpp"
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::turret {
 namespace {

@@ -18,8 +18,8 @@
 #include "dds/fastdds/fastdds_type_adapter.hpp"
 #include "messages/cdr_format.hpp"
 #include "messages/idl_schema.hpp"
-#include "random_cdr.hpp"
-#include "test_support.hpp"
+#include "test/random_cdr.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

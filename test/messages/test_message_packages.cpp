@@ -11,8 +11,8 @@
 
 #include "messages/cdr_format.hpp"
 #include "messages/idl_schema.hpp"
-#include "test_support.hpp"
-#include "tools/msg_to_idl.hpp"
+#include "mocap_msg_to_idl/msg_to_idl.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

@@ -18,11 +18,11 @@
 #include <nav_msgs/msg/odometry.hpp>
 #include <tf2_msgs/msg/tf_message.hpp>
 
-#include "body_frames.hpp"
-#include "core/plugin_loader.hpp"
-#include "outputs/pose_feeder.hpp"
-#include "pose_message.hpp"
-#include "test_support.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "host/plugin_loader.hpp"
+#include "outputs/body_frames/body_frames.hpp"
+#include "test/outputs/pose_feeder.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::outputs {
 namespace {

@@ -17,12 +17,12 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <px4_msgs/msg/vehicle_odometry.hpp>
 
-#include "body_frames.hpp"
-#include "core/plugin_loader.hpp"
-#include "outputs/pose_feeder.hpp"
-#include "pose_message.hpp"
-#include "px4_frames.hpp"
-#include "test_support.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "host/plugin_loader.hpp"
+#include "outputs/body_frames/body_frames.hpp"
+#include "outputs/px4_odometry/px4_frames.hpp"
+#include "test/outputs/pose_feeder.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::outputs {
 namespace {

@@ -22,9 +22,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "test_support.hpp"
-#include "tracker_server.hpp"
-#include "vrpn_protocol.hpp"
+#include "outputs/vrpn_server/tracker_server.hpp"
+#include "outputs/vrpn_server/vrpn_protocol.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::vrpn {
 namespace {

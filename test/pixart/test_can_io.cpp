@@ -17,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "adaptor_clock.hpp"
-#include "can_frame.hpp"
-#include "candump_log.hpp"
-#include "serial_port.hpp"
-#include "slcan.hpp"
-#include "socketcan.hpp"
-#include "test_support.hpp"
+#include "common/can_io/adaptor_clock.hpp"
+#include "common/can_io/can_frame.hpp"
+#include "common/can_io/candump_log.hpp"
+#include "common/can_io/slcan.hpp"
+#include "common/can_io/socketcan.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::can {
 

@@ -11,12 +11,12 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <mocap_msgs/msg/pixart_raw_point_array.hpp>
 
-#include "candump_log.hpp"
-#include "core/plugin_loader.hpp"
-#include "pixart_decoder.hpp"
-#include "serial_port.hpp"
-#include "slcan.hpp"
-#include "test_support.hpp"
+#include "common/can_io/candump_log.hpp"
+#include "common/can_io/slcan.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "host/plugin_loader.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::pixart {
 namespace {

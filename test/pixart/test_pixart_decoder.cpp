@@ -1,8 +1,8 @@
 // PixArt frame decoding (docs/pixart_can.md) and the grouping of frames into camera samples.
 #include <gtest/gtest.h>
 
-#include "camera_samples.hpp"
-#include "pixart_decoder.hpp"
+#include "pixart/pixart_bridge/camera_samples.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
 
 namespace mocap::pixart {
 namespace {

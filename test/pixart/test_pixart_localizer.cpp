@@ -21,14 +21,14 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
-#include "camera_views.hpp"
-#include "core/plugin_loader.hpp"
-#include "led_plane_points.hpp"
-#include "pixart_rig.hpp"
-#include "planar_fit.hpp"
-#include "point_merging.hpp"
-#include "robot_localizer.hpp"
-#include "test_support.hpp"
+#include "host/plugin_loader.hpp"
+#include "pixart/pixart_localizer/camera_views.hpp"
+#include "pixart/pixart_localizer/led_plane_points.hpp"
+#include "pixart/pixart_localizer/planar_fit.hpp"
+#include "pixart/pixart_localizer/point_merging.hpp"
+#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::pixart::localization {
 namespace {

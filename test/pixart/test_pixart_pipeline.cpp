@@ -20,11 +20,11 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
-#include "candump_recording.hpp"
-#include "core/plugin_loader.hpp"
-#include "pixart_box_simulator.hpp"
-#include "pixart_scene.hpp"
-#include "test_support.hpp"
+#include "host/plugin_loader.hpp"
+#include "sim/pixart_box_sim/candump_recording.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::pixart {
 namespace {

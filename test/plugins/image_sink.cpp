@@ -2,7 +2,7 @@
 #include <mocap/component.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "sequence_message.hpp"
+#include "test/plugins/sequence_message.hpp"
 
 namespace mocap::test {
 namespace {

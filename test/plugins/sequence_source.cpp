@@ -5,7 +5,7 @@
 
 #include <mocap/component.hpp>
 
-#include "sequence_message.hpp"
+#include "test/plugins/sequence_message.hpp"
 
 namespace mocap::test {
 namespace {

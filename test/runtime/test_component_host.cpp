@@ -22,8 +22,9 @@
 
 #include "core/names.hpp"
 #include "dds/dds_transport.hpp"
-#include "plugins/sequence_message.hpp"
-#include "test_support.hpp"
+#include "host/dds_implementations.hpp"
+#include "test/plugins/sequence_message.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {
@@ -780,8 +781,8 @@ TEST(DdsImplementation, TheLaunchFileThenTheEnvironmentThenFastDds) {
     ADD_FAILURE() << "connext accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()),
-              "MOCAP_DDS_IMPLEMENTATION 'connext' is not a DDS implementation here (available: "
-              "fastdds, cyclonedds)");
+              "MOCAP_DDS_IMPLEMENTATION 'connext' is not a DDS implementation here (available: " +
+                  dds_implementation_names() + ")");
   }
   // A host on an unknown implementation does not start.
   EXPECT_THROW(ComponentHost({.name = "bad", .dds = {.implementation = "opendds"}}),

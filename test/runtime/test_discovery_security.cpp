@@ -27,7 +27,7 @@
 #include <mocap/component_host.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {
@@ -288,7 +288,7 @@ groups:
   EXPECT_NE(output.find(file.string() +
                         ":2: dds.security: group 'sink' (fastdds, line 9) and group 'source' "
                         "(cyclonedds, line 4) would authenticate each other only when the "
-                        "Cyclone DDS side starts the handshake, which with one identity is "
+                        "cyclonedds side starts the handshake, which with one identity is "
                         "chance; run them on one implementation, or in separate launch files "
                         "with identities ordered as launch_yaml/README.md explains"),
             std::string::npos)
@@ -455,7 +455,7 @@ TEST_F(Security, EveryMessageSizeAroundTheDatagramLimitCrossesEncrypted) {
     }
     auto options = [&](const std::string& identity) {
       DdsOptions dds;
-      dds.fastdds.shared_memory = shared_memory;
+      dds.shared_memory = shared_memory;
       dds.security_directory = credentials().string();
       dds.security_identity = identity;
       return HostOptions{.name = identity, .threads = 2, .dds = dds};

@@ -15,7 +15,7 @@
 
 #include <fmt/format.h>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

@@ -2,8 +2,10 @@
 // naming the file, the line and the key.
 #include <gtest/gtest.h>
 
+#include "dds/dds_transport.hpp"
+#include "host/dds_implementations.hpp"
 #include "launch/launch_file.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {
@@ -70,7 +72,7 @@ groups:
 TEST_F(LaunchFileTest, ReadsAValidFile) {
   LaunchFile file = load(kValid);
   EXPECT_EQ(file.dds.domain_id, 7);
-  EXPECT_FALSE(file.dds.fastdds.shared_memory);
+  EXPECT_FALSE(file.dds.shared_memory);
   ASSERT_EQ(file.groups.size(), 2u);
   EXPECT_EQ(file.groups[0].name, "source");
   EXPECT_EQ(file.groups[0].threads, 2);
@@ -399,7 +401,8 @@ groups:
         name: sink
 )"),
             "launch.yaml:1: dds: implementation 'zenoh' is not a DDS implementation here "
-            "(available: fastdds, cyclonedds)");
+            "(available: " +
+                dds_implementation_names() + ")");
   auto list = problems(R"(groups:
   - name: a
     dds: {implementation: cyclone, domain_id: 3}
@@ -412,9 +415,10 @@ groups:
             "launch.yaml:3: unknown key 'domain_id' in a group's 'dds' (keys: implementation)");
   EXPECT_EQ(list[1],
             "launch.yaml:3: dds: implementation 'cyclone' is not a DDS implementation here "
-            "(available: fastdds, cyclonedds)");
+            "(available: " +
+                dds_implementation_names() + ")");
 
-  // Fast DDS's Discovery Servers: not with a Cyclone DDS group.
+  // Discovery servers: not with a group on an implementation without them.
   EXPECT_EQ(only_problem(R"(dds:
   discovery: {server: "127.0.0.1:11811"}
 groups:
@@ -424,9 +428,9 @@ groups:
       - plugin: sequence_sink
         name: sink
 )"),
-            "launch.yaml:2: dds.discovery.server: Fast DDS Discovery Servers do not work with "
-            "cyclonedds (group 'a', line 4); run that group on fastdds, or use multicast "
-            "discovery, or give Cyclone DDS its peers (Discovery/Peers) through CYCLONEDDS_URI");
+            "launch.yaml:2: dds.discovery.server: cyclonedds has no discovery servers (group 'a', "
+            "line 4); run that group on an implementation that has them (fastdds), or use "
+            "multicast discovery (launch_yaml/README.md says how to give it its peers instead)");
 }
 
 TEST_F(LaunchFileTest, SetOptions) {

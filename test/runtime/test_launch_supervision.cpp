@@ -9,7 +9,7 @@
 #include <string>
 #include <thread>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

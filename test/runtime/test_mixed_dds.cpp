@@ -18,9 +18,10 @@
 #include <mocap/generated_message_types.hpp>
 
 #include "dds/dds_transport.hpp"
+#include "host/dds_implementations.hpp"
 #include "messages/idl_schema.hpp"
-#include "random_cdr.hpp"
-#include "test_support.hpp"
+#include "test/random_cdr.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

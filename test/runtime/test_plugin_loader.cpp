@@ -6,8 +6,8 @@
 
 #include <cstdlib>
 
-#include "core/plugin_loader.hpp"
-#include "test_support.hpp"
+#include "host/plugin_loader.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <mocap/component_host.hpp>
 
-#include "core/plugin_loader.hpp"
+#include "host/plugin_loader.hpp"
 #include "launch/yaml_value.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

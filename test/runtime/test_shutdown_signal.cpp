@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "core/shutdown_signal.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

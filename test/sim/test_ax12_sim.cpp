@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "ax12_control_table.hpp"
-#include "protocol.hpp"
-#include "simulated_ax12_chain.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
+#include "follower/dynamixel/protocol.hpp"
+#include "sim/ax12_sim/simulated_ax12_chain.hpp"
 
 namespace mocap::dynamixel {
 namespace {

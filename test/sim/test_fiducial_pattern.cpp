@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "fiducial_pattern.hpp"
+#include "sim/fiducial_pattern_source/fiducial_pattern.hpp"
 
 namespace mocap::demo {
 namespace {

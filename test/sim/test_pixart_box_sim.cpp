@@ -16,19 +16,19 @@
 #include <mocap/component_host.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
-#include "candump_log.hpp"
-#include "candump_recording.hpp"
-#include "core/plugin_loader.hpp"
-#include "floor_trajectory.hpp"
-#include "pixart_box_simulator.hpp"
-#include "pixart_decoder.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
-#include "sample_schedule.hpp"
-#include "serial_port.hpp"
-#include "simulated_slcan_adaptor.hpp"
-#include "slcan.hpp"
-#include "test_support.hpp"
+#include "common/can_io/candump_log.hpp"
+#include "common/can_io/slcan.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "host/plugin_loader.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/candump_recording.hpp"
+#include "sim/pixart_box_sim/floor_trajectory.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
+#include "sim/pixart_box_sim/sample_schedule.hpp"
+#include "sim/pixart_box_sim/simulated_slcan_adaptor.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap::pixart {
 namespace {

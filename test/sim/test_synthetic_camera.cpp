@@ -13,11 +13,11 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
-#include "constellation_database.hpp"
-#include "ir_renderer.hpp"
-#include "scene.hpp"
-#include "test_support.hpp"
-#include "trajectory.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
+#include "sim/synthetic_ir_camera/trajectory.hpp"
+#include "test/test_support.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 namespace mocap::synthetic {
 namespace {

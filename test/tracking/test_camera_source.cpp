@@ -11,8 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "frame_source.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
+#include "tracking/camera_source/frame_source.hpp"
 
 namespace mocap::capture {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <Eigen/Geometry>
 
-#include "constellation_database.hpp"
-#include "cross_ratio.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
+#include "tracking/constellation_database/cross_ratio.hpp"
 
 namespace mocap::constellations {
 namespace {

@@ -8,12 +8,12 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
-#include "constellation_identifier.hpp"
-#include "constellation_pose.hpp"
-#include "draw_order.hpp"
-#include "line_search.hpp"
-#include "planar_pose.hpp"
-#include "test_support.hpp"
+#include "test/draw_order.hpp"
+#include "test/test_support.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
+#include "tracking/constellation_identifier/line_search.hpp"
+#include "tracking/pose_estimator/constellation_pose.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
 
 namespace mocap::constellations {
 namespace {

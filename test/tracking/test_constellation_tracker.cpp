@@ -11,18 +11,18 @@
 #include <Eigen/Geometry>
 #include <mocap/calibration/camera_file.hpp>
 
-#include "body_motion.hpp"
-#include "constellation_tracker.hpp"
-#include "draw_order.hpp"
-#include "fiducial_detector.hpp"
-#include "ir_renderer.hpp"
-#include "marker_association.hpp"
-#include "marker_visibility.hpp"
-#include "min_cost_assignment.hpp"
-#include "one_line_search.hpp"
-#include "pose_evaluation.hpp"
-#include "sequence_evaluation.hpp"
-#include "test_support.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "test/draw_order.hpp"
+#include "test/test_support.hpp"
+#include "tracking/constellation_identifier/one_line_search.hpp"
+#include "tracking/constellation_tracker/body_motion.hpp"
+#include "tracking/constellation_tracker/constellation_tracker.hpp"
+#include "tracking/constellation_tracker/marker_association.hpp"
+#include "tracking/constellation_tracker/marker_visibility.hpp"
+#include "tracking/constellation_tracker/min_cost_assignment.hpp"
+#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/pose_evaluator/sequence_evaluation.hpp"
 
 namespace mocap::tracking {
 namespace {

@@ -21,9 +21,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "fiducial_detector.hpp"
-#include "image_message.hpp"
-#include "test_support.hpp"
+#include "common/image_message/image_message.hpp"
+#include "test/test_support.hpp"
+#include "tracking/fiducial_tracker/fiducial_detector.hpp"
 
 namespace mocap::tracking {
 namespace {

@@ -13,7 +13,7 @@
 
 #include <opencv2/calib3d.hpp>
 
-#include "ippe.hpp"
+#include "tracking/pose_estimator/ippe.hpp"
 
 namespace mocap::pose {
 namespace {

@@ -7,8 +7,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "png_file.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
+#include "tracking/overlay/png_file.hpp"
 
 namespace mocap::overlay {
 namespace {

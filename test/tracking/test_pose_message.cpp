@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
 
 namespace mocap {
 namespace {

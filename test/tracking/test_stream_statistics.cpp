@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "stream_statistics.hpp"
+#include "tracking/fiducial_monitor/stream_statistics.hpp"
 
 namespace mocap::demo {
 namespace {

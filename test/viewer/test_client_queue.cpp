@@ -6,7 +6,7 @@
 #include <chrono>
 #include <string>
 
-#include "client_queue.hpp"
+#include "viewer/foxglove_bridge/client_queue.hpp"
 
 namespace mocap::foxglove {
 namespace {

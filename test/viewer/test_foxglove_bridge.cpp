@@ -21,7 +21,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

@@ -11,7 +11,7 @@
 #include <mocap/message_type.hpp>
 #include <nlohmann/json.hpp>
 
-#include "foxglove_protocol.hpp"
+#include "viewer/foxglove_bridge/foxglove_protocol.hpp"
 
 namespace mocap::foxglove {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "origin_policy.hpp"
+#include "viewer/foxglove_bridge/origin_policy.hpp"
 
 namespace mocap::foxglove {
 namespace {

@@ -19,12 +19,12 @@
 #include <Eigen/Geometry>
 #include <mocap/calibration/camera_file.hpp>
 
-#include "constellation_database.hpp"
-#include "fiducial_detector.hpp"
-#include "ir_renderer.hpp"
-#include "rendered_volume.hpp"
-#include "scene.hpp"
-#include "volume_calibration.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
+#include "test/volume/rendered_volume.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
+#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "volume/volume_calibration/volume_calibration.hpp"
 
 namespace mocap::volume::test {
 

@@ -21,13 +21,13 @@
 
 #include <mocap/calibration/camera_file.hpp>
 
-#include "constellation_database.hpp"
-#include "fiducial_detector.hpp"
-#include "ir_renderer.hpp"
-#include "planar_pose.hpp"
-#include "rigid_body_database.hpp"
-#include "scene.hpp"
-#include "volume_tracker.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
+#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
+#include "volume/volume_fusion/volume_tracker.hpp"
 
 namespace mocap::volume::test {
 

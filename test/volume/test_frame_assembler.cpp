@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "frame_assembler.hpp"
+#include "volume/frame_assembly/frame_assembler.hpp"
 
 namespace mocap::volume {
 namespace {

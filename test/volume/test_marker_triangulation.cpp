@@ -8,10 +8,10 @@
 #include <random>
 #include <vector>
 
-#include "marker_triangulation.hpp"
-#include "multi_camera_pose.hpp"
-#include "rigid_body_identification.hpp"
-#include "synthetic_volume.hpp"
+#include "test/volume/synthetic_volume.hpp"
+#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/rigid_bodies/rigid_body_identification.hpp"
+#include "volume/triangulation/marker_triangulation.hpp"
 
 namespace mocap::volume {
 namespace {

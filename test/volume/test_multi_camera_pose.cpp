@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "multi_camera_pose.hpp"
-#include "planar_pose.hpp"
-#include "synthetic_volume.hpp"
+#include "test/volume/synthetic_volume.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
+#include "volume/pose_fusion/multi_camera_pose.hpp"
 
 namespace mocap::volume {
 namespace {

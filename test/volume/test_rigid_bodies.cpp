@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "planar_pose.hpp"
-#include "rigid_body_identification.hpp"
-#include "synthetic_volume.hpp"
+#include "test/volume/synthetic_volume.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
+#include "volume/rigid_bodies/rigid_body_identification.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "rendered_calibration.hpp"
-#include "rendered_volume.hpp"
-#include "test_support.hpp"
+#include "test/test_support.hpp"
+#include "test/volume/rendered_calibration.hpp"
+#include "test/volume/rendered_volume.hpp"
 
 namespace mocap::volume {
 namespace {

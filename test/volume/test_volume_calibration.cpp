@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "synthetic_volume.hpp"
-#include "volume_calibration.hpp"
+#include "test/volume/synthetic_volume.hpp"
+#include "volume/volume_calibration/volume_calibration.hpp"
 
 namespace mocap::volume {
 namespace {

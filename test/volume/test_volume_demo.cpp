@@ -22,7 +22,7 @@
 
 #include <mocap/calibration/camera_file.hpp>
 
-#include "test_support.hpp"
+#include "test/test_support.hpp"
 
 namespace mocap {
 namespace {

@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "rigid_body_database.hpp"
-#include "synthetic_volume.hpp"
-#include "volume_tracker.hpp"
+#include "test/volume/synthetic_volume.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
+#include "volume/volume_fusion/volume_tracker.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -1,4 +1,4 @@
-#include "camera_info_message.hpp"
+#include "common/image_message/camera_info_message.hpp"
 
 #include <mocap/calibration/pinhole_camera.hpp>
 

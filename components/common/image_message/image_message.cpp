@@ -1,4 +1,4 @@
-#include "image_message.hpp"
+#include "common/image_message/image_message.hpp"
 
 #include <cstring>
 #include <stdexcept>

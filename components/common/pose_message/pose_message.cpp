@@ -1,4 +1,4 @@
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "device_link.hpp"
+#include "common/serial_io/device_link.hpp"
 
 #include <unistd.h>
 

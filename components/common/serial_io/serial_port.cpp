@@ -1,4 +1,4 @@
-#include "serial_port.hpp"
+#include "common/serial_io/serial_port.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "acceleration_limiter.hpp"
+#include "follower/drive_follower/acceleration_limiter.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -10,7 +10,7 @@
 // A stop bypasses the limits: a base that cannot see what it follows must not coast on.
 #pragma once
 
-#include "velocity.hpp"
+#include "follower/drive_follower/velocity.hpp"
 
 namespace mocap::drive {
 

@@ -1,4 +1,4 @@
-#include "drive_follower.hpp"
+#include "follower/drive_follower/drive_follower.hpp"
 
 #include <algorithm>
 #include <cmath>

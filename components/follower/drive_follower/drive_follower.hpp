@@ -13,8 +13,8 @@
 
 #include <optional>
 
-#include "acceleration_limiter.hpp"
-#include "drive_rules.hpp"
+#include "follower/drive_follower/acceleration_limiter.hpp"
+#include "follower/drive_follower/drive_rules.hpp"
 
 namespace mocap::drive {
 

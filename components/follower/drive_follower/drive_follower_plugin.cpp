@@ -22,12 +22,12 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "drive_follower.hpp"
-#include "graph_topics.hpp"
-#include "joint_history.hpp"
-#include "object_in_base.hpp"
-#include "pose_message.hpp"
-#include "turret_model.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "follower/drive_follower/drive_follower.hpp"
+#include "follower/drive_follower/object_in_base.hpp"
+#include "follower/turret_kinematics/joint_history.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
 
 namespace mocap::drive {
 namespace {

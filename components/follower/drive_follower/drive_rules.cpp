@@ -1,4 +1,4 @@
-#include "drive_rules.hpp"
+#include "follower/drive_follower/drive_rules.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -23,7 +23,7 @@
 
 #include <Eigen/Core>
 
-#include "velocity.hpp"
+#include "follower/drive_follower/velocity.hpp"
 
 namespace mocap::drive {
 

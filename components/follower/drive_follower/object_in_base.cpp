@@ -1,4 +1,4 @@
-#include "object_in_base.hpp"
+#include "follower/drive_follower/object_in_base.hpp"
 
 namespace mocap::drive {
 

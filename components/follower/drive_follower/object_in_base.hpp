@@ -16,7 +16,7 @@
 
 #include <Eigen/Geometry>
 
-#include "drive_rules.hpp"
+#include "follower/drive_follower/drive_rules.hpp"
 
 namespace mocap::drive {
 

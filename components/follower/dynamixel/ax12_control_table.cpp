@@ -1,4 +1,4 @@
-#include "ax12_control_table.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
 
 #include <algorithm>
 #include <cmath>

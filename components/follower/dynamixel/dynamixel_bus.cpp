@@ -1,4 +1,4 @@
-#include "dynamixel_bus.hpp"
+#include "follower/dynamixel/dynamixel_bus.hpp"
 
 #include <array>
 #include <utility>

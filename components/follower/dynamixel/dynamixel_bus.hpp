@@ -20,8 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include "protocol.hpp"
-#include "serial_port.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "follower/dynamixel/protocol.hpp"
 
 namespace mocap::dynamixel {
 

@@ -1,4 +1,4 @@
-#include "protocol.hpp"
+#include "follower/dynamixel/protocol.hpp"
 
 #include <array>
 #include <stdexcept>

@@ -25,13 +25,13 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "ax12_control_table.hpp"
-#include "dynamixel_bus.hpp"
-#include "graph_topics.hpp"
-#include "joint_history.hpp"
-#include "servo_mapping.hpp"
-#include "turret_follower.hpp"
-#include "turret_model.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
+#include "follower/dynamixel/dynamixel_bus.hpp"
+#include "follower/dynamixel_follower/servo_mapping.hpp"
+#include "follower/dynamixel_follower/turret_follower.hpp"
+#include "follower/turret_kinematics/joint_history.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
 
 namespace mocap::turret {
 namespace {

@@ -1,9 +1,9 @@
-#include "servo_mapping.hpp"
+#include "follower/dynamixel_follower/servo_mapping.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "ax12_control_table.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
 
 namespace mocap::turret {
 

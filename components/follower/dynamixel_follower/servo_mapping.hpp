@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
 
 namespace mocap::turret {
 

@@ -1,4 +1,4 @@
-#include "turret_follower.hpp"
+#include "follower/dynamixel_follower/turret_follower.hpp"
 
 #include <algorithm>
 #include <cmath>

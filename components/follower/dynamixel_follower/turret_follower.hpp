@@ -20,7 +20,7 @@
 
 #include <Eigen/Core>
 
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
 
 namespace mocap::turret {
 

@@ -1,4 +1,4 @@
-#include "follow_evaluation.hpp"
+#include "follower/follower_monitor/follow_evaluation.hpp"
 
 #include <algorithm>
 #include <cmath>

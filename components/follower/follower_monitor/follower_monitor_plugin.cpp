@@ -16,9 +16,9 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "follow_evaluation.hpp"
-#include "graph_topics.hpp"
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "follower/follower_monitor/follow_evaluation.hpp"
 
 namespace mocap::evaluation {
 namespace {

@@ -1,4 +1,4 @@
-#include "joint_history.hpp"
+#include "follower/turret_kinematics/joint_history.hpp"
 
 #include <algorithm>
 

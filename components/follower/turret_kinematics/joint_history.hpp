@@ -7,7 +7,7 @@
 #include <deque>
 #include <optional>
 
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
 
 namespace mocap::turret {
 

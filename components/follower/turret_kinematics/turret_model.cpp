@@ -1,4 +1,4 @@
-#include "turret_model.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -12,7 +12,7 @@
 
 #include <fmt/format.h>
 
-#include "yaml_reader.hpp"
+#include "common/yaml_reader/yaml_reader.hpp"
 
 namespace mocap::turret {
 namespace {

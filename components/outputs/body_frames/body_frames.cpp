@@ -1,4 +1,4 @@
-#include "body_frames.hpp"
+#include "outputs/body_frames/body_frames.hpp"
 
 #include <stdexcept>
 #include <string>

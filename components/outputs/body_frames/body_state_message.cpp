@@ -1,6 +1,6 @@
-#include "body_state_message.hpp"
+#include "outputs/body_frames/body_state_message.hpp"
 
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
 
 namespace mocap::outputs {
 namespace {

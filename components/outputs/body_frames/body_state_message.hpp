@@ -5,7 +5,7 @@
 
 #include <mocap_msgs/msg/constellation_pose.hpp>
 
-#include "body_frames.hpp"
+#include "outputs/body_frames/body_frames.hpp"
 
 namespace mocap::outputs {
 

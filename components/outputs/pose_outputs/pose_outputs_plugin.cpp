@@ -18,10 +18,10 @@
 #include <nav_msgs/msg/odometry.hpp>
 #include <tf2_msgs/msg/tf_message.hpp>
 
-#include "body_state_message.hpp"
-#include "graph_topics.hpp"
-#include "pose_message.hpp"
-#include "stamp_rate.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "outputs/body_frames/body_state_message.hpp"
+#include "outputs/body_frames/stamp_rate.hpp"
 
 namespace mocap::outputs {
 namespace {

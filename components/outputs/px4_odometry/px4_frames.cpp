@@ -1,4 +1,4 @@
-#include "px4_frames.hpp"
+#include "outputs/px4_odometry/px4_frames.hpp"
 
 namespace mocap::outputs {
 namespace {

@@ -9,7 +9,7 @@
 
 #include <array>
 
-#include "body_frames.hpp"
+#include "outputs/body_frames/body_frames.hpp"
 
 namespace mocap::outputs {
 

@@ -17,10 +17,10 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <px4_msgs/msg/vehicle_odometry.hpp>
 
-#include "body_state_message.hpp"
-#include "graph_topics.hpp"
-#include "px4_frames.hpp"
-#include "stamp_rate.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "outputs/body_frames/body_state_message.hpp"
+#include "outputs/body_frames/stamp_rate.hpp"
+#include "outputs/px4_odometry/px4_frames.hpp"
 
 namespace mocap::outputs {
 namespace {

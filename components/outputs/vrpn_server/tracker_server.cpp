@@ -1,4 +1,4 @@
-#include "tracker_server.hpp"
+#include "outputs/vrpn_server/tracker_server.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -22,7 +22,7 @@
 
 #include <Eigen/Geometry>
 
-#include "vrpn_protocol.hpp"
+#include "outputs/vrpn_server/vrpn_protocol.hpp"
 
 namespace mocap::vrpn {
 

@@ -1,4 +1,4 @@
-#include "vrpn_protocol.hpp"
+#include "outputs/vrpn_server/vrpn_protocol.hpp"
 
 #include <cstring>
 

@@ -12,9 +12,9 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
-#include "body_state_message.hpp"
-#include "graph_topics.hpp"
-#include "tracker_server.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "outputs/body_frames/body_state_message.hpp"
+#include "outputs/vrpn_server/tracker_server.hpp"
 
 namespace mocap::vrpn {
 namespace {

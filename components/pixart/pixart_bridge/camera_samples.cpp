@@ -1,4 +1,4 @@
-#include "camera_samples.hpp"
+#include "pixart/pixart_bridge/camera_samples.hpp"
 
 namespace mocap::pixart {
 

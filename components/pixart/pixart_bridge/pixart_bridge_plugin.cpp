@@ -9,10 +9,10 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <mocap_msgs/msg/pixart_raw_point_array.hpp>
 
-#include "camera_samples.hpp"
-#include "can_source.hpp"
-#include "graph_topics.hpp"
-#include "pixart_decoder.hpp"
+#include "common/can_io/can_source.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "pixart/pixart_bridge/camera_samples.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
 
 namespace mocap::pixart {
 namespace {

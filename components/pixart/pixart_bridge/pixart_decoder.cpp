@@ -1,4 +1,4 @@
-#include "pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
 
 #include <stdexcept>
 #include <string>

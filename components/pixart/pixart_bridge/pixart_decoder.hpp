@@ -11,7 +11,7 @@
 #include <optional>
 #include <vector>
 
-#include "can_frame.hpp"
+#include "common/can_io/can_frame.hpp"
 
 namespace mocap::pixart {
 

@@ -1,4 +1,4 @@
-#include "camera_views.hpp"
+#include "pixart/pixart_localizer/camera_views.hpp"
 
 #include <stdexcept>
 #include <string>

@@ -1,4 +1,4 @@
-#include "led_plane_points.hpp"
+#include "pixart/pixart_localizer/led_plane_points.hpp"
 
 namespace mocap::pixart::localization {
 

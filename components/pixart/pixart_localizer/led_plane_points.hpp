@@ -11,7 +11,7 @@
 
 #include <Eigen/Core>
 
-#include "pixart_rig.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace mocap::pixart::localization {
 

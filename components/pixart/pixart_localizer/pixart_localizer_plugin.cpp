@@ -19,10 +19,10 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
-#include "graph_topics.hpp"
-#include "led_plane_points.hpp"
-#include "pixart_rig.hpp"
-#include "robot_localizer.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "pixart/pixart_localizer/led_plane_points.hpp"
+#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace mocap::pixart::localization {
 namespace {

@@ -1,4 +1,4 @@
-#include "planar_fit.hpp"
+#include "pixart/pixart_localizer/planar_fit.hpp"
 
 #include <algorithm>
 #include <cmath>

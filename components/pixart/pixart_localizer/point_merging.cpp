@@ -1,4 +1,4 @@
-#include "point_merging.hpp"
+#include "pixart/pixart_localizer/point_merging.hpp"
 
 #include <algorithm>
 #include <cmath>

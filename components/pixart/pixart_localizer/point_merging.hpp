@@ -19,7 +19,7 @@
 
 #include <Eigen/Core>
 
-#include "camera_views.hpp"
+#include "pixart/pixart_localizer/camera_views.hpp"
 
 namespace mocap::pixart::localization {
 

@@ -1,4 +1,4 @@
-#include "robot_localizer.hpp"
+#include "pixart/pixart_localizer/robot_localizer.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -27,12 +27,12 @@
 
 #include <Eigen/Core>
 
-#include "camera_views.hpp"
-#include "led_plane_points.hpp"
-#include "pixart_rig.hpp"
-#include "point_merging.hpp"
-#include "robot_recognition.hpp"
-#include "robot_tracking.hpp"
+#include "pixart/pixart_localizer/camera_views.hpp"
+#include "pixart/pixart_localizer/led_plane_points.hpp"
+#include "pixart/pixart_localizer/point_merging.hpp"
+#include "pixart/pixart_localizer/robot_recognition.hpp"
+#include "pixart/pixart_localizer/robot_tracking.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace mocap::pixart::localization {
 

@@ -1,4 +1,4 @@
-#include "robot_recognition.hpp"
+#include "pixart/pixart_localizer/robot_recognition.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -45,9 +45,9 @@
 
 #include <Eigen/Core>
 
-#include "pixart_rig.hpp"
-#include "planar_fit.hpp"
-#include "point_merging.hpp"
+#include "pixart/pixart_localizer/planar_fit.hpp"
+#include "pixart/pixart_localizer/point_merging.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace mocap::pixart::localization {
 

@@ -1,4 +1,4 @@
-#include "robot_tracking.hpp"
+#include "pixart/pixart_localizer/robot_tracking.hpp"
 
 #include <cmath>
 #include <utility>

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "planar_fit.hpp"
-#include "robot_recognition.hpp"
+#include "pixart/pixart_localizer/planar_fit.hpp"
+#include "pixart/pixart_localizer/robot_recognition.hpp"
 
 namespace mocap::pixart::localization {
 

@@ -1,4 +1,4 @@
-#include "pixart_rig.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -14,7 +14,7 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
-#include "yaml_reader.hpp"
+#include "common/yaml_reader/yaml_reader.hpp"
 
 namespace mocap::pixart {
 namespace {

@@ -17,10 +17,10 @@
 
 #include <mocap/component.hpp>
 
-#include "ax12_control_table.hpp"
-#include "device_link.hpp"
-#include "serial_port.hpp"
-#include "simulated_ax12_chain.hpp"
+#include "common/serial_io/device_link.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
+#include "sim/ax12_sim/simulated_ax12_chain.hpp"
 
 namespace mocap::dynamixel {
 namespace {

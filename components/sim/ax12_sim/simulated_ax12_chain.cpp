@@ -1,4 +1,4 @@
-#include "simulated_ax12_chain.hpp"
+#include "sim/ax12_sim/simulated_ax12_chain.hpp"
 
 #include <algorithm>
 #include <cmath>

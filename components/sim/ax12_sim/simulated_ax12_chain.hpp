@@ -36,8 +36,8 @@
 #include <utility>
 #include <vector>
 
-#include "ax12_control_table.hpp"
-#include "protocol.hpp"
+#include "follower/dynamixel/ax12_control_table.hpp"
+#include "follower/dynamixel/protocol.hpp"
 
 namespace mocap::dynamixel {
 

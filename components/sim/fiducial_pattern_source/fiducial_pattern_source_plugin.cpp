@@ -5,8 +5,8 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "fiducial_pattern.hpp"
-#include "graph_topics.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "sim/fiducial_pattern_source/fiducial_pattern.hpp"
 
 namespace mocap::demo {
 namespace {

@@ -20,10 +20,10 @@
 #include <mocap/message_time.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
-#include "graph_topics.hpp"
-#include "pose_message.hpp"
-#include "turret_model.hpp"
-#include "unicycle_base.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "follower/turret_kinematics/turret_model.hpp"
+#include "sim/mobile_base_sim/unicycle_base.hpp"
 
 namespace mocap::sim {
 namespace {

@@ -1,4 +1,4 @@
-#include "unicycle_base.hpp"
+#include "sim/mobile_base_sim/unicycle_base.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "candump_recording.hpp"
+#include "sim/pixart_box_sim/candump_recording.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "candump_log.hpp"
+#include "common/can_io/candump_log.hpp"
 
 namespace mocap::pixart {
 namespace {

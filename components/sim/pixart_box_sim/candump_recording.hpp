@@ -13,8 +13,8 @@
 #include <stop_token>
 #include <string>
 
-#include "pixart_box_simulator.hpp"
-#include "sample_schedule.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/sample_schedule.hpp"
 
 namespace mocap::pixart {
 

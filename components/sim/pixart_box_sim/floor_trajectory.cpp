@@ -1,4 +1,4 @@
-#include "floor_trajectory.hpp"
+#include "sim/pixart_box_sim/floor_trajectory.hpp"
 
 #include <cmath>
 #include <stdexcept>

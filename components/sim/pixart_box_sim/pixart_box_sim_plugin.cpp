@@ -32,16 +32,16 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/robot_pose_array.hpp>
 
-#include "candump_recording.hpp"
-#include "device_link.hpp"
-#include "graph_topics.hpp"
-#include "pixart_box_simulator.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
-#include "sample_schedule.hpp"
-#include "serial_port.hpp"
-#include "simulated_slcan_adaptor.hpp"
-#include "slcan.hpp"
+#include "common/can_io/slcan.hpp"
+#include "common/serial_io/device_link.hpp"
+#include "common/serial_io/serial_port.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/candump_recording.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
+#include "sim/pixart_box_sim/sample_schedule.hpp"
+#include "sim/pixart_box_sim/simulated_slcan_adaptor.hpp"
 
 namespace mocap::pixart {
 namespace {

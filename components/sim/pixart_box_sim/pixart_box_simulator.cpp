@@ -1,11 +1,11 @@
-#include "pixart_box_simulator.hpp"
+#include "sim/pixart_box_sim/pixart_box_simulator.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
-#include "pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_decoder.hpp"
 
 namespace mocap::pixart {
 

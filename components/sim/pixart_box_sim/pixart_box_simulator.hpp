@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "can_frame.hpp"
-#include "floor_trajectory.hpp"
-#include "pixart_rig.hpp"
-#include "pixart_scene.hpp"
+#include "common/can_io/can_frame.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/floor_trajectory.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
 
 namespace mocap::pixart {
 

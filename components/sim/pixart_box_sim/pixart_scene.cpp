@@ -1,4 +1,4 @@
-#include "pixart_scene.hpp"
+#include "sim/pixart_box_sim/pixart_scene.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -17,7 +17,7 @@
 #include <fmt/ranges.h>
 #include <mocap/spelling.hpp>
 
-#include "yaml_reader.hpp"
+#include "common/yaml_reader/yaml_reader.hpp"
 
 namespace mocap::pixart {
 namespace {

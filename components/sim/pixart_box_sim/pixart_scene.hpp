@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "floor_trajectory.hpp"
-#include "pixart_rig.hpp"
+#include "pixart/pixart_rig/pixart_rig.hpp"
+#include "sim/pixart_box_sim/floor_trajectory.hpp"
 
 namespace mocap::pixart {
 

@@ -1,4 +1,4 @@
-#include "sample_schedule.hpp"
+#include "sim/pixart_box_sim/sample_schedule.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "simulated_slcan_adaptor.hpp"
+#include "sim/pixart_box_sim/simulated_slcan_adaptor.hpp"
 
 #include <array>
 #include <cctype>
@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "slcan.hpp"
+#include "common/can_io/slcan.hpp"
 
 namespace mocap::pixart {
 namespace {

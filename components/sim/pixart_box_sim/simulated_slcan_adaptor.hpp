@@ -20,7 +20,7 @@
 #include <string>
 #include <string_view>
 
-#include "can_frame.hpp"
+#include "common/can_io/can_frame.hpp"
 
 namespace mocap::pixart {
 

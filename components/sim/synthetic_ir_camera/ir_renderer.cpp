@@ -1,4 +1,4 @@
-#include "ir_renderer.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
 
 #include <algorithm>
 #include <array>

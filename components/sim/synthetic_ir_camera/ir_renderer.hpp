@@ -30,9 +30,9 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "ray_table.hpp"
-#include "scene.hpp"
-#include "sensor_noise.hpp"
+#include "sim/synthetic_ir_camera/ray_table.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
+#include "sim/synthetic_ir_camera/sensor_noise.hpp"
 
 namespace mocap::synthetic {
 

@@ -1,4 +1,4 @@
-#include "ray_table.hpp"
+#include "sim/synthetic_ir_camera/ray_table.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "scene.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -16,7 +16,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "yaml_reader.hpp"
+#include "common/yaml_reader/yaml_reader.hpp"
 
 namespace mocap::synthetic {
 namespace {

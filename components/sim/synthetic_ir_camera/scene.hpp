@@ -11,8 +11,8 @@
 
 #include <Eigen/Core>
 
-#include "constellation_database.hpp"
-#include "trajectory.hpp"
+#include "sim/synthetic_ir_camera/trajectory.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 namespace mocap::synthetic {
 

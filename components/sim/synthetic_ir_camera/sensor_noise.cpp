@@ -1,4 +1,4 @@
-#include "sensor_noise.hpp"
+#include "sim/synthetic_ir_camera/sensor_noise.hpp"
 
 #include <random>
 

@@ -37,14 +37,14 @@
 #include <sensor_msgs/msg/camera_info.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "camera_info_message.hpp"
-#include "constellation_database.hpp"
-#include "database_parameters.hpp"
-#include "graph_topics.hpp"
-#include "image_message.hpp"
-#include "ir_renderer.hpp"
-#include "pose_message.hpp"
-#include "scene.hpp"
+#include "common/image_message/camera_info_message.hpp"
+#include "common/image_message/image_message.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "sim/synthetic_ir_camera/ir_renderer.hpp"
+#include "sim/synthetic_ir_camera/scene.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
+#include "tracking/constellation_database/database_parameters.hpp"
 
 namespace mocap::synthetic {
 namespace {

@@ -1,4 +1,4 @@
-#include "trajectory.hpp"
+#include "sim/synthetic_ir_camera/trajectory.hpp"
 
 #include <algorithm>
 #include <cmath>

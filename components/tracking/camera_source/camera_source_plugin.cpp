@@ -15,9 +15,9 @@
 #include <mocap/message_time.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "frame_source.hpp"
-#include "graph_topics.hpp"
-#include "image_message.hpp"
+#include "common/image_message/image_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/camera_source/frame_source.hpp"
 
 namespace mocap::capture {
 namespace {

@@ -1,4 +1,4 @@
-#include "constellation_database.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -15,7 +15,7 @@
 #include <Eigen/SVD>
 #include <mocap/config_reader.hpp>
 
-#include "cross_ratio.hpp"
+#include "tracking/constellation_database/cross_ratio.hpp"
 
 namespace mocap::constellations {
 namespace {

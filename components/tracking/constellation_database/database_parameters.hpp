@@ -7,7 +7,7 @@
 #include <mocap/config_files.hpp>
 #include <mocap/parameter_list.hpp>
 
-#include "constellation_database.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 namespace mocap::constellations {
 

@@ -1,4 +1,4 @@
-#include "plane_homography.hpp"
+#include "tracking/constellation_database/plane_homography.hpp"
 
 #include <cmath>
 

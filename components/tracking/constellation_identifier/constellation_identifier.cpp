@@ -1,4 +1,4 @@
-#include "constellation_identifier.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
 
 #include <algorithm>
 #include <array>
@@ -7,10 +7,10 @@
 #include <optional>
 #include <span>
 
-#include "cross_ratio.hpp"
-#include "line_candidate.hpp"
-#include "one_line_search.hpp"
-#include "plane_homography.hpp"
+#include "tracking/constellation_database/cross_ratio.hpp"
+#include "tracking/constellation_database/plane_homography.hpp"
+#include "tracking/constellation_identifier/line_candidate.hpp"
+#include "tracking/constellation_identifier/one_line_search.hpp"
 
 namespace mocap::constellations {
 

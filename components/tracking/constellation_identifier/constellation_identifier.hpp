@@ -16,8 +16,8 @@
 
 #include <Eigen/Core>
 
-#include "constellation_database.hpp"
-#include "line_search.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
+#include "tracking/constellation_identifier/line_search.hpp"
 
 namespace mocap::constellations {
 

@@ -10,10 +10,10 @@
 #include <mocap_msgs/msg/constellation_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "constellation_identifier.hpp"
-#include "constellation_message.hpp"
-#include "database_parameters.hpp"
-#include "graph_topics.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/constellation_database/database_parameters.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
+#include "tracking/constellation_identifier/constellation_message.hpp"
 
 namespace mocap::constellations {
 namespace {

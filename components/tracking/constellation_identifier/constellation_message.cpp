@@ -1,8 +1,8 @@
-#include "constellation_message.hpp"
+#include "tracking/constellation_identifier/constellation_message.hpp"
 
 #include <limits>
 
-#include "cross_ratio.hpp"
+#include "tracking/constellation_database/cross_ratio.hpp"
 
 namespace mocap::constellations {
 

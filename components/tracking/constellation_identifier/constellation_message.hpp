@@ -6,7 +6,7 @@
 #include <mocap_msgs/msg/constellation.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "constellation_identifier.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
 
 namespace mocap::constellations {
 

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "constellation_database.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 namespace mocap::constellations {
 

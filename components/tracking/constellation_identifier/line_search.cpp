@@ -1,4 +1,4 @@
-#include "line_search.hpp"
+#include "tracking/constellation_identifier/line_search.hpp"
 
 #include <algorithm>
 #include <cmath>

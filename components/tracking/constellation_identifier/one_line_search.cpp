@@ -1,4 +1,4 @@
-#include "one_line_search.hpp"
+#include "tracking/constellation_identifier/one_line_search.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
-#include "plane_homography.hpp"
+#include "tracking/constellation_database/plane_homography.hpp"
 
 namespace mocap::constellations {
 namespace {

@@ -17,8 +17,8 @@
 
 #include <Eigen/Core>
 
-#include "constellation_identifier.hpp"
-#include "line_candidate.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
+#include "tracking/constellation_identifier/line_candidate.hpp"
 
 namespace mocap::constellations {
 

@@ -1,4 +1,4 @@
-#include "body_motion.hpp"
+#include "tracking/constellation_tracker/body_motion.hpp"
 
 #include <cmath>
 

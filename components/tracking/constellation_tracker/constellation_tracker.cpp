@@ -1,4 +1,4 @@
-#include "constellation_tracker.hpp"
+#include "tracking/constellation_tracker/constellation_tracker.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "cross_ratio.hpp"
-#include "marker_association.hpp"
+#include "tracking/constellation_database/cross_ratio.hpp"
+#include "tracking/constellation_tracker/marker_association.hpp"
 
 namespace mocap::tracking {
 namespace {

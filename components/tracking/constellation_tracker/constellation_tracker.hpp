@@ -30,12 +30,12 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "body_motion.hpp"
-#include "constellation_database.hpp"
-#include "constellation_identifier.hpp"
-#include "marker_association.hpp"
-#include "marker_visibility.hpp"
-#include "planar_pose.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
+#include "tracking/constellation_identifier/constellation_identifier.hpp"
+#include "tracking/constellation_tracker/body_motion.hpp"
+#include "tracking/constellation_tracker/marker_association.hpp"
+#include "tracking/constellation_tracker/marker_visibility.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
 
 namespace mocap::tracking {
 

@@ -13,11 +13,11 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "constellation_message.hpp"
-#include "constellation_tracker.hpp"
-#include "database_parameters.hpp"
-#include "graph_topics.hpp"
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/constellation_database/database_parameters.hpp"
+#include "tracking/constellation_identifier/constellation_message.hpp"
+#include "tracking/constellation_tracker/constellation_tracker.hpp"
 
 namespace mocap::tracking {
 namespace {

@@ -1,4 +1,4 @@
-#include "marker_association.hpp"
+#include "tracking/constellation_tracker/marker_association.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <Eigen/LU>
 
-#include "min_cost_assignment.hpp"
+#include "tracking/constellation_tracker/min_cost_assignment.hpp"
 
 namespace mocap::tracking {
 namespace {

@@ -1,4 +1,4 @@
-#include "marker_visibility.hpp"
+#include "tracking/constellation_tracker/marker_visibility.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -10,7 +10,7 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "constellation_database.hpp"
+#include "tracking/constellation_database/constellation_database.hpp"
 
 namespace mocap::tracking {
 

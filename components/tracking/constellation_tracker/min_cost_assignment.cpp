@@ -1,4 +1,4 @@
-#include "min_cost_assignment.hpp"
+#include "tracking/constellation_tracker/min_cost_assignment.hpp"
 
 #include <limits>
 #include <stdexcept>

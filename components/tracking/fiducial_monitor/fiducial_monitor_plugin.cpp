@@ -5,8 +5,8 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
-#include "graph_topics.hpp"
-#include "stream_statistics.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/fiducial_monitor/stream_statistics.hpp"
 
 namespace mocap::demo {
 namespace {

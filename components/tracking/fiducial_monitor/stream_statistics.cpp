@@ -1,4 +1,4 @@
-#include "stream_statistics.hpp"
+#include "tracking/fiducial_monitor/stream_statistics.hpp"
 
 #include <algorithm>
 #include <cmath>

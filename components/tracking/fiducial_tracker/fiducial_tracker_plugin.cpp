@@ -10,9 +10,9 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "fiducial_detector.hpp"
-#include "graph_topics.hpp"
-#include "image_message.hpp"
+#include "common/image_message/image_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/fiducial_tracker/fiducial_detector.hpp"
 
 namespace mocap::tracking {
 namespace {

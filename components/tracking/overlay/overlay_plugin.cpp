@@ -13,11 +13,11 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
-#include "graph_topics.hpp"
-#include "image_message.hpp"
-#include "overlay_drawing.hpp"
-#include "png_file.hpp"
-#include "pose_message.hpp"
+#include "common/image_message/image_message.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/overlay/overlay_drawing.hpp"
+#include "tracking/overlay/png_file.hpp"
 
 namespace mocap::overlay {
 namespace {

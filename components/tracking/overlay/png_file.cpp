@@ -1,4 +1,4 @@
-#include "png_file.hpp"
+#include "tracking/overlay/png_file.hpp"
 
 #include <array>
 #include <cerrno>

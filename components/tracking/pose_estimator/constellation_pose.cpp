@@ -1,4 +1,4 @@
-#include "constellation_pose.hpp"
+#include "tracking/pose_estimator/constellation_pose.hpp"
 
 namespace mocap::pose {
 

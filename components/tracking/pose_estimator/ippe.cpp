@@ -1,4 +1,4 @@
-#include "ippe.hpp"
+#include "tracking/pose_estimator/ippe.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
-#include "plane_homography.hpp"
+#include "tracking/constellation_database/plane_homography.hpp"
 
 namespace mocap::pose {
 namespace {

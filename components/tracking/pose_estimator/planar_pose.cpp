@@ -1,4 +1,4 @@
-#include "planar_pose.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 #include <Eigen/SVD>
 
-#include "ippe.hpp"
-#include "pose_refinement.hpp"
+#include "tracking/pose_estimator/ippe.hpp"
+#include "tracking/pose_estimator/pose_refinement.hpp"
 
 namespace mocap::pose {
 namespace {

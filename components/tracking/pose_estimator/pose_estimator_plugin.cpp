@@ -9,11 +9,11 @@
 #include <mocap_msgs/msg/constellation_array.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
-#include "constellation_pose.hpp"
-#include "database_parameters.hpp"
-#include "graph_topics.hpp"
-#include "planar_pose.hpp"
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/constellation_database/database_parameters.hpp"
+#include "tracking/pose_estimator/constellation_pose.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
 
 namespace mocap::pose {
 namespace {

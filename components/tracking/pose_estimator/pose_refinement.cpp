@@ -1,4 +1,4 @@
-#include "pose_refinement.hpp"
+#include "tracking/pose_estimator/pose_refinement.hpp"
 
 #include <algorithm>
 #include <cmath>

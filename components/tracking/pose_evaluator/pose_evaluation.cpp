@@ -1,4 +1,4 @@
-#include "pose_evaluation.hpp"
+#include "tracking/pose_evaluator/pose_evaluation.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,9 +8,9 @@
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
-#include "graph_topics.hpp"
-#include "pose_evaluation.hpp"
-#include "pose_message.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "tracking/pose_evaluator/pose_evaluation.hpp"
 
 namespace mocap::evaluation {
 namespace {

@@ -1,4 +1,4 @@
-#include "sequence_evaluation.hpp"
+#include "tracking/pose_evaluator/sequence_evaluation.hpp"
 
 #include <algorithm>
 #include <cmath>

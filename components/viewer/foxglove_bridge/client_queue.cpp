@@ -1,4 +1,4 @@
-#include "client_queue.hpp"
+#include "viewer/foxglove_bridge/client_queue.hpp"
 
 namespace mocap::foxglove {
 

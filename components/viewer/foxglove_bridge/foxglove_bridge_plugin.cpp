@@ -20,10 +20,10 @@
 
 #include <mocap/component.hpp>
 
-#include "client_queue.hpp"
-#include "foxglove_protocol.hpp"
-#include "viewer_assets.hpp"
-#include "websocket_server.hpp"
+#include "viewer/foxglove_bridge/client_queue.hpp"
+#include "viewer/foxglove_bridge/foxglove_protocol.hpp"
+#include "viewer/foxglove_bridge/websocket_server.hpp"
+#include "viewer/web/viewer_assets.hpp"
 
 namespace mocap::foxglove {
 namespace {

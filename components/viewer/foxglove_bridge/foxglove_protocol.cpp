@@ -1,4 +1,4 @@
-#include "foxglove_protocol.hpp"
+#include "viewer/foxglove_bridge/foxglove_protocol.hpp"
 
 #include <limits>
 

@@ -1,4 +1,4 @@
-#include "origin_policy.hpp"
+#include "viewer/foxglove_bridge/origin_policy.hpp"
 
 #include <arpa/inet.h>
 #include <ifaddrs.h>

@@ -1,9 +1,9 @@
 // Built as C++17: websocketpp 0.8.2 (Debian 12) does not compile as C++20 (its constructors
 // are declared with template-ids, which C++20 forbids; fixed upstream only after 0.8.2).
 #define ASIO_STANDALONE
-#include "websocket_server.hpp"
+#include "viewer/foxglove_bridge/websocket_server.hpp"
 
-#include "origin_policy.hpp"
+#include "viewer/foxglove_bridge/origin_policy.hpp"
 
 #include <algorithm>
 #include <map>

@@ -1,4 +1,4 @@
-#include "multi_camera_pose.hpp"
+#include "volume/pose_fusion/multi_camera_pose.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "pose_refinement.hpp"
+#include "tracking/pose_estimator/pose_refinement.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -19,7 +19,7 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "marker_triangulation.hpp"
+#include "volume/triangulation/marker_triangulation.hpp"
 
 namespace mocap::volume {
 

@@ -1,4 +1,4 @@
-#include "rigid_body_database.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
 
 #include <cmath>
 #include <functional>
@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "rigid_body_identification.hpp"
-#include "yaml_reader.hpp"
+#include "common/yaml_reader/yaml_reader.hpp"
+#include "volume/rigid_bodies/rigid_body_identification.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -1,4 +1,4 @@
-#include "rigid_body_identification.hpp"
+#include "volume/rigid_bodies/rigid_body_identification.hpp"
 
 #include <algorithm>
 #include <cmath>

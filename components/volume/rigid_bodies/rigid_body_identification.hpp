@@ -15,7 +15,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "rigid_body_database.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
 
 namespace mocap::volume {
 

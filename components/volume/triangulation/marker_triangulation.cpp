@@ -1,4 +1,4 @@
-#include "marker_triangulation.hpp"
+#include "volume/triangulation/marker_triangulation.hpp"
 
 #include <algorithm>
 #include <cmath>

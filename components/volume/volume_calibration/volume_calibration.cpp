@@ -1,4 +1,4 @@
-#include "volume_calibration.hpp"
+#include "volume/volume_calibration/volume_calibration.hpp"
 
 #include <algorithm>
 #include <map>
@@ -10,8 +10,8 @@
 #include <mocap/calibration/camera_factory.hpp>
 #include <mocap/calibration/floor_frame.hpp>
 
-#include "multi_camera_pose.hpp"
-#include "planar_pose.hpp"
+#include "tracking/pose_estimator/planar_pose.hpp"
+#include "volume/pose_fusion/multi_camera_pose.hpp"
 
 namespace mocap::volume {
 namespace {

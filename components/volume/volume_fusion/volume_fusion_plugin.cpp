@@ -25,11 +25,11 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <tf2_msgs/msg/tf_message.hpp>
 
-#include "frame_assembler.hpp"
-#include "graph_topics.hpp"
-#include "pose_message.hpp"
-#include "rigid_body_database.hpp"
-#include "volume_tracker.hpp"
+#include "common/pose_message/pose_message.hpp"
+#include "common/topics/graph_topics.hpp"
+#include "volume/frame_assembly/frame_assembler.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
+#include "volume/volume_fusion/volume_tracker.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -1,4 +1,4 @@
-#include "volume_tracker.hpp"
+#include "volume/volume_fusion/volume_tracker.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -28,10 +28,10 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "marker_triangulation.hpp"
-#include "multi_camera_pose.hpp"
-#include "rigid_body_database.hpp"
-#include "rigid_body_identification.hpp"
+#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/rigid_bodies/rigid_body_database.hpp"
+#include "volume/rigid_bodies/rigid_body_identification.hpp"
+#include "volume/triangulation/marker_triangulation.hpp"
 
 namespace mocap::volume {
 

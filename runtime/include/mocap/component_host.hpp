@@ -22,25 +22,13 @@
 
 namespace mocap {
 
-// What only Fast DDS does; other implementations talk UDP and discover by multicast.
-struct FastDdsOptions {
-  // Off: UDP only. Needed between containers that do not share /dev/shm, and to force the
-  // network path between network namespaces.
-  bool shared_memory = true;
-  // Discovery through Fast DDS Discovery Servers instead of multicast: "host:port" each (host
-  // an IPv4 address or a name), the i-th being the server started with id i
-  // (`fast-discovery-server -i i -l host -p port`, as ROS_DISCOVERY_SERVER). Empty: multicast
-  // (SIMPLE) discovery. The MOCAP_DISCOVERY_SERVER environment variable ("host:port;..")
-  // overrides it.
-  std::vector<std::string> discovery_servers = {};
-};
-
 struct DdsOptions {
   // Off: the process talks to nobody outside itself (no participant is created).
   bool enabled = true;
-  // The DDS implementation: "fastdds" (eProsima Fast DDS) or "cyclonedds" (Eclipse Cyclone
-  // DDS). Both put the same wire on the network, so processes on either talk to each other.
-  // Empty: the MOCAP_DDS_IMPLEMENTATION environment variable, else "fastdds".
+  // The DDS implementation, by name: "fastdds" (eProsima Fast DDS) or "cyclonedds" (Eclipse
+  // Cyclone DDS) in this build (`mocap_launch --help` lists them). All put the same wire on the
+  // network, so processes on any of them talk to each other. Empty: the
+  // MOCAP_DDS_IMPLEMENTATION environment variable, else the first of the list.
   std::string implementation = {};
   // 0..232; the MOCAP_DOMAIN_ID environment variable overrides it.
   int domain_id = 0;
@@ -50,7 +38,18 @@ struct DdsOptions {
   // variables override them.
   std::string security_directory = {};
   std::string security_identity = {};
-  FastDdsOptions fastdds = {};
+  // Samples between processes of one host through shared memory, where the implementation
+  // offers it (Fast DDS does; Cyclone DDS here talks UDP only). Off: UDP only, needed between
+  // containers that do not share /dev/shm, and to force the network path between network
+  // namespaces.
+  bool shared_memory = true;
+  // Discovery through discovery servers instead of multicast, where the implementation offers
+  // them (Fast DDS's Discovery Servers: the i-th "host:port" is the server started with id i,
+  // `fast-discovery-server -i i -l host -p port`, as ROS_DISCOVERY_SERVER; host an IPv4 address
+  // or a name). A launch file that names them for a group on an implementation without them is
+  // refused. Empty: multicast discovery. The MOCAP_DISCOVERY_SERVER environment variable
+  // ("host:port;..") overrides it.
+  std::vector<std::string> discovery_servers = {};
 };
 
 struct HostOptions {

@@ -117,7 +117,7 @@ DdsOptions with_environment(DdsOptions options) {
     return std::string(text);
   };
   if (auto servers = variable("MOCAP_DISCOVERY_SERVER")) {
-    options.fastdds.discovery_servers.clear();
+    options.discovery_servers.clear();
     for (size_t start = 0; start <= servers->size();) {
       size_t end = std::min(servers->find(';', start), servers->size());
       std::string server = servers->substr(start, end - start);
@@ -126,7 +126,7 @@ DdsOptions with_environment(DdsOptions options) {
             "MOCAP_DISCOVERY_SERVER='{}': '{}' is not host:port (expected host:port;host:port..)",
             *servers, server));
       }
-      options.fastdds.discovery_servers.push_back(server);
+      options.discovery_servers.push_back(server);
       start = end + 1;
     }
   }

@@ -6,6 +6,7 @@
 // implementations in one graph exchange every message both ways.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -30,33 +31,12 @@ struct DiscoveredEndpoint {
 
 class DdsTransport : public Transport {
  public:
-  // "fastdds" or "cyclonedds".
+  // Its name in the table of implementations (DdsImplementation::name).
   virtual std::string_view implementation() const = 0;
   virtual int domain_id() const = 0;
   // Endpoints of other participants seen so far (alive ones only).
   virtual std::vector<DiscoveredEndpoint> discovered_endpoints() const = 0;
 };
-
-// A DDS implementation this runtime carries, and what it can do. Adding one: a folder under
-// dds/ with its DdsTransport, and its line in the table of dds_transport.cpp (runtime/README.md).
-struct DdsImplementation {
-  std::string_view name;  // as DdsOptions::implementation and MOCAP_DDS_IMPLEMENTATION say it
-  // Whether it takes DdsOptions::fastdds (shared memory, Discovery Servers); otherwise it
-  // talks UDP only and discovers by multicast.
-  bool takes_fastdds_options;
-  // Why it cannot take the signed governance document `governance`, or nullopt.
-  std::optional<std::string> (*governance_problem)(const std::filesystem::path& governance);
-  std::unique_ptr<DdsTransport> (*make)(const DdsOptions& options,
-                                        const std::string& participant_name);
-};
-
-// The names DdsOptions::implementation takes, for messages: "fastdds, cyclonedds".
-std::string dds_implementation_names();
-
-// `configured` when set, else MOCAP_DDS_IMPLEMENTATION when set, else the first of the table
-// (Fast DDS). Throws std::runtime_error naming the source of an unknown name and listing the
-// known ones.
-const DdsImplementation& resolve_dds_implementation(std::string_view configured);
 
 // MOCAP_DOMAIN_ID if set (validated), otherwise `configured`.
 int resolve_domain_id(int configured);
@@ -72,10 +52,5 @@ constexpr uint32_t kUdpSocketBufferBytes = 4 * 1024 * 1024;
 // command that lifts the cap; nullopt when it does not.
 std::optional<std::string> udp_buffer_problem(
     const std::filesystem::path& sysctl_directory = "/proc/sys/net/core");
-
-// A participant named `participant_name` on the implementation `options` (and the environment)
-// choose. Throws std::runtime_error when it cannot be created.
-std::unique_ptr<DdsTransport> make_dds_transport(const DdsOptions& options,
-                                                 const std::string& participant_name);
 
 }  // namespace mocap

@@ -17,6 +17,7 @@
 #include "core/names.hpp"
 #include "dds/dds_options.hpp"
 #include "dds/dds_transport.hpp"
+#include "host/dds_implementations.hpp"
 #include "launch/yaml_value.hpp"
 
 namespace mocap {
@@ -245,8 +246,7 @@ class Reader {
       if (auto v = int_value(n, "domain_id", 0, 232, problems_)) result_.dds.domain_id = int(*v);
     }
     if (YAML::Node n = dds["shared_memory"]) {
-      if (auto v = bool_value(n, "shared_memory", problems_))
-        result_.dds.fastdds.shared_memory = *v;
+      if (auto v = bool_value(n, "shared_memory", problems_)) result_.dds.shared_memory = *v;
     }
     if (YAML::Node n = dds["discovery"]) {
       read_discovery(n);
@@ -269,8 +269,8 @@ class Reader {
     return "";
   }
 
-  // What a group's implementation cannot do: Fast DDS's Discovery Servers under Cyclone DDS,
-  // and DDS Security between groups on different implementations.
+  // What a group's implementation cannot do (DdsFeature): discovery servers, and DDS
+  // Security's handshake with groups on another implementation.
   void check_implementations() {
     // Implementation -> its first group.
     std::map<std::string_view, const LaunchGroup*> first_on;
@@ -283,14 +283,15 @@ class Reader {
         continue;
       }
       first_on.emplace(implementation->name, &group);
-      if (!implementation->takes_fastdds_options &&
-          !result_.dds.fastdds.discovery_servers.empty()) {
+      if (!implementation->supports(DdsFeature::kDiscoveryServers) &&
+          !result_.dds.discovery_servers.empty()) {
         problems_.record(discovery_line_,
-                         fmt::format("dds.discovery.server: Fast DDS Discovery Servers do not work "
-                                     "with {} (group '{}'{}); run that group on fastdds, or use "
-                                     "multicast discovery, or give Cyclone DDS its peers "
-                                     "(Discovery/Peers) through CYCLONEDDS_URI",
-                                     implementation->name, group.name, where_chosen(group)));
+                         fmt::format("dds.discovery.server: {} has no discovery servers (group "
+                                     "'{}'{}); run that group on an implementation that has "
+                                     "them ({}), or use multicast discovery (launch_yaml/README.md "
+                                     "says how to give it its peers instead)",
+                                     implementation->name, group.name, where_chosen(group),
+                                     implementations_with(DdsFeature::kDiscoveryServers)));
       }
     }
     if (result_.dds.security_identity.empty()) return;
@@ -301,20 +302,35 @@ class Reader {
                                                      *problem, group->name, name));
       }
     }
-    // One identity on both sides: which side starts the handshake is chance, and Fast DDS 2.9
-    // starting it fails with Cyclone DDS 0.10 (launch_yaml/README.md).
-    if (first_on.count("fastdds") > 0 && first_on.count("cyclonedds") > 0) {
-      const LaunchGroup& fast = *first_on.at("fastdds");
-      const LaunchGroup& cyclone = *first_on.at("cyclonedds");
-      problems_.record(
-          security_line_,
-          fmt::format("dds.security: group '{}' (fastdds{}) and group '{}' (cyclonedds{}) "
-                      "would authenticate each other only when the Cyclone DDS side "
-                      "starts the handshake, which with one identity is chance; run "
-                      "them on one implementation, or in separate launch files with "
-                      "identities ordered as launch_yaml/README.md explains",
-                      fast.name, where_chosen(fast), cyclone.name, where_chosen(cyclone)));
+    // One identity on both sides: which side starts the handshake is chance, and an
+    // implementation without kSecurityHandshakeWithOthers fails when it starts it
+    // (launch_yaml/README.md).
+    for (const auto& [name, group] : first_on) {
+      if (resolve_dds_implementation(name).supports(DdsFeature::kSecurityHandshakeWithOthers)) {
+        continue;
+      }
+      for (const auto& [other_name, other] : first_on) {
+        if (other_name == name) continue;
+        problems_.record(
+            security_line_,
+            fmt::format("dds.security: group '{}' ({}{}) and group '{}' ({}{}) would "
+                        "authenticate each other only when the {} side starts the handshake, "
+                        "which with one identity is chance; run them on one implementation, or "
+                        "in separate launch files with identities ordered as "
+                        "launch_yaml/README.md explains",
+                        group->name, name, where_chosen(*group), other->name, other_name,
+                        where_chosen(*other), other_name));
+      }
     }
+  }
+
+  // The implementations that have `feature`, for messages: "fastdds".
+  static std::string implementations_with(DdsFeature feature) {
+    std::vector<std::string_view> names;
+    for (const DdsImplementation& implementation : dds_implementations()) {
+      if (implementation.supports(feature)) names.push_back(implementation.name);
+    }
+    return names.empty() ? "none here" : fmt::format("{}", fmt::join(names, ", "));
   }
 
   // Where a group's implementation comes from, for messages: ", line N" or ", from
@@ -345,7 +361,7 @@ class Reader {
     }
     for (const YAML::Node& entry : entries) {
       if (entry.IsScalar() && parse_host_port(entry.Scalar())) {
-        result_.dds.fastdds.discovery_servers.push_back(entry.Scalar());
+        result_.dds.discovery_servers.push_back(entry.Scalar());
       } else {
         problems_.record(entry, fmt::format("dds.discovery.server: '{}' is not host:port",
                                             entry.IsScalar() ? entry.Scalar() : "?"));

@@ -10,7 +10,7 @@
 
 #include <mocap/component_host.hpp>
 
-#include "core/plugin_loader.hpp"
+#include "host/plugin_loader.hpp"
 
 namespace mocap {
 

@@ -19,11 +19,6 @@
 
 namespace mocap {
 
-// Our QoS in Cyclone's terms, as FastDdsTransport sets it (fastdds_qos.cpp). Shared by the
-// transport and the benchmark's raw Cyclone DDS reference.
-void to_cyclone_reader_qos(const Qos& qos, dds_qos_t* out);
-void to_cyclone_writer_qos(const Qos& qos, dds_qos_t* out);
-
 class CycloneDdsTransport final : public DdsTransport {
  public:
   // Throws std::runtime_error when the domain or the participant cannot be created.

@@ -209,14 +209,14 @@ dds::DomainParticipantQos to_participant_qos(const DdsOptions& given, const std:
   auto& discovery = out.wire_protocol().builtin.discovery_config;
   discovery.leaseDuration = {5, 0};
   discovery.leaseDuration_announcementperiod = {1, 0};
-  if (!options.fastdds.discovery_servers.empty()) {
-    set_discovery_servers(options.fastdds.discovery_servers, discovery);
+  if (!options.discovery_servers.empty()) {
+    set_discovery_servers(options.discovery_servers, discovery);
   }
   if (!options.security_directory.empty()) {
     set_security(options.security_directory, options.security_identity, out.properties());
   }
   out.transport().use_builtin_transports = false;
-  if (options.fastdds.shared_memory) {
+  if (options.shared_memory) {
     // Fast DDS's default 512 KiB segment cannot hold a camera image, which then goes over
     // UDP in fragments: 20 times slower for 1280x720 mono8 (bench/transport_bench).
     auto shared_memory = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();

@@ -404,7 +404,7 @@ FastDdsTransport::FastDdsTransport(const DdsOptions& options, const std::string&
     // Until the participant holds its ports, another one in this process would choose them too.
     static std::mutex choosing_ports;
     std::lock_guard lock(choosing_ports);
-    if (options.fastdds.shared_memory) {
+    if (options.shared_memory) {
       remove_orphaned_shared_memory();
       if (auto id = unused_participant_id(domain_id_)) qos.wire_protocol().participant_id = *id;
     }

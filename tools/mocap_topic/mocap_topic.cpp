@@ -1,0 +1,291 @@
+// mocap_topic: what is on the DDS domain, and what goes over it.
+#include <charconv>
+#include <condition_variable>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include <mocap/generated_message_types.hpp>
+
+#include <mocap/raw_message_type.hpp>
+#include "core/rate_estimator.hpp"
+#include "core/shutdown_signal.hpp"
+#include "dds/dds_transport.hpp"
+#include "host/dds_implementations.hpp"
+#include "host/plugin_loader.hpp"
+#include "messages/cdr_format.hpp"
+#include "messages/idl_schema.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage:
+  mocap_topic list [--wait SECONDS]
+  mocap_topic echo TOPIC [--count N] [--full] [--idl FILE]...
+  mocap_topic hz TOPIC [--window N] [--count N]
+options for all: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
+
+  list   topics seen on the domain, with their types and endpoint counts, and each
+         publisher/subscriber pair that cannot connect (QoS or type) and why
+  echo   print each message (YAML-like); --count stops after N, --full prints whole arrays,
+         --idl adds definitions for types this build does not know
+  hz     publication rate from the publisher's timestamps, every second; --window sets the
+         samples averaged (default 10000), --count stops after N reports
+)";
+
+[[noreturn]] void usage_error(std::string_view message) {
+  fmt::print(stderr, "mocap_topic: {}\n\n{}", message, kUsage);
+  std::exit(2);
+}
+
+size_t parse_number(std::string_view option, const std::string& text, size_t min, size_t max) {
+  size_t value = 0;
+  auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size() || value < min || value > max) {
+    usage_error(fmt::format("{} {}: expected an integer in [{}, {}]", option, text, min, max));
+  }
+  return value;
+}
+
+void sleep_unless_stopped(std::chrono::milliseconds duration) {
+  mocap::ShutdownSignal::wait(duration);
+}
+
+// Topics with their types and endpoint counts, and under each topic every publisher and
+// subscriber pair that DDS will not connect (QoS or type), whichever implementation each
+// runs on: such a subscriber gets nothing, and its own process only logs it.
+int list(mocap::DdsTransport& transport, double wait_seconds) {
+  sleep_unless_stopped(std::chrono::milliseconds(static_cast<int>(wait_seconds * 1000)));
+  struct Topic {
+    std::set<std::string> types;
+    std::vector<mocap::DiscoveredEndpoint> publishers, subscribers;
+  };
+  std::map<std::string, Topic> topics;
+  for (auto& endpoint : transport.discovered_endpoints()) {
+    Topic& topic = topics[endpoint.topic];
+    topic.types.insert(mocap::ros_type_name(endpoint.type));
+    (endpoint.is_publisher ? topic.publishers : topic.subscribers).push_back(std::move(endpoint));
+  }
+  for (const auto& [name, topic] : topics) {
+    std::vector<std::string> mismatches;
+    for (const auto& subscriber : topic.subscribers) {
+      for (const auto& publisher : topic.publishers) {
+        auto why = publisher.type != subscriber.type
+                       ? std::optional<std::string>(fmt::format(
+                             "types differ ({} vs {})", mocap::ros_type_name(publisher.type),
+                             mocap::ros_type_name(subscriber.type)))
+                       : mocap::qos_mismatch(publisher.qos, subscriber.qos);
+        if (why) {
+          mismatches.push_back(
+              fmt::format("  incompatible: publisher of '{}' -> subscriber of "
+                          "'{}': {}",
+                          publisher.participant, subscriber.participant, *why));
+        }
+      }
+    }
+    fmt::print(
+        "{} [{}] {} publisher(s), {} subscriber(s){}\n", name, fmt::join(topic.types, ", "),
+        topic.publishers.size(), topic.subscribers.size(),
+        mismatches.empty() ? "" : fmt::format(", {} incompatible pair(s)", mismatches.size()));
+    for (const auto& line : mismatches) fmt::print("{}\n", line);
+  }
+  return 0;
+}
+
+// Waits for the topic's publishers; returns their type and a QoS every one of them matches.
+std::optional<std::pair<std::string, mocap::Qos>> find_publishers(mocap::DdsTransport& transport,
+                                                                  const std::string& topic) {
+  auto start = std::chrono::steady_clock::now();
+  bool announced = false;
+  while (!mocap::ShutdownSignal::received()) {
+    std::set<std::string> types;
+    mocap::Qos qos{mocap::Reliability::Reliable, mocap::Durability::TransientLocal,
+                   mocap::History::KeepLast, 1000};
+    for (const auto& endpoint : transport.discovered_endpoints()) {
+      if (endpoint.topic != topic || !endpoint.is_publisher) continue;
+      types.insert(endpoint.type);
+      if (endpoint.qos.reliability == mocap::Reliability::BestEffort) {
+        qos.reliability = mocap::Reliability::BestEffort;
+      }
+      if (endpoint.qos.durability == mocap::Durability::Volatile) {
+        qos.durability = mocap::Durability::Volatile;
+      }
+    }
+    if (types.size() > 1) {
+      fmt::print(stderr, "mocap_topic: {} is published with several types: {}\n", topic,
+                 fmt::join(types, ", "));
+      return std::nullopt;
+    }
+    if (types.size() == 1) return std::make_pair(*types.begin(), qos);
+    if (!announced && std::chrono::steady_clock::now() - start > std::chrono::seconds(1)) {
+      fmt::print(stderr, "waiting for a publisher of {} ...\n", topic);
+      announced = true;
+    }
+    sleep_unless_stopped(std::chrono::milliseconds(50));
+  }
+  return std::nullopt;
+}
+
+// Calls `each` for every message received, from this thread, until it returns false.
+template <class Each>
+int receive(mocap::DdsTransport& transport, const std::string& topic,
+            const mocap::RawMessageType& type, const mocap::Qos& qos, Each each) {
+  std::mutex mutex;
+  std::condition_variable arrived;
+  bool pending = false;
+  auto subscription = transport.subscribe({topic, &type, qos, "mocap_topic"}, [&](bool) {
+    std::lock_guard lock(mutex);
+    pending = true;
+    arrived.notify_one();
+  });
+  mocap::ReceivedMessage received;
+  while (!mocap::ShutdownSignal::received()) {
+    while (subscription->take(received)) {
+      if (!each(received)) return 0;
+    }
+    std::unique_lock lock(mutex);
+    arrived.wait_for(lock, std::chrono::milliseconds(100), [&] { return pending; });
+    pending = false;
+  }
+  return 0;
+}
+
+int echo(mocap::DdsTransport& transport, const std::string& topic, size_t count, bool full,
+         const std::vector<std::string>& idl_files) {
+  auto found = find_publishers(transport, topic);
+  if (!found) return 1;
+  auto [dds_type, qos] = *found;
+  mocap::IdlSchema schema;
+  try {
+    for (const std::string& file : idl_files) {
+      std::ifstream stream(file);
+      if (!stream) {
+        fmt::print(stderr, "mocap_topic: cannot read {}\n", file);
+        return 1;
+      }
+      std::stringstream text;
+      text << stream.rdbuf();
+      schema.parse(text.str());
+    }
+    if (const mocap::MessageType* known = mocap::find_message_type(dds_type)) {
+      schema.parse(mocap::full_definition(*known));
+    }
+  } catch (const mocap::IdlError& e) {
+    fmt::print(stderr, "mocap_topic: {}\n", e.what());
+    return 1;
+  }
+  mocap::RawMessageType type(dds_type);
+  if (schema.find(type.name()) == nullptr) {
+    fmt::print(stderr,
+               "mocap_topic: {} has type {}, which this build does not know; pass its IDL "
+               "with --idl FILE\n",
+               topic, type.name());
+    return 1;
+  }
+  mocap::CdrFormatOptions options;
+  if (full) options.max_items = SIZE_MAX;
+  size_t printed = 0;
+  return receive(transport, topic, type, qos, [&](const mocap::ReceivedMessage& received) {
+    const auto& bytes = *static_cast<const std::vector<uint8_t>*>(received.message.get());
+    try {
+      fmt::print("{}---\n", mocap::format_cdr(schema, type.name(), bytes, options));
+    } catch (const std::exception& e) {
+      fmt::print("# cannot show this message: {}\n---\n", e.what());
+    }
+    std::fflush(stdout);
+    return ++printed < count;
+  });
+}
+
+int hz(mocap::DdsTransport& transport, const std::string& topic, size_t window, size_t count) {
+  auto found = find_publishers(transport, topic);
+  if (!found) return 1;
+  auto [dds_type, qos] = *found;
+  mocap::RawMessageType type(dds_type);
+  mocap::RateEstimator estimator(window);
+  size_t reports = 0;
+  auto next_report = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  return receive(transport, topic, type, qos, [&](const mocap::ReceivedMessage& received) {
+    estimator.add(received.source_time);
+    if (std::chrono::steady_clock::now() < next_report) return true;
+    next_report += std::chrono::seconds(1);
+    if (auto stats = estimator.stats()) {
+      fmt::print(
+          "average rate: {:.3f} Hz\n  min: {:.6f} s  max: {:.6f} s  std dev: {:.6f} s  "
+          "window: {}\n",
+          stats->rate_hz, stats->min_period_s, stats->max_period_s, stats->stddev_period_s,
+          stats->samples);
+      std::fflush(stdout);
+      return ++reports < count;
+    }
+    return true;
+  });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) usage_error("no command given");
+  if (args[0] == "--help" || args[0] == "-h") {
+    fmt::print("{}", kUsage);
+    return 0;
+  }
+  std::string command = args[0];
+  std::optional<std::string> topic;
+  std::optional<int> domain;
+  size_t count = SIZE_MAX, window = 10000;
+  double wait_seconds = 1.5;
+  bool full = false;
+  std::vector<std::string> idl_files;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) usage_error(fmt::format("{} needs a value", arg));
+      return args[++i];
+    };
+    if (arg == "--domain") {
+      domain = static_cast<int>(parse_number(arg, value(), 0, 232));
+    } else if (arg == "--count") {
+      count = parse_number(arg, value(), 1, SIZE_MAX);
+    } else if (arg == "--window") {
+      window = parse_number(arg, value(), 2, 10000000);
+    } else if (arg == "--wait") {
+      wait_seconds = std::atof(value().c_str());
+    } else if (arg == "--full") {
+      full = true;
+    } else if (arg == "--idl") {
+      idl_files.push_back(value());
+    } else if (arg.starts_with("-")) {
+      usage_error(fmt::format("unknown option {}", arg));
+    } else if (!topic) {
+      topic = arg;
+    } else {
+      usage_error(fmt::format("unexpected argument {}", arg));
+    }
+  }
+  if (command != "list" && !topic) usage_error(fmt::format("{} needs a TOPIC", command));
+  if (domain) setenv("MOCAP_DOMAIN_ID", std::to_string(*domain).c_str(), 1);
+
+  mocap::ShutdownSignal::install();
+  mocap::generated_message_types();  // registers the known types for echo
+  for (const std::string& error : mocap::PluginLoader().load_message_libraries()) {
+    fmt::print(stderr, "mocap_topic: {}\n", error);  // its types stay unknown: echo says so
+  }
+  try {
+    auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_topic");
+    mocap::DdsTransport& transport = *dds;
+    if (command == "list") return list(transport, wait_seconds);
+    if (command == "echo") return echo(transport, *topic, count, full, idl_files);
+    if (command == "hz") return hz(transport, *topic, window, count);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "mocap_topic: {}\n", e.what());
+    return 1;
+  }
+  usage_error(fmt::format("unknown command {}", command));
+}
