@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -17,55 +16,15 @@
 
 #include <fmt/format.h>
 
+#include "bag_salvage.hpp"
 #include "mcap_reader.hpp"
 #include "sqlite_database.hpp"
+#include "stamps.hpp"
 
 namespace mocap::bag {
 namespace {
 
-// Stamps and row ids come from the file and may be anything: sums and differences of them
-// saturate rather than overflow.
-int64_t clamped_sum(int64_t a, int64_t b) {
-  int64_t sum = 0;
-  if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? INT64_MAX : INT64_MIN;
-  return sum;
-}
-int64_t clamped_difference(int64_t a, int64_t b) {
-  int64_t difference = 0;
-  if (__builtin_sub_overflow(a, b, &difference)) return b < 0 ? INT64_MAX : INT64_MIN;
-  return difference;
-}
-
 namespace fs = std::filesystem;
-
-// Salvage seeks past a damaged stretch up to the highest id known plus this margin (a damaged
-// file may not say how many rows it had)...
-constexpr int64_t kProbeMargin = 10000;
-// ...one id at a time for this many seeks, ever longer steps after...
-constexpr int64_t kLinearProbes = 1024;
-// ...and never more than this many seeks per file, so that a file whose every page is garbage
-// ends in seconds. Each damaged stretch costs at most kLinearProbes plus twice 63.
-constexpr int64_t kProbeBudget = 200'000;
-constexpr int kRangeBatch = 4096;
-
-// "12:03:04.512", local time: what a user compares with the clock of the recording.
-std::string time_of_day(int64_t stamp_ns) {
-  const std::time_t seconds = static_cast<std::time_t>(stamp_ns / 1'000'000'000);
-  const auto millis = static_cast<int>((stamp_ns % 1'000'000'000) / 1'000'000);
-  std::tm tm{};
-  if (localtime_r(&seconds, &tm) == nullptr) return fmt::format("{} ns", stamp_ns);
-  return fmt::format("{:02}:{:02}:{:02}.{:03}", tm.tm_hour, tm.tm_min, tm.tm_sec,
-                     millis < 0 ? 0 : millis);
-}
-
-// The part of a SqliteError after "<file>: <what>: ", for problem lines that name the file
-// themselves.
-std::string sqlite_reason(const sqlite::SqliteError& error) {
-  std::string text = error.what();
-  auto first = text.find(": ");
-  auto second = first == std::string::npos ? first : text.find(": ", first + 2);
-  return second == std::string::npos ? text : text.substr(second + 2);
-}
 
 std::string uri_for(const std::string& path) {
   std::string uri = "file:";
@@ -104,11 +63,6 @@ bool natural_less(const std::string& a, const std::string& b) {
   return a.size() - i < b.size() - j;
 }
 
-struct Row {
-  int64_t timestamp, id, topic_id;
-  auto key() const { return std::pair(timestamp, id); }
-};
-
 struct FileState {
   std::string path;                        // what is opened
   std::string name;                        // what problems call it: relative to the bag directory
@@ -142,204 +96,6 @@ struct FileState {
     int64_t first_ns = 0, last_ns = 0;
     std::string reason;
   } loss;
-};
-
-// Keeps the row a "SELECT id, topic_id, timestamp" statement is on, or counts it untimed.
-void keep_row(const sqlite::Statement& row, FileState& file, std::vector<Row>& rows) {
-  if (row.column_is_null(2)) {
-    ++file.untimed;
-    return;
-  }
-  rows.push_back({row.column_int64(2), row.column_int64(0), row.column_int64(1)});
-}
-
-// Finds every row of a damaged file whose id, topic and timestamp can still be read: ranges of
-// ids while the b-tree walks, seeks past each damaged stretch to where it walks again. One
-// problem line per damaged stretch.
-class Salvage {
- public:
-  Salvage(FileState& file, std::string reason, std::function<void(std::string)> problem)
-      : file_(file), reason_(std::move(reason)), problem_(std::move(problem)) {}
-
-  // The rows found, unsorted.
-  std::vector<Row> run() {
-    try {
-      sqlite::Statement max(file_.db, "SELECT max(id) FROM messages");
-      if (max.step() && !max.column_is_null(0)) max_id_ = max.column_int64(0);
-    } catch (const sqlite::SqliteError&) {
-    }
-    try {
-      range_.emplace(file_.db, fmt::format("SELECT id, topic_id, timestamp FROM messages WHERE "
-                                           "id > ? ORDER BY id LIMIT {}",
-                                           kRangeBatch));
-      seek_.emplace(
-          file_.db,
-          "SELECT id, topic_id, timestamp FROM messages WHERE id >= ? ORDER BY id LIMIT 1");
-    } catch (const sqlite::SqliteError& e) {
-      problem_(fmt::format("{}: no message readable: {}", file_.name, sqlite_reason(e)));
-      return {};
-    }
-    for (;;) {
-      walk_ranges();
-      // The last row read, where one was (ids read are above 0, the cursor's start).
-      const std::string before = cursor_ > 0 ? place(cursor_) : std::string();
-      const Stretch damage = find_where_damage_ends();
-      // Again where the damage ends, to read the row there.
-      const bool row_after = damage.walks && seek_from(*damage.walks) == Seek::kRow;
-      const int64_t lost = damage.walks ? *damage.walks - cursor_ - 1 : 0;
-      if (row_after) {
-        const int64_t next = seek_->column_int64(0);
-        keep_row(*seek_, file_, rows_);
-        seek_->reset();
-        if (lost > 0) report_gap(before, next, lost, *damage.walks);
-        cursor_ = next;
-        continue;
-      }
-      seek_->reset();
-      report_end(before, lost > 0 || (!damage.walks && cursor_ < damage.upper));
-      return std::move(rows_);
-    }
-  }
-
- private:
-  static constexpr const char* kOutOfOrder = "the table's row ids are out of order";
-
-  // Fast: ranges of ids while the b-tree can be walked, from cursor_ on.
-  void walk_ranges() {
-    try {
-      for (bool more = true; more;) {
-        range_->reset();
-        range_->bind(1, cursor_);
-        int n = 0;
-        while (more && range_->step()) {
-          // A damaged b-tree can give ids out of order: reading on from a smaller id would
-          // read the same rows again.
-          if (const int64_t id = range_->column_int64(0); id > cursor_) {
-            cursor_ = id;
-            ++n;
-            keep_row(*range_, file_, rows_);
-          } else {
-            reason_ = kOutOfOrder;
-            more = false;
-          }
-        }
-        more = more && n == kRangeBatch;
-      }
-    } catch (const sqlite::SqliteError& e) {
-      reason_ = sqlite_reason(e);
-    }
-    range_->reset();
-  }
-
-  // A damaged stretch after cursor_: the last id whose seek failed, the first whose seek did not
-  // (none: damaged to `upper`, the highest id there may be).
-  struct Stretch {
-    int64_t damaged = 0;
-    std::optional<int64_t> walks;
-    int64_t upper = 0;
-  };
-  // Slow: seeks past the damage until one walks again; a seek steps over absent ids. One id at
-  // a time first, as a damaged leaf page hides a few hundred ids at most; then ever longer
-  // steps, so that a damaged interior page or a corrupt max(id) costs tens of seeks, and a
-  // binary search back to where the damage ends, so that no row past it is skipped.
-  Stretch find_where_damage_ends() {
-    Stretch stretch;
-    stretch.upper = clamped_sum(std::max({cursor_, max_id_.value_or(0),
-                                          static_cast<int64_t>(file_.expected_count.value_or(0))}),
-                                kProbeMargin);
-    stretch.damaged = cursor_;
-    int64_t step = 1;
-    for (int64_t id = cursor_, tries = 0;
-         id < stretch.upper && !stretch.walks && probes_ < kProbeBudget;) {
-      id = stretch.upper - id > step ? id + step : stretch.upper;
-      ++probes_;
-      if (seek_from(id) != Seek::kDamaged) {
-        stretch.walks = id;
-      } else {
-        stretch.damaged = id;
-        if (++tries >= kLinearProbes && step <= INT64_MAX / 2) step *= 2;
-      }
-    }
-    while (stretch.walks && *stretch.walks - stretch.damaged > 1 && probes_ < kProbeBudget) {
-      ++probes_;
-      const int64_t middle = stretch.damaged + (*stretch.walks - stretch.damaged) / 2;
-      if (seek_from(middle) != Seek::kDamaged) {
-        stretch.walks = middle;
-      } else {
-        stretch.damaged = middle;
-      }
-    }
-    return stretch;
-  }
-
-  // Seeks the first row at or after `id`; on kRow, seek_ stays on it.
-  enum class Seek { kRow, kEnd, kDamaged };
-  Seek seek_from(int64_t id) {
-    try {
-      seek_->reset();
-      seek_->bind(1, id);
-      if (!seek_->step()) return Seek::kEnd;
-      if (seek_->column_int64(0) >= id) return Seek::kRow;
-      reason_ = kOutOfOrder;
-      return Seek::kDamaged;
-    } catch (const sqlite::SqliteError& e) {
-      reason_ = sqlite_reason(e);
-      return Seek::kDamaged;
-    }
-  }
-
-  // Where a problem line places a row: its time, or its id if it has none.
-  std::string place(int64_t id) const {
-    return !rows_.empty() && rows_.back().id == id ? time_of_day(rows_.back().timestamp)
-                                                   : fmt::format("id {}", id);
-  }
-
-  // `lost` ids unreadable between the row at `before` (none: the file's start) and `next`.
-  void report_gap(const std::string& before, int64_t next, int64_t lost, int64_t walks) {
-    reported_lost_ += static_cast<uint64_t>(lost);
-    problem_(before.empty()
-                 ? fmt::format("{}: messages before {} ({}, ids {}-{}) unreadable: {}", file_.name,
-                               place(next), lost, cursor_ + 1, walks - 1, reason_)
-                 : fmt::format("{}: messages between {} and {} ({}, ids {}-{}) unreadable: {}",
-                               file_.name, before, place(next), lost, cursor_ + 1, walks - 1,
-                               reason_));
-  }
-
-  // Nothing readable after cursor_: damaged to the end (`damaged_to_the_end`), or simply the end
-  // (also where the last row read has the largest id there can be).
-  void report_end(const std::string& before, bool damaged_to_the_end) {
-    const uint64_t found = rows_.size() + reported_lost_;
-    if (damaged_to_the_end) {
-      std::string how_many;
-      if (max_id_ && *max_id_ > cursor_) {
-        how_many = fmt::format("about {}", *max_id_ - cursor_);
-      } else if (file_.expected_count && *file_.expected_count > found) {
-        how_many = fmt::format("about {}", *file_.expected_count - found);
-      } else {
-        how_many = "how many is unknown";
-      }
-      problem_(before.empty()
-                   ? fmt::format("{}: no message readable ({}): {}", file_.name, how_many, reason_)
-                   : fmt::format("{}: messages after {} ({}) unreadable: {}", file_.name, before,
-                                 how_many, reason_));
-    } else if (file_.expected_count && *file_.expected_count > found) {
-      // The walk ended cleanly short of what metadata.yaml counted: the damage hid rows
-      // without an error to show for it.
-      problem_(fmt::format("{}: {} of the {} messages metadata.yaml counts are missing: {}",
-                           file_.name, *file_.expected_count - found, *file_.expected_count,
-                           reason_));
-    }
-  }
-
-  FileState& file_;
-  std::string reason_;  // why the last read failed
-  std::function<void(std::string)> problem_;
-  std::vector<Row> rows_;
-  std::optional<int64_t> max_id_;
-  std::optional<sqlite::Statement> range_, seek_;
-  int64_t cursor_ = 0;  // rosbag2's ids start at 1
-  int64_t probes_ = 0;
-  uint64_t reported_lost_ = 0;  // in the stretches reported so far
 };
 
 }  // namespace
@@ -472,7 +228,7 @@ struct BagReader::State {
       problem(fmt::format(
           "{}: its write-ahead log {}-wal cannot be used ({}); the messages only in the log "
           "are missing (copy the bag to a directory you may write to, to read them)",
-          file.name, fs::path(file.path).filename().string(), sqlite_reason(e)));
+          file.name, fs::path(file.path).filename().string(), e.reason()));
     }
   }
 
@@ -684,7 +440,7 @@ struct BagReader::State {
     std::vector<Row> rows;
     sqlite::Statement all(file.db, "SELECT id, topic_id, timestamp FROM messages");
     file.untimed = 0;
-    while (all.step()) keep_row(all, file, rows);
+    while (all.step()) keep_row(all, rows, file.untimed);
     std::sort(rows.begin(), rows.end(),
               [](const Row& a, const Row& b) { return a.key() < b.key(); });
     file.rows = std::move(rows);
@@ -697,12 +453,13 @@ struct BagReader::State {
     file.rows.clear();
     file.next_row = 0;
     file.untimed = 0;
-    std::vector<Row> rows = Salvage(file, sqlite_reason(first_error), [this](std::string line) {
-                              problem(std::move(line));
-                            }).run();
-    std::sort(rows.begin(), rows.end(),
+    SalvagedRows salvaged =
+        salvage_rows(file.db, file.name, file.expected_count, first_error.reason(),
+                     [this](std::string line) { problem(std::move(line)); });
+    std::sort(salvaged.rows.begin(), salvaged.rows.end(),
               [](const Row& a, const Row& b) { return a.key() < b.key(); });
-    file.rows = std::move(rows);
+    file.rows = std::move(salvaged.rows);
+    file.untimed = salvaged.untimed;
   }
 
   // ---- iteration ----------------------------------------------------------------------
@@ -803,7 +560,7 @@ struct BagReader::State {
         FileState::Loss& loss = file.loss;
         if (loss.count++ == 0) loss.first_ns = row.timestamp;
         loss.last_ns = row.timestamp;
-        loss.reason = sqlite_reason(e);
+        loss.reason = e.reason();
       }
     }
     flush_loss(file);

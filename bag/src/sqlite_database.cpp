@@ -45,6 +45,13 @@ bool SqliteError::is_wal_access() const {
   }
 }
 
+std::string SqliteError::reason() const {
+  std::string text = what();
+  auto first = text.find(": ");
+  auto second = first == std::string::npos ? first : text.find(": ", first + 2);
+  return second == std::string::npos ? text : text.substr(second + 2);
+}
+
 void throw_error(sqlite3* db, int code, std::string_view name, std::string_view what) {
   // sqlite3_errmsg describes the last failure on the connection, which may be older than
   // `code` when the failing call does not set it (sqlite3_open_v2 without a handle).

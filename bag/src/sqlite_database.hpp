@@ -27,6 +27,9 @@ class SqliteError : public BagError {
   // Opening failed because of the write-ahead log or its shared-memory index (a killed
   // writer's leftovers in a directory we may not write to).
   bool is_wal_access() const;
+  // The part of the message after "<file>: <what>: ", for problem lines that name the file
+  // themselves.
+  std::string reason() const;
 
  private:
   int code_;
