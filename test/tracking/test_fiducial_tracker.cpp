@@ -522,6 +522,10 @@ TEST(FiducialDetector, RejectsBadOptionsAndImages) {
   invalid([](auto& o) { o.connectivity = 6; });
   invalid([](auto& o) { o.region_of_interest = cv::Rect(0, 0, -5, 10); });
   invalid([](auto& o) { o.centroid_level = -0.1; });
+  FiducialDetectorOptions options;
+  EXPECT_EQ(options.problem(), std::nullopt);
+  options.connectivity = 6;
+  EXPECT_EQ(options.problem(), "connectivity must be 4 or 8, got 6");
   EXPECT_THROW(detect_fiducials(cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(0))),
                std::invalid_argument);
   EXPECT_THROW(detect_fiducials(cv::Mat(10, 10, CV_16U, cv::Scalar(0))), std::invalid_argument);

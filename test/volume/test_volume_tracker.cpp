@@ -302,3 +302,37 @@ TEST(VolumeTracker, BadInputThrows) {
 
 }  // namespace
 }  // namespace mocap::volume
+
+namespace mocap::volume {
+namespace {
+
+// Options built in code (a benchmark's, a test's) get the checks the plugin's parameter ranges
+// give a launch file: the tracker refuses them, naming the field by its path.
+TEST(VolumeTrackerOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(VolumeTrackerOptions{}.problem(), std::nullopt);
+  VolumeTrackerOptions options;
+  options.fusion.min_points = 2;
+  EXPECT_EQ(options.problem(), "fusion.min_points: 2; three points at least fix a pose");
+  options = {};
+  options.triangulation.tolerance_px = 0;
+  EXPECT_EQ(options.problem(), "triangulation.tolerance_px: 0 is not above 0");
+  options = {};
+  options.identification.min_markers = 2;
+  EXPECT_EQ(options.problem(), "identification.min_markers: 2; three markers at least fix a body");
+  options = {};
+  options.drift_px = -1;
+  EXPECT_EQ(options.problem(), "drift_px: -1 is not above 0");
+
+  const Sequence sequence;
+  try {
+    VolumeTracker tracker(sequence.cameras(), sequence.bodies, options);
+    ADD_FAILURE() << "negative drift_px accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "VolumeTrackerOptions::drift_px: -1 is not above 0");
+  }
+  EXPECT_THROW(triangulate_markers({}, {.tolerance_px = 1.5, .min_cameras = 1}),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mocap::volume

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 #include <opencv2/core.hpp>
 #include <opencv2/core/hal/intrin.hpp>
 
@@ -63,33 +65,6 @@ constexpr double kThresholdOnlySampling = 3;
 // Regions whose bounding box holds more pixels than this are not outlined when their size
 // alone rules them out as round (see circularity()).
 constexpr int64_t kLargestOutlinedBox = 1 << 16;
-
-void check(bool condition, const std::string& what) {
-  if (!condition) throw std::invalid_argument("FiducialDetectorOptions: " + what);
-}
-
-void validate(const FiducialDetectorOptions& o) {
-  check(o.threshold_ratio >= 0 && o.threshold_ratio <= 1,
-        "threshold_ratio must be in [0, 1], got " + std::to_string(o.threshold_ratio));
-  check(o.min_threshold >= 0 && o.min_threshold <= 255,
-        "min_threshold must be in [0, 255], got " + std::to_string(o.min_threshold));
-  check(o.min_area_px >= 1, "min_area_px must be at least 1, got " + std::to_string(o.min_area_px));
-  check(o.max_area_px >= o.min_area_px, "max_area_px (" + std::to_string(o.max_area_px) +
-                                            ") must be at least min_area_px (" +
-                                            std::to_string(o.min_area_px) + ")");
-  check(o.min_circularity >= 0 && o.min_circularity <= 1,
-        "min_circularity must be in [0, 1], got " + std::to_string(o.min_circularity));
-  check(o.circularity_min_area_px >= 0, "circularity_min_area_px must not be negative");
-  check(o.region_of_interest.width >= 0 && o.region_of_interest.height >= 0,
-        "region_of_interest must not have a negative size");
-  check(o.connectivity == 4 || o.connectivity == 8,
-        "connectivity must be 4 or 8, got " + std::to_string(o.connectivity));
-  check(o.centroid_margin_px >= 0, "centroid_margin_px must not be negative");
-  check(o.centroid_level >= 0 && o.centroid_level <= 1,
-        "centroid_level must be in [0, 1], got " + std::to_string(o.centroid_level));
-  check(o.pixel_noise >= 0, "pixel_noise must not be negative");
-  check(o.sampling_error_px >= 0, "sampling_error_px must not be negative");
-}
 
 // The length and twice the area of the outline where `values` (a patch of `height` rows of
 // `stride`) crosses zero, by marching squares (FiducialDetector::circularity says how).
@@ -152,10 +127,46 @@ Outline outline_of_patch(const float* values, int stride, int patch_height, bool
 
 }  // namespace
 
+std::optional<std::string> FiducialDetectorOptions::problem() const {
+  auto outside = [](double value, double low, double high) {
+    return !(value >= low && value <= high);
+  };
+  if (outside(threshold_ratio, 0, 1)) {
+    return fmt::format("threshold_ratio must be in [0, 1], got {}", threshold_ratio);
+  }
+  if (outside(min_threshold, 0, 255)) {
+    return fmt::format("min_threshold must be in [0, 255], got {}", min_threshold);
+  }
+  if (min_area_px < 1) return fmt::format("min_area_px must be at least 1, got {}", min_area_px);
+  if (max_area_px < min_area_px) {
+    return fmt::format("max_area_px ({}) must be at least min_area_px ({})", max_area_px,
+                       min_area_px);
+  }
+  if (outside(min_circularity, 0, 1)) {
+    return fmt::format("min_circularity must be in [0, 1], got {}", min_circularity);
+  }
+  if (circularity_min_area_px < 0) return "circularity_min_area_px must not be negative";
+  if (region_of_interest.width < 0 || region_of_interest.height < 0) {
+    return "region_of_interest must not have a negative size";
+  }
+  if (connectivity != 4 && connectivity != 8) {
+    return fmt::format("connectivity must be 4 or 8, got {}", connectivity);
+  }
+  if (centroid_margin_px < 0) return "centroid_margin_px must not be negative";
+  if (outside(centroid_level, 0, 1)) {
+    return fmt::format("centroid_level must be in [0, 1], got {}", centroid_level);
+  }
+  if (!(pixel_noise >= 0)) return "pixel_noise must not be negative";
+  if (!(sampling_error_px >= 0)) return "sampling_error_px must not be negative";
+  return std::nullopt;
+}
+
 FiducialDetector::FiducialDetector(FiducialDetectorOptions options) { set_options(options); }
 
 void FiducialDetector::set_options(const FiducialDetectorOptions& options) {
-  validate(options);
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("FiducialDetectorOptions: " + *problem);
+  }
   options_ = options;
 }
 

@@ -16,6 +16,8 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -77,6 +79,10 @@ struct FiducialDetectorOptions {
   // Regions touching the edge of the image (or of the region of interest) are cut off and
   // their centroid pulled inward. false: keep them, flagged touches_border; true: reject.
   bool reject_border_regions = false;
+
+  // Why these options cannot be used, naming the field ("connectivity must be 4 or 8, got 5");
+  // nullopt when they can. FiducialDetector's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct DetectedFiducial {

@@ -81,13 +81,22 @@ std::vector<CameraView> views_near(const std::vector<CameraDetections>& cameras,
   return views;
 }
 
+std::optional<std::string> MultiCameraPoseOptions::problem() const {
+  if (!(max_reprojection_rms_px > 0)) {
+    return fmt::format("max_reprojection_rms_px: {} is not above 0", max_reprojection_rms_px);
+  }
+  if (min_points < 3) {
+    return fmt::format("min_points: {}; three points at least fix a pose", min_points);
+  }
+  if (max_iterations < 1) return fmt::format("max_iterations: {} is below 1", max_iterations);
+  return std::nullopt;
+}
+
 MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
                                            const Eigen::Isometry3d& start,
                                            const MultiCameraPoseOptions& options) {
-  if (options.min_points < 3) {
-    throw std::invalid_argument(
-        fmt::format("MultiCameraPoseOptions::min_points is {}: three points at least fix a pose",
-                    options.min_points));
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("MultiCameraPoseOptions::" + *problem);
   }
   MultiCameraPose result;
   for (const CameraView& view : views) {

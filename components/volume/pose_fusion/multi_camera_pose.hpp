@@ -11,6 +11,7 @@
 // moved into the world frame, or the track's prediction.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct MultiCameraPoseOptions {
   // Fewest points over all views; at least three (fewer throw std::invalid_argument).
   int min_points = 4;
   int max_iterations = 20;
+  // Why these options cannot be used, naming the field ("tolerance_px: 0 is not above 0");
+  // nullopt when they can. The functions that take them throw std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct MultiCameraPose {

@@ -6,6 +6,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include <Eigen/SVD>
 
 namespace mocap::volume {
@@ -137,11 +139,19 @@ double best_fit_rms(const std::vector<Eigen::Vector3d>& from,
   return std::sqrt(sum / static_cast<double>(from.size()));
 }
 
+std::optional<std::string> RigidBodyIdentificationOptions::problem() const {
+  if (!(tolerance > 0)) return fmt::format("tolerance: {} m is not above 0", tolerance);
+  if (min_markers < 3) {
+    return fmt::format("min_markers: {}; three markers at least fix a body", min_markers);
+  }
+  return std::nullopt;
+}
+
 std::vector<IdentifiedBody> identify_rigid_bodies(const RigidBodyDatabase& database,
                                                   const std::vector<Eigen::Vector3d>& markers,
                                                   const RigidBodyIdentificationOptions& options) {
-  if (options.min_markers < 3) {
-    throw std::invalid_argument("RigidBodyIdentificationOptions::min_markers must be 3 or more");
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("RigidBodyIdentificationOptions::" + *problem);
   }
   // Larger bodies first: a smaller one must not take markers of a larger one.
   std::vector<size_t> order(database.bodies.size());

@@ -9,6 +9,7 @@
 // marker belongs to one body.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct RigidBodyIdentificationOptions {
   double tolerance = 0.004;
   // Fewest of a body's markers that identify it (at least 3, which fix a pose).
   int min_markers = 3;
+  // Why these options cannot be used, naming the field ("tolerance_px: 0 is not above 0");
+  // nullopt when they can. The functions that take them throw std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct IdentifiedBody {

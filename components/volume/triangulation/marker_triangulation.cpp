@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include <Eigen/Cholesky>
 
 namespace mocap::volume {
@@ -108,10 +110,16 @@ std::optional<Eigen::Vector3d> triangulate_point(const std::vector<CameraDetecti
   return point;
 }
 
+std::optional<std::string> MarkerTriangulationOptions::problem() const {
+  if (!(tolerance_px > 0)) return fmt::format("tolerance_px: {} is not above 0", tolerance_px);
+  if (min_cameras < 2) return fmt::format("min_cameras: {}; two cameras at least", min_cameras);
+  return std::nullopt;
+}
+
 std::vector<TriangulatedMarker> triangulate_markers(const std::vector<CameraDetections>& cameras,
                                                     const MarkerTriangulationOptions& options) {
-  if (options.min_cameras < 2) {
-    throw std::invalid_argument("MarkerTriangulationOptions::min_cameras must be 2 or more");
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("MarkerTriangulationOptions::" + *problem);
   }
   std::vector<std::vector<bool>> none_used;
   for (const CameraDetections& camera : cameras) none_used.emplace_back(camera.pixels.size());

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct MarkerTriangulationOptions {
   double tolerance_px = 1.5;
   // Fewest cameras that must see a marker (at least 2).
   int min_cameras = 2;
+  // Why these options cannot be used, naming the field ("tolerance_px: 0 is not above 0");
+  // nullopt when they can. The functions that take them throw std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct TriangulatedMarker {

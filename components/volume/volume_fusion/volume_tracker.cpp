@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <fmt/format.h>
+
 namespace mocap::volume {
 namespace {
 
@@ -159,6 +161,17 @@ Eigen::Isometry3d predicted(const Eigen::Isometry3d& world_from_body, const Eige
 
 }  // namespace
 
+std::optional<std::string> VolumeTrackerOptions::problem() const {
+  if (auto problem = triangulation.problem()) return "triangulation." + *problem;
+  if (auto problem = identification.problem()) return "identification." + *problem;
+  if (auto problem = fusion.problem()) return "fusion." + *problem;
+  if (!(match_radius_px > 0))
+    return fmt::format("match_radius_px: {} is not above 0", match_radius_px);
+  if (!(lost_after_s >= 0)) return fmt::format("lost_after_s: {} is below 0", lost_after_s);
+  if (!(drift_px > 0)) return fmt::format("drift_px: {} is not above 0", drift_px);
+  return std::nullopt;
+}
+
 VolumeTracker::VolumeTracker(std::vector<VolumeCamera> cameras, RigidBodyDatabase bodies,
                              VolumeTrackerOptions options)
     : cameras_(std::move(cameras)),
@@ -170,10 +183,8 @@ VolumeTracker::VolumeTracker(std::vector<VolumeCamera> cameras, RigidBodyDatabas
   for (const VolumeCamera& camera : cameras_) {
     if (!camera.model) throw std::invalid_argument("camera '" + camera.name + "' has no model");
   }
-  if (!(options_.match_radius_px > 0) || !(options_.lost_after_s >= 0) ||
-      !(options_.drift_px > 0)) {
-    throw std::invalid_argument(
-        "match_radius_px and drift_px must be above 0, lost_after_s not below 0");
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("VolumeTrackerOptions::" + *problem);
   }
 }
 

@@ -56,6 +56,11 @@ struct VolumeTrackerOptions {
   // A camera whose average residual (each view's median pixel error) against the others' fused
   // poses exceeds this (pixels) has moved.
   double drift_px = 2.0;
+
+  // Why these options cannot be used, naming the field (nested ones by their path:
+  // "fusion.min_points: ..."); nullopt when they can. The tracker's constructor throws
+  // std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // One frame's detections of one camera.
