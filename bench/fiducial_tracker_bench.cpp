@@ -24,7 +24,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include "sim/synthetic_ir_camera/scene.hpp"
 #include "tracking/constellation_identifier/constellation_identifier.hpp"
 #include "tracking/constellation_tracker/constellation_tracker.hpp"
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 #include "tracking/pose_estimator/planar_pose.hpp"
 
 namespace mocap::bench {

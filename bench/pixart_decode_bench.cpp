@@ -13,7 +13,7 @@
 
 #include "common/can_io/candump_log.hpp"
 #include "common/can_io/slcan.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 
 #include <fmt/format.h>
 
-#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_localizer/pixart_localizer.hpp"
 #include "pixart/pixart_rig/pixart_rig.hpp"
 #include "sim/pixart_box_sim/pixart_box_simulator.hpp"
 #include "sim/pixart_box_sim/pixart_scene.hpp"

@@ -14,7 +14,7 @@
 #include "bench/offline_pipeline.hpp"
 #include "sim/synthetic_ir_camera/ir_renderer.hpp"
 #include "tracking/constellation_tracker/constellation_tracker.hpp"
-#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/pose_evaluator/pose_evaluator.hpp"
 #include "tracking/pose_evaluator/sequence_evaluation.hpp"
 
 namespace {

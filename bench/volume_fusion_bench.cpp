@@ -1,7 +1,7 @@
 // The fusion's cost: 4 cameras x 8 bodies a frame, one thread, each body's pose fused over
 // every view from a start a track would give (the last pose, 5 mm and 1 degree off), beside
 // the single-camera pose (IPPE and refinement) of the same views in the same run; then the
-// whole frame as the volume_fusion component runs it (volume_tracker.hpp), from each camera's
+// whole frame as the volume_fusion component runs it (volume_fusion.hpp), from each camera's
 // unlabelled detections: 8 bodies of 6 markers moving through the volume at 120 Hz, tracked,
 // and identified afresh from triangulated markers in every frame (no tracks).
 //
@@ -18,9 +18,9 @@
 
 #include "test/volume/synthetic_volume.hpp"
 #include "tracking/pose_estimator/planar_pose.hpp"
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
-#include "volume/volume_fusion/volume_tracker.hpp"
+#include "volume/volume_fusion/volume_fusion.hpp"
 
 namespace {
 

@@ -27,8 +27,8 @@
 
 #include <fmt/format.h>
 
-#include "outputs/vrpn_server/tracker_server.hpp"
 #include "outputs/vrpn_server/vrpn_protocol.hpp"
+#include "outputs/vrpn_server/vrpn_server.hpp"
 
 using namespace mocap::vrpn;
 using Clock = std::chrono::steady_clock;

@@ -16,7 +16,7 @@
 
 #include "common/can_io/socketcan.hpp"
 #include "pixart/pixart_bridge/camera_samples.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace {
 

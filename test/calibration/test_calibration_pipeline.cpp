@@ -33,7 +33,7 @@
 #include <mocap/calibration/calibration_config.hpp>
 #include <mocap/calibration/pinhole_camera.hpp>
 
-#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_localizer/pixart_localizer.hpp"
 #include "pixart/pixart_rig/pixart_rig.hpp"
 #include "sim/pixart_box_sim/candump_recording.hpp"
 #include "sim/pixart_box_sim/pixart_box_simulator.hpp"

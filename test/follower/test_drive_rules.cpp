@@ -17,7 +17,7 @@
 #include "follower/drive_follower/drive_rules.hpp"
 #include "follower/drive_follower/object_in_base.hpp"
 #include "follower/turret_kinematics/turret_model.hpp"
-#include "sim/mobile_base_sim/unicycle_base.hpp"
+#include "sim/mobile_base_sim/mobile_base_sim.hpp"
 #include "test/test_support.hpp"
 
 namespace mocap::drive {

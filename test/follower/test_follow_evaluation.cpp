@@ -1,11 +1,11 @@
-// The follower demo's figures (components/follower/follower_monitor/follow_evaluation.hpp) on
+// The follower demo's figures (components/follower/follower_monitor/follower_monitor.hpp) on
 // scripted truth: pointing error, distance kept once the object has stood for settle_s, stop
 // latency.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "follower/follower_monitor/follow_evaluation.hpp"
+#include "follower/follower_monitor/follower_monitor.hpp"
 
 namespace mocap::evaluation {
 namespace {

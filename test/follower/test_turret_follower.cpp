@@ -19,8 +19,8 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <sensor_msgs/msg/joint_state.hpp>
 
+#include "follower/dynamixel_follower/dynamixel_follower.hpp"
 #include "follower/dynamixel_follower/servo_mapping.hpp"
-#include "follower/dynamixel_follower/turret_follower.hpp"
 #include "follower/turret_kinematics/joint_history.hpp"
 #include "follower/turret_kinematics/turret_model.hpp"
 #include "host/plugin_loader.hpp"

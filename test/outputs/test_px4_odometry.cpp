@@ -20,7 +20,7 @@
 #include "common/pose_message/pose_message.hpp"
 #include "host/plugin_loader.hpp"
 #include "outputs/body_frames/body_frames.hpp"
-#include "outputs/px4_odometry/px4_frames.hpp"
+#include "outputs/px4_odometry/px4_odometry.hpp"
 #include "test/outputs/pose_feeder.hpp"
 #include "test/test_support.hpp"
 

@@ -22,8 +22,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "outputs/vrpn_server/tracker_server.hpp"
 #include "outputs/vrpn_server/vrpn_protocol.hpp"
+#include "outputs/vrpn_server/vrpn_server.hpp"
 #include "test/test_support.hpp"
 
 namespace mocap::vrpn {

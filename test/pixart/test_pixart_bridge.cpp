@@ -15,7 +15,7 @@
 #include "common/can_io/slcan.hpp"
 #include "common/serial_io/serial_port.hpp"
 #include "host/plugin_loader.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 #include "test/test_support.hpp"
 
 namespace mocap::pixart {

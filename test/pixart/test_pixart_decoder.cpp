@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "pixart/pixart_bridge/camera_samples.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace mocap::pixart {
 namespace {

@@ -24,9 +24,9 @@
 #include "host/plugin_loader.hpp"
 #include "pixart/pixart_localizer/camera_views.hpp"
 #include "pixart/pixart_localizer/led_plane_points.hpp"
+#include "pixart/pixart_localizer/pixart_localizer.hpp"
 #include "pixart/pixart_localizer/planar_fit.hpp"
 #include "pixart/pixart_localizer/point_merging.hpp"
-#include "pixart/pixart_localizer/robot_localizer.hpp"
 #include "pixart/pixart_rig/pixart_rig.hpp"
 #include "test/test_support.hpp"
 

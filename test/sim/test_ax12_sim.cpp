@@ -10,7 +10,7 @@
 
 #include "follower/dynamixel/ax12_control_table.hpp"
 #include "follower/dynamixel/protocol.hpp"
-#include "sim/ax12_sim/simulated_ax12_chain.hpp"
+#include "sim/ax12_sim/ax12_sim.hpp"
 
 namespace mocap::dynamixel {
 namespace {

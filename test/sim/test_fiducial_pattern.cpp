@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "sim/fiducial_pattern_source/fiducial_pattern.hpp"
+#include "sim/fiducial_pattern_source/fiducial_pattern_source.hpp"
 
 namespace mocap::demo {
 namespace {

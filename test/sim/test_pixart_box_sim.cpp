@@ -20,7 +20,7 @@
 #include "common/can_io/slcan.hpp"
 #include "common/serial_io/serial_port.hpp"
 #include "host/plugin_loader.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 #include "pixart/pixart_rig/pixart_rig.hpp"
 #include "sim/pixart_box_sim/candump_recording.hpp"
 #include "sim/pixart_box_sim/floor_trajectory.hpp"

@@ -12,7 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "test/test_support.hpp"
-#include "tracking/camera_source/frame_source.hpp"
+#include "tracking/camera_source/camera_source.hpp"
 
 namespace mocap::capture {
 namespace {

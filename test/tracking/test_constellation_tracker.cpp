@@ -20,8 +20,8 @@
 #include "tracking/constellation_tracker/marker_association.hpp"
 #include "tracking/constellation_tracker/marker_visibility.hpp"
 #include "tracking/constellation_tracker/min_cost_assignment.hpp"
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
-#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
+#include "tracking/pose_evaluator/pose_evaluator.hpp"
 #include "tracking/pose_evaluator/sequence_evaluation.hpp"
 
 namespace mocap::tracking {

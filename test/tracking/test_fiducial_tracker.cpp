@@ -23,7 +23,7 @@
 
 #include "common/image_message/image_message.hpp"
 #include "test/test_support.hpp"
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 
 namespace mocap::tracking {
 namespace {

@@ -6,8 +6,8 @@
 #include <mocap/calibration/pinhole_camera.hpp>
 #include <opencv2/core.hpp>
 
-#include "tracking/overlay/overlay_drawing.hpp"
-#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/overlay/overlay.hpp"
+#include "tracking/pose_evaluator/pose_evaluator.hpp"
 
 namespace mocap {
 namespace {

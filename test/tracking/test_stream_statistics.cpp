@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "tracking/fiducial_monitor/stream_statistics.hpp"
+#include "tracking/fiducial_monitor/fiducial_monitor.hpp"
 
 namespace mocap::demo {
 namespace {

@@ -23,7 +23,7 @@
 #include "sim/synthetic_ir_camera/scene.hpp"
 #include "test/volume/rendered_volume.hpp"
 #include "tracking/constellation_database/constellation_database.hpp"
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 #include "volume/volume_calibration/volume_calibration.hpp"
 
 namespace mocap::volume::test {

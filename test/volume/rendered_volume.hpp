@@ -24,10 +24,10 @@
 #include "sim/synthetic_ir_camera/ir_renderer.hpp"
 #include "sim/synthetic_ir_camera/scene.hpp"
 #include "tracking/constellation_database/constellation_database.hpp"
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 #include "tracking/pose_estimator/planar_pose.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
-#include "volume/volume_fusion/volume_tracker.hpp"
+#include "volume/volume_fusion/volume_fusion.hpp"
 
 namespace mocap::volume::test {
 

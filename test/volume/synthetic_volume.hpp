@@ -10,7 +10,7 @@
 
 #include <mocap/calibration/camera_factory.hpp>
 
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 
 namespace mocap::volume::test {
 

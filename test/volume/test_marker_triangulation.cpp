@@ -1,4 +1,4 @@
-// Markers in 3D from a volume's cameras without labels (marker_triangulation.hpp), and bodies
+// Markers in 3D from a volume's cameras without labels (triangulation.hpp), and bodies
 // found from them (rigid_body_identification.hpp) when no camera sees a whole body.
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "test/volume/synthetic_volume.hpp"
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 #include "volume/rigid_bodies/rigid_body_identification.hpp"
-#include "volume/triangulation/marker_triangulation.hpp"
+#include "volume/triangulation/triangulation.hpp"
 
 namespace mocap::volume {
 namespace {

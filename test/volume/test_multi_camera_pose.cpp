@@ -1,4 +1,4 @@
-// The pose of a body seen by a volume of fixed cameras (multi_camera_pose.hpp): on the same
+// The pose of a body seen by a volume of fixed cameras (pose_fusion.hpp): on the same
 // frames, against each camera's own pose of it (planar_pose.hpp), with pixel noise; a body that
 // only one camera sees; a camera whose extrinsics have moved.
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 
 #include "test/volume/synthetic_volume.hpp"
 #include "tracking/pose_estimator/planar_pose.hpp"
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 
 namespace mocap::volume {
 namespace {

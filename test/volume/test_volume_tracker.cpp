@@ -1,4 +1,4 @@
-// The volume's frame-by-frame tracker (volume_tracker.hpp) on a synthetic volume: two rigid
+// The volume's frame-by-frame tracker (volume_fusion.hpp) on a synthetic volume: two rigid
 // bodies of no particular shape moving through it, seen through occluders, with a camera that
 // stops, a camera that is bumped, and bodies that only one camera keeps seeing.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 
 #include "test/volume/synthetic_volume.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
-#include "volume/volume_fusion/volume_tracker.hpp"
+#include "volume/volume_fusion/volume_fusion.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -24,7 +24,7 @@
 #include "common/can_io/can_source.hpp"
 #include "common/can_io/slcan.hpp"
 #include "pixart/pixart_bridge/camera_samples.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // dynamixel_follower: the pan/tilt turret of seed 000 §5.11 on two AX-12A servos. It keeps the
-// tracked constellation on the camera's optical axis (turret_follower.hpp) and drives the
+// tracked constellation on the camera's optical axis (dynamixel_follower.hpp) and drives the
 // servos over a Dynamixel Protocol 1.0 bus (dynamixel_bus.hpp) on a worker the host runs, each
 // cycle:
 //
@@ -28,8 +28,8 @@
 #include "common/topics/graph_topics.hpp"
 #include "follower/dynamixel/ax12_control_table.hpp"
 #include "follower/dynamixel/dynamixel_bus.hpp"
+#include "follower/dynamixel_follower/dynamixel_follower.hpp"
 #include "follower/dynamixel_follower/servo_mapping.hpp"
-#include "follower/dynamixel_follower/turret_follower.hpp"
 #include "follower/turret_kinematics/joint_history.hpp"
 #include "follower/turret_kinematics/turret_model.hpp"
 

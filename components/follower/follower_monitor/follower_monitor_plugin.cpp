@@ -1,4 +1,4 @@
-// follower_monitor: the follower demo's live summary and final figures (follow_evaluation.hpp)
+// follower_monitor: the follower demo's live summary and final figures (follower_monitor.hpp)
 // from the simulation's ground truth: pointing error of the turret, distance the base keeps,
 // time from a lost track to a stopped base, and the rates of the loops.
 #include <chrono>
@@ -18,7 +18,7 @@
 
 #include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
-#include "follower/follower_monitor/follow_evaluation.hpp"
+#include "follower/follower_monitor/follower_monitor.hpp"
 
 namespace mocap::evaluation {
 namespace {

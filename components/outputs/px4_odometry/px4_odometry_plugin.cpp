@@ -1,7 +1,7 @@
 // px4_odometry: one tracked board, carried by a PX4 vehicle, as px4_msgs/VehicleOdometry on
 // /fmu/in/vehicle_visual_odometry, the topic PX4's uXRCE-DDS agent forwards to the flight
 // controller's external-vision input (remap it to /fmu/in/vehicle_mocap_odometry for PX4's
-// motion-capture input). Frames converted to PX4's (px4_frames.hpp); rate kept by the poses'
+// motion-capture input). Frames converted to PX4's (px4_odometry.hpp); rate kept by the poses'
 // capture stamps.
 #include <chrono>
 #include <cmath>
@@ -20,7 +20,7 @@
 #include "common/topics/graph_topics.hpp"
 #include "outputs/body_frames/body_state_message.hpp"
 #include "outputs/body_frames/stamp_rate.hpp"
-#include "outputs/px4_odometry/px4_frames.hpp"
+#include "outputs/px4_odometry/px4_odometry.hpp"
 
 namespace mocap::outputs {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "common/topics/graph_topics.hpp"
 #include "outputs/body_frames/body_state_message.hpp"
-#include "outputs/vrpn_server/tracker_server.hpp"
+#include "outputs/vrpn_server/vrpn_server.hpp"
 
 namespace mocap::vrpn {
 namespace {

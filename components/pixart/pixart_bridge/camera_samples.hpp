@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace mocap::pixart {
 

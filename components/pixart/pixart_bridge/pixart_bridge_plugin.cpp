@@ -1,4 +1,4 @@
-// pixart_bridge: PixArt points from a CAN bus (can_source.hpp, pixart_decoder.hpp), published
+// pixart_bridge: PixArt points from a CAN bus (can_source.hpp, pixart_bridge.hpp), published
 // raw and as one FiducialArray per camera sample, so that downstream components treat each
 // PixArt sensor like any camera.
 #include <chrono>
@@ -12,7 +12,7 @@
 #include "common/can_io/can_source.hpp"
 #include "common/topics/graph_topics.hpp"
 #include "pixart/pixart_bridge/camera_samples.hpp"
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace mocap::pixart {
 namespace {

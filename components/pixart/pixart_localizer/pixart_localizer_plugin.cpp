@@ -1,5 +1,5 @@
 // pixart_localizer: every PixArt camera's fiducial arrays -> robot poses x, y, θ in the world
-// frame (robot_localizer.hpp), published at a steady rate whether the robots move or not.
+// frame (pixart_localizer.hpp), published at a steady rate whether the robots move or not.
 //
 // publish_rate_hz: 0 publishes after every sample used instead, for consumers that want each
 // sample's result at once (a timer adds up to one period of latency, 20 ms at the default
@@ -21,7 +21,7 @@
 
 #include "common/topics/graph_topics.hpp"
 #include "pixart/pixart_localizer/led_plane_points.hpp"
-#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_localizer/pixart_localizer.hpp"
 #include "pixart/pixart_rig/pixart_rig.hpp"
 
 namespace mocap::pixart::localization {

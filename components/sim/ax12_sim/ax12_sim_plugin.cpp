@@ -1,4 +1,4 @@
-// ax12_sim: a chain of simulated AX-12A servos (simulated_ax12_chain.hpp) behind a USB
+// ax12_sim: a chain of simulated AX-12A servos (ax12_sim.hpp) behind a USB
 // adaptor, played on a pseudo-terminal, the embedded default when no servos are attached.
 // The driver opens the pseudo-terminal (or the device_link to it) like a USB2Dynamixel and
 // speaks Protocol 1.0 to it, so the real driver code path runs.
@@ -20,7 +20,7 @@
 #include "common/serial_io/device_link.hpp"
 #include "common/serial_io/serial_port.hpp"
 #include "follower/dynamixel/ax12_control_table.hpp"
-#include "sim/ax12_sim/simulated_ax12_chain.hpp"
+#include "sim/ax12_sim/ax12_sim.hpp"
 
 namespace mocap::dynamixel {
 namespace {

@@ -1,4 +1,5 @@
-// fiducial_pattern_source: publishes a synthetic FiducialArray stream (fiducial_pattern.hpp).
+// fiducial_pattern_source: publishes a synthetic FiducialArray stream
+// (fiducial_pattern_source.hpp).
 #include <chrono>
 
 #include <mocap/component.hpp>
@@ -6,7 +7,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 #include "common/topics/graph_topics.hpp"
-#include "sim/fiducial_pattern_source/fiducial_pattern.hpp"
+#include "sim/fiducial_pattern_source/fiducial_pattern_source.hpp"
 
 namespace mocap::demo {
 namespace {

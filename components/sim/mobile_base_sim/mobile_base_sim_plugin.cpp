@@ -1,4 +1,4 @@
-// mobile_base_sim: a simulated two-wheeled base (unicycle_base.hpp) driven by /cmd_vel,
+// mobile_base_sim: a simulated two-wheeled base (mobile_base_sim.hpp) driven by /cmd_vel,
 // carrying the pan/tilt turret; publishes where the base is and where the turret's camera is,
 // for the drive follower's closed loop and for a synthetic camera that renders from the
 // moving camera (synthetic_ir_camera's moving_camera).
@@ -23,7 +23,7 @@
 #include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
 #include "follower/turret_kinematics/turret_model.hpp"
-#include "sim/mobile_base_sim/unicycle_base.hpp"
+#include "sim/mobile_base_sim/mobile_base_sim.hpp"
 
 namespace mocap::sim {
 namespace {

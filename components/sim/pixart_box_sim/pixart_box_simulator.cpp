@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 namespace mocap::pixart {
 

@@ -1,5 +1,5 @@
 // camera_source: publishes mono8 images from a V4L2 camera, a video file or a directory of
-// images (frame_source.hpp).
+// images (camera_source.hpp).
 //
 // Frames are read on a thread of the component's own, so a device's blocking grab never holds
 // the executor. Recorded input is paced at rate_hz and, by default, waits for its first
@@ -17,7 +17,7 @@
 
 #include "common/image_message/image_message.hpp"
 #include "common/topics/graph_topics.hpp"
-#include "tracking/camera_source/frame_source.hpp"
+#include "tracking/camera_source/camera_source.hpp"
 
 namespace mocap::capture {
 namespace {

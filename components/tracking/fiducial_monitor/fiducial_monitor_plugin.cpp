@@ -6,7 +6,7 @@
 #include <mocap_msgs/msg/fiducial_array.hpp>
 
 #include "common/topics/graph_topics.hpp"
-#include "tracking/fiducial_monitor/stream_statistics.hpp"
+#include "tracking/fiducial_monitor/fiducial_monitor.hpp"
 
 namespace mocap::demo {
 namespace {

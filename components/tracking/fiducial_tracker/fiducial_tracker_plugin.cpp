@@ -1,4 +1,4 @@
-// fiducial_tracker: finds fiducials in camera images (fiducial_detector.hpp) and publishes
+// fiducial_tracker: finds fiducials in camera images (fiducial_tracker.hpp) and publishes
 // them, one FiducialArray per image, stamped and framed as the image was.
 #include <chrono>
 #include <cstdint>
@@ -12,7 +12,7 @@
 
 #include "common/image_message/image_message.hpp"
 #include "common/topics/graph_topics.hpp"
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 
 namespace mocap::tracking {
 namespace {

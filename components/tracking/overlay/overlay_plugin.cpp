@@ -1,5 +1,5 @@
 // overlay: draws fiducials, identified lines and pose axes on the camera image, publishes the
-// picture and saves PNG snapshots (overlay_drawing.hpp).
+// picture and saves PNG snapshots (overlay.hpp).
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -16,7 +16,7 @@
 #include "common/image_message/image_message.hpp"
 #include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
-#include "tracking/overlay/overlay_drawing.hpp"
+#include "tracking/overlay/overlay.hpp"
 #include "tracking/overlay/png_file.hpp"
 
 namespace mocap::overlay {

@@ -1,5 +1,5 @@
 // Levenberg–Marquardt over a rigid pose, for any pixel residuals: one camera's view of a board
-// (planar_pose.hpp) or every view of a body in a volume of cameras (multi_camera_pose.hpp).
+// (planar_pose.hpp) or every view of a body in a volume of cameras (pose_fusion.hpp).
 // The Jacobian is numeric, as camera models are opaque.
 #pragma once
 

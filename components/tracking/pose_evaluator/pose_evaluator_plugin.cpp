@@ -1,5 +1,5 @@
 // pose_evaluator: compares /mocap/poses with the synthetic camera's ground truth and prints
-// a live summary line and a final table (pose_evaluation.hpp).
+// a live summary line and a final table (pose_evaluator.hpp).
 #include <chrono>
 #include <fstream>
 #include <optional>
@@ -10,7 +10,7 @@
 
 #include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
-#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/pose_evaluator/pose_evaluator.hpp"
 
 namespace mocap::evaluation {
 namespace {

@@ -11,7 +11,7 @@
 #include <mocap/calibration/floor_frame.hpp>
 
 #include "tracking/pose_estimator/planar_pose.hpp"
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -1,5 +1,5 @@
 // volume_fusion: a volume's fixed cameras' fiducials -> one world pose per rigid body
-// (volume_tracker.hpp), published on /mocap/poses in frame 'world' for each capture time.
+// (volume_fusion.hpp), published on /mocap/poses in frame 'world' for each capture time.
 //
 // Each camera's fiducials come on its own topic (/volume/{camera}/fiducials, the name in its
 // camera file), stamped at capture. The messages of one capture time are gathered
@@ -29,7 +29,7 @@
 #include "common/topics/graph_topics.hpp"
 #include "volume/frame_assembly/frame_assembler.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
-#include "volume/volume_fusion/volume_tracker.hpp"
+#include "volume/volume_fusion/volume_fusion.hpp"
 
 namespace mocap::volume {
 namespace {

@@ -1,4 +1,4 @@
-#include "volume/triangulation/marker_triangulation.hpp"
+#include "volume/triangulation/triangulation.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "outputs/vrpn_server/tracker_server.hpp"
+#include "outputs/vrpn_server/vrpn_server.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "outputs/px4_odometry/px4_frames.hpp"
+#include "outputs/px4_odometry/px4_odometry.hpp"
 
 namespace mocap::outputs {
 namespace {

@@ -99,7 +99,7 @@ struct DetectedFiducial {
   double y = 0;
   double area_px = 0;  // pixels above the threshold
   // 4πA/P² of the sub-pixel outline where the image crosses the threshold (marching squares,
-  // fiducial_detector.cpp): 1 for a perfect disc, 0.95-1 for imaged ones of radius 2 px or
+  // fiducial_tracker.cpp): 1 for a perfect disc, 0.95-1 for imaged ones of radius 2 px or
   // more, π/4 for a lone pixel, lower the longer and rougher a blob is.
   double circularity = 0;
   double peak = 0;  // brightest pixel, grey levels

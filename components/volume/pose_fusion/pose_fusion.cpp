@@ -1,4 +1,4 @@
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "sim/fiducial_pattern_source/fiducial_pattern.hpp"
+#include "sim/fiducial_pattern_source/fiducial_pattern_source.hpp"
 
 #include <cmath>
 #include <numbers>

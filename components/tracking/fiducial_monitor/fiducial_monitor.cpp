@@ -1,4 +1,4 @@
-#include "tracking/fiducial_monitor/stream_statistics.hpp"
+#include "tracking/fiducial_monitor/fiducial_monitor.hpp"
 
 #include <algorithm>
 #include <cmath>

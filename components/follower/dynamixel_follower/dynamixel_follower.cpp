@@ -1,4 +1,4 @@
-#include "follower/dynamixel_follower/turret_follower.hpp"
+#include "follower/dynamixel_follower/dynamixel_follower.hpp"
 
 #include <algorithm>
 #include <cmath>

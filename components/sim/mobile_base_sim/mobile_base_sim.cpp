@@ -1,4 +1,4 @@
-#include "sim/mobile_base_sim/unicycle_base.hpp"
+#include "sim/mobile_base_sim/mobile_base_sim.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "tracking/camera_source/frame_source.hpp"
+#include "tracking/camera_source/camera_source.hpp"
 
 #include <algorithm>
 #include <cctype>

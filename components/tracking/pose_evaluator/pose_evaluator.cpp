@@ -1,4 +1,4 @@
-#include "tracking/pose_evaluator/pose_evaluation.hpp"
+#include "tracking/pose_evaluator/pose_evaluator.hpp"
 
 #include <algorithm>
 #include <cmath>

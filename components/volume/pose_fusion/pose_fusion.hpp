@@ -20,7 +20,7 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "volume/triangulation/marker_triangulation.hpp"
+#include "volume/triangulation/triangulation.hpp"
 
 namespace mocap::volume {
 

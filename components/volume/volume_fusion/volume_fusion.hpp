@@ -28,10 +28,10 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
-#include "volume/pose_fusion/multi_camera_pose.hpp"
+#include "volume/pose_fusion/pose_fusion.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
 #include "volume/rigid_bodies/rigid_body_identification.hpp"
-#include "volume/triangulation/marker_triangulation.hpp"
+#include "volume/triangulation/triangulation.hpp"
 
 namespace mocap::volume {
 

@@ -1,4 +1,4 @@
-#include "tracking/overlay/overlay_drawing.hpp"
+#include "tracking/overlay/overlay.hpp"
 
 #include <opencv2/imgproc.hpp>
 

@@ -1,4 +1,4 @@
-#include "volume/volume_fusion/volume_tracker.hpp"
+#include "volume/volume_fusion/volume_fusion.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "tracking/fiducial_tracker/fiducial_detector.hpp"
+#include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "follower/follower_monitor/follow_evaluation.hpp"
+#include "follower/follower_monitor/follower_monitor.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pixart/pixart_bridge/pixart_decoder.hpp"
+#include "pixart/pixart_bridge/pixart_bridge.hpp"
 
 #include <stdexcept>
 #include <string>

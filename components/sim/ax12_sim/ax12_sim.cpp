@@ -1,4 +1,4 @@
-#include "sim/ax12_sim/simulated_ax12_chain.hpp"
+#include "sim/ax12_sim/ax12_sim.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pixart/pixart_localizer/robot_localizer.hpp"
+#include "pixart/pixart_localizer/pixart_localizer.hpp"
 
 #include <cmath>
 #include <stdexcept>
