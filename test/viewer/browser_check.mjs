@@ -97,7 +97,7 @@ try {
     await page.waitForTimeout(1000);
     const floor = await state(page);
     check(true, `floor: ${floor.footprintsDrawn} footprints, ${floor.robotsDrawn} robots`);
-    check(/no \/camera\/ir\/image_raw/.test(await page.textContent("#camera-note")), "the page says there is no camera");
+    check(/no sensor_msgs\/msg\/Image/.test(await page.textContent("#camera-note")), "the page says there is no camera");
     await page.screenshot({ path: screenshot, fullPage: true });
     check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
     await browser.close();

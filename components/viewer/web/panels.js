@@ -1,0 +1,96 @@
+// The page's text, from the viewer's state (state.js): the connection's status and the rates
+// in the header, which panels the graph fills and the topics they show, the poses' table, the
+// alerts, the turret's angles and every topic with its rate and bandwidth.
+import { rollPitchYaw } from "./geometry.js";
+import { graph, report, stampSeconds } from "./state.js";
+import { TYPES } from "./topics.js";
+
+const $ = (id) => document.getElementById(id);
+const statusLine = $("status");
+const degrees = (radians) => ((radians * 180) / Math.PI).toFixed(1);
+
+export function connected(url) {
+  statusLine.textContent = `connected to ${url}`;
+  statusLine.className = "connected";
+}
+
+export function disconnected(url, wasConnected) {
+  statusLine.textContent = `disconnected: no bridge at ${url}${wasConnected ? " (it went away)" : ""}; retrying every 2 s`;
+  statusLine.className = "disconnected";
+}
+
+// Image topics in one line, as "/volume/<camera>/image_raw" when they differ in one name.
+function pattern(topics) {
+  const names = topics.map((t) => t.split("/"));
+  if (names.some((n) => n.length !== names[0].length)) return topics.join(", ");
+  return names[0].map((name, i) => (names.every((n) => n[i] === name) ? name : "<camera>")).join("/");
+}
+
+// Which panels this graph fills: a single camera's, or a volume's cameras side by side.
+export function layout(channels) {
+  const cameras = [...graph.cameras.keys()];
+  const volume = cameras.length > 1;
+  const advertised = [...channels.values()];
+  const types = new Set(advertised.map((c) => c.schemaName));
+  $("camera-topic").textContent = cameras.length === 1 ? cameras[0] : "";
+  $("camera-note").textContent = cameras.length ? "" : `no ${TYPES.image} in this graph`;
+  $("volume").hidden = !volume;
+  if (volume) $("volume-topics").textContent = `${pattern(cameras)} with their fiducials`;
+  // A volume alone: the single camera's panels (its image, its top view, the floor) stay empty.
+  $("camera-section").hidden = volume;
+  $("side-section").hidden = volume && !types.has(TYPES.robots) && !types.has(TYPES.footprints);
+  const alertTopics = advertised.filter((c) => c.schemaName === TYPES.alert).map((c) => c.topic);
+  $("alerts-topic").textContent = alertTopics.sort().join(", ");
+}
+
+export function poses() {
+  const rows = [...graph.poses.values()].flatMap((message) => message.poses).map((pose) => {
+    const p = pose.pose.pose.position;
+    const [roll, pitch, yaw] = rollPitchYaw(pose.pose.pose.orientation).map(degrees);
+    // Speed and turn rate from the track (zero with a large covariance when just found).
+    const v = pose.velocity ? pose.velocity.linear : { x: 0, y: 0, z: 0 };
+    const w = pose.velocity ? pose.velocity.angular : { x: 0, y: 0, z: 0 };
+    const speed = Math.hypot(v.x, v.y, v.z).toFixed(2);
+    const turn = ((Math.hypot(w.x, w.y, w.z) * 180) / Math.PI).toFixed(0);
+    return `<tr><td>${pose.name}</td><td>${p.x.toFixed(3)}</td><td>${p.y.toFixed(3)}</td>
+      <td>${p.z.toFixed(3)}</td><td>${roll}</td><td>${pitch}</td><td>${yaw}</td>
+      <td>${speed}</td><td>${turn}</td>
+      <td>${pose.points_used}</td><td>${pose.reprojection_rms_px.toFixed(2)}</td>
+      <td>${pose.cameras_used || ""}</td></tr>`;
+  });
+  $("poses-topic").textContent = [...graph.poses.keys()].join(", ");
+  const html = rows.join("") || `<tr><td colspan="12" class="note">no constellation identified</td></tr>`;
+  $("poses").tBodies[0].innerHTML = html;
+  report.poseReadout = $("poses").tBodies[0].textContent;
+}
+
+export function alerts() {
+  const level = (l) => (l >= 2 ? "error" : "warning");
+  $("alerts").innerHTML = graph.alerts
+    .map((a) => `<li class="${level(a.level)}">${new Date(stampSeconds(a.header) * 1000).toLocaleTimeString()} ${a.source}: ${a.text}</li>`)
+    .join("");
+}
+
+export function turret() {
+  if (graph.turret) $("turret").textContent = `turret: pan ${degrees(graph.turret.pan)}°, tilt ${degrees(graph.turret.tilt)}°`;
+}
+
+export function topics() {
+  const rows = [...graph.topics.entries()].sort().map(([name, t]) =>
+    `<tr><td>${name}</td><td>${t.type}</td><td>${t.rate === null ? "—" : t.rate.toFixed(1)}</td>
+      <td>${t.bandwidth === null ? "—" : (t.bandwidth / 1000).toFixed(1)}</td></tr>`);
+  $("topics").tBodies[0].innerHTML = rows.join("");
+}
+
+// The cameras' and the estimated poses' rates and the poses' latency, in the header.
+export function rates() {
+  const rate = (topic) => graph.topics.get(topic)?.rate ?? 0;
+  const cameras = [...graph.cameras.keys()].map(rate);
+  const shown = cameras.length > 1
+    ? `${cameras.length} cameras ${Math.min(...cameras)}–${Math.max(...cameras)} Hz shown`
+    : `camera ${cameras[0] ?? 0} Hz shown`;
+  const poses = [...graph.poses.keys()].reduce((sum, topic) => sum + rate(topic), 0);
+  $("rates").textContent = report.connected
+    ? `${shown} · poses ${poses} Hz · latency to bridge ${report.latencyMs === null ? "—" : report.latencyMs.toFixed(1) + " ms"}`
+    : "";
+}
