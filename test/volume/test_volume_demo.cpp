@@ -91,9 +91,9 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
 }
 
 // Camera cam_1's process is killed: the compute process says so and goes on fusing the other
-// three, a pose array for every frame; started again, the camera is taken back. cam_1 is away
-// for about 4 s of the run's 12 or more: 99 % tracked over the run (98 % while away, 99.5 %
-// the rest).
+// three, a pose array for every frame; started again, the camera is taken back. Tracked over
+// the run: the design's figures, 98 % while cam_1 is away (from the kill until it is taken back,
+// about 4 s) and 99.5 % the rest, each for its share of the run (about 11 s).
 TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   test::TempDir dir;
   const auto summary = dir / "summary.yaml";
@@ -113,8 +113,10 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   }
   ASSERT_TRUE(compute->wait_for_output("camera cam_1: first fiducials", std::chrono::seconds(30)))
       << compute->output();
+  const auto first_fiducials = std::chrono::steady_clock::now();
   std::this_thread::sleep_for(std::chrono::seconds(4));
 
+  const auto killed = std::chrono::steady_clock::now();
   cameras[1]->signal(SIGKILL);
   ASSERT_TRUE(compute->wait_for_output("camera cam_1 is silent", std::chrono::seconds(10)))
       << compute->output();
@@ -123,18 +125,24 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   cameras[1] = group("cam_1", "cam_1_again.log");
   ASSERT_TRUE(compute->wait_for_output("camera cam_1 is back", std::chrono::seconds(20)))
       << compute->output();
-  const double back_after_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - restarted).count();
+  const auto back = std::chrono::steady_clock::now();
+  const double back_after_s = std::chrono::duration<double>(back - restarted).count();
   std::printf("cam_1 taken back %.2f s after its process was started again\n", back_after_s);
   std::this_thread::sleep_for(std::chrono::seconds(3));
+  const auto stopped = std::chrono::steady_clock::now();
   compute->signal(SIGTERM);
+  const double away_share = std::chrono::duration<double>(back - killed).count() /
+                            std::chrono::duration<double>(stopped - first_fiducials).count();
+  const double tracked_bound = 0.98 * away_share + 0.995 * (1 - away_share);
+  std::printf("cam_1 away %.0f %% of the run: %.2f %% tracked at least\n", 100 * away_share,
+              100 * tracked_bound);
   ASSERT_EQ(compute->wait(std::chrono::seconds(20)), 0) << compute->output();
 
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
   // A pose array for every frame of the truth camera (cam_0), through the kill and the return.
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << compute->output();
-  EXPECT_GE(figures.tracked_share(), 0.99) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), tracked_bound) << test::read_file(summary);
   EXPECT_EQ(figures.false_identifications(), 0) << compute->output();
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
