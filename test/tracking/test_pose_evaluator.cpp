@@ -50,6 +50,15 @@ TEST(PoseEvaluator, CountsMissesFalseIdentificationsAndLostFrames) {
   EXPECT_EQ(evaluator.total().expected, 1u);
   EXPECT_EQ(evaluator.total().tracked, 0u);
   EXPECT_EQ(evaluator.total().false_identifications, 2u);
+  // Each is kept with its object, its stamp and how far off it was, so it can be told.
+  const auto& told = evaluator.total().false_identification_details;
+  ASSERT_EQ(told.size(), 2u);
+  EXPECT_EQ(told[0].name, "c");
+  EXPECT_EQ(told[0].stamp_ns, 1);
+  EXPECT_TRUE(std::isnan(told[0].position_error_m));
+  EXPECT_EQ(told[1].name, "a");
+  EXPECT_NEAR(told[1].position_error_m, 0.2, 1e-9);
+  EXPECT_NEAR(told[1].orientation_error_deg, 0.0, 1e-6);
   // Truth frames whose estimates never come are lost once newer ones pile up.
   for (int stamp = 2; stamp <= 5; ++stamp) evaluator.add_truth(stamp, {at("a", 0, 2)});
   EXPECT_EQ(evaluator.total().frames_lost, 2u);

@@ -19,6 +19,9 @@ void merge(EvaluationSummary& into, const EvaluationSummary& from) {
   into.expected += from.expected;
   into.tracked += from.tracked;
   into.false_identifications += from.false_identifications;
+  into.false_identification_details.insert(into.false_identification_details.end(),
+                                           from.false_identification_details.begin(),
+                                           from.false_identification_details.end());
   into.position_errors_m.insert(into.position_errors_m.end(), from.position_errors_m.begin(),
                                 from.position_errors_m.end());
   into.orientation_errors_deg.insert(into.orientation_errors_deg.end(),
@@ -46,7 +49,7 @@ double EvaluationSummary::quantile(std::vector<double> values, double q) {
 
 void PoseEvaluator::add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects) {
   if (auto estimate = pending_estimates_.find(stamp_ns); estimate != pending_estimates_.end()) {
-    evaluate(objects, estimate->second);
+    evaluate(stamp_ns, objects, estimate->second);
     pending_estimates_.erase(estimate);
     return;
   }
@@ -56,7 +59,7 @@ void PoseEvaluator::add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects)
 
 void PoseEvaluator::add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects) {
   if (auto truth = pending_truth_.find(stamp_ns); truth != pending_truth_.end()) {
-    evaluate(truth->second, objects);
+    evaluate(stamp_ns, truth->second, objects);
     pending_truth_.erase(truth);
     return;
   }
@@ -64,9 +67,13 @@ void PoseEvaluator::add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objec
   expire();
 }
 
-void PoseEvaluator::evaluate(const std::vector<ObjectPose>& truth,
+void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& truth,
                              const std::vector<ObjectPose>& estimates) {
   EvaluationSummary frame;
+  auto count_false = [&](const std::string& name, double position, double orientation) {
+    ++frame.false_identifications;
+    frame.false_identification_details.push_back({stamp_ns, name, position, orientation});
+  };
   frame.frames = 1;
   for (const ObjectPose& t : truth) {
     if (t.visible_markers >= options_.min_visible_markers) ++frame.expected;
@@ -75,14 +82,15 @@ void PoseEvaluator::evaluate(const std::vector<ObjectPose>& truth,
     auto t = std::find_if(truth.begin(), truth.end(),
                           [&](const ObjectPose& o) { return o.name == e.name; });
     if (t == truth.end()) {
-      ++frame.false_identifications;
+      count_false(e.name, std::numeric_limits<double>::quiet_NaN(),
+                  std::numeric_limits<double>::quiet_NaN());
       continue;
     }
     double position = (e.pose.translation() - t->pose.translation()).norm();
     double orientation = angle_deg(e.pose, t->pose);
     if (position > options_.false_position_error_m ||
         orientation > options_.false_orientation_error_deg) {
-      ++frame.false_identifications;
+      count_false(e.name, position, orientation);
       continue;
     }
     // Found with fewer visible markers than expected is a bonus, not a trackable object.

@@ -33,6 +33,15 @@ struct ObjectPose {
   std::optional<Eigen::Vector3d> linear_velocity, angular_velocity;
 };
 
+// One estimate counted as a false identification, kept so it can be told: which object, when,
+// and how far from the truth (NaN errors: the object is not in the truth at all).
+struct FalseIdentification {
+  int64_t stamp_ns = 0;
+  std::string name;
+  double position_error_m = 0;
+  double orientation_error_deg = 0;
+};
+
 // Totals over a run or a window of it.
 struct EvaluationSummary {
   uint64_t frames = 0;       // truth frames evaluated
@@ -40,8 +49,9 @@ struct EvaluationSummary {
   uint64_t expected = 0;     // trackable objects in those frames
   uint64_t tracked = 0;      // of them, estimated within the false-identification bounds
   uint64_t false_identifications = 0;
-  std::vector<double> position_errors_m;       // one per tracked object
-  std::vector<double> orientation_errors_deg;  // one per tracked object
+  std::vector<FalseIdentification> false_identification_details;  // one per count above
+  std::vector<double> position_errors_m;                          // one per tracked object
+  std::vector<double> orientation_errors_deg;                     // one per tracked object
   // Per tracked object with a measured velocity: |v - v_true| m/s, |w - w_true| deg/s.
   std::vector<double> velocity_errors_mps, angular_velocity_errors_dps;
 
@@ -63,7 +73,8 @@ class PoseEvaluator {
   EvaluationSummary take_window();
 
  private:
-  void evaluate(const std::vector<ObjectPose>& truth, const std::vector<ObjectPose>& estimates);
+  void evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& truth,
+                const std::vector<ObjectPose>& estimates);
   void expire();
 
   EvaluationOptions options_;

@@ -1,6 +1,7 @@
 // pose_evaluator: compares /mocap/poses with the synthetic camera's ground truth and prints
 // a live summary line and a final table (pose_evaluator.hpp).
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <optional>
 
@@ -132,6 +133,17 @@ class PoseEvaluatorComponent final : public Component {
     all_latencies_s_.insert(all_latencies_s_.end(), window_latencies_s_.begin(),
                             window_latencies_s_.end());
     latencies_s_.clear();
+    for (const FalseIdentification& f : window.false_identification_details) {
+      if (std::isnan(f.position_error_m)) {
+        log().warn("false identification: {} estimated at capture {} ns, not in view", f.name,
+                   f.stamp_ns);
+      } else {
+        log().warn(
+            "false identification: {} estimated at capture {} ns, {:.1f} mm and {:.2f} deg from "
+            "the truth",
+            f.name, f.stamp_ns, f.position_error_m * 1e3, f.orientation_error_deg);
+      }
+    }
     if (window.frames == 0) {
       log().info("no frames evaluated in the last {} s ({} truth arrays so far)",
                  settings_.report_period_s, truth_arrays_);
