@@ -87,6 +87,8 @@ struct BodyFrame {
 struct RenderedVolumeOptions {
   int frames = 150;
   double rate_hz = 30;
+  double start_s = 0;       // the scene time of the first frame
+  uint64_t noise_seed = 0;  // another draws other sensor noise over the same scene
   // cam_0 .. cam_{cameras-1} of config/volume/cameras: 4 is the demo, 8 its larger form.
   int cameras = 4;
   // The extrinsics the tracker uses, by camera (a calibration's); empty: the true ones, which
@@ -114,7 +116,7 @@ struct RenderedVolume {
   }
 };
 
-// Frames from scene time 0, with the demo's files under `config_dir` and the volume_fusion
+// Frames from scene time start_s, with the demo's files under `config_dir` and the volume_fusion
 // component's settings (min_markers 5).
 inline RenderedVolume render_volume(const std::string& config_dir,
                                     const RenderedVolumeOptions& rendering = {}) {
@@ -147,13 +149,14 @@ inline RenderedVolume render_volume(const std::string& config_dir,
                         options);
   tracking::FiducialDetector detector;
   for (int f = 0; f < frames; ++f) {
-    const double time_s = f / rate_hz;
+    const double time_s = rendering.start_s + f / rate_hz;
     const auto stamp_ns = static_cast<int64_t>(std::llround(time_s * 1e9));
     std::vector<CameraFrame> detections(cameras.size());
     std::vector<synthetic::RenderedFrame> rendered;
     for (size_t c = 0; c < cameras.size(); ++c) {
       rendered.push_back(
-          renderers[c]->render(time_s, static_cast<uint64_t>(f), cameras[c].camera_from_world));
+          renderers[c]->render(time_s, static_cast<uint64_t>(f) + rendering.noise_seed * 1000003,
+                               cameras[c].camera_from_world));
       detections[c] = {true, stamp_ns, {}, {}};
       for (const auto& fiducial : detector.detect(rendered.back().image)) {
         detections[c].pixels.emplace_back(fiducial.x, fiducial.y);

@@ -109,6 +109,45 @@ TEST(MultiCameraPose, OneCameraAloneGivesItsPoseFlaggedAsSuch) {
   EXPECT_EQ(fused.view_rms_px[1], 0.0);
 }
 
+// Points on one line of the body leave the pose free to turn about it, however many cameras
+// see them: two cameras that see only the board's first side (three markers, and two of them)
+// give no pose, and say why; one marker off that line fixes it.
+TEST(MultiCameraPose, PointsOnOneLineDoNotFixThePose) {
+  const Volume volume;
+  std::mt19937 random(5);
+  Eigen::Isometry3d truth;
+  std::vector<CameraView> views;
+  do {
+    truth = random_pose(random);
+    views = views_of(volume, truth, 0.1, random);
+  } while (views[0].body_points.empty() || views[1].body_points.empty());
+  auto keep = [](CameraView& view, const std::vector<size_t>& markers) {
+    CameraView kept{view.camera, view.camera_from_world, {}, {}, {}};
+    for (size_t m : markers) {
+      kept.body_points.push_back(view.body_points[m]);
+      kept.pixels.push_back(view.pixels[m]);
+    }
+    view = kept;
+  };
+  std::vector<CameraView> line = views;
+  keep(line[0], {0, 1, 2});  // (0, 0), (0.10, 0), (0.30, 0): the side along x
+  keep(line[1], {0, 2});
+  for (size_t c = 2; c < line.size(); ++c) keep(line[c], {});
+  const MultiCameraPose on_a_line = estimate_multi_camera_pose(line, truth);
+  EXPECT_FALSE(on_a_line.valid);
+  EXPECT_NE(on_a_line.rejection.find("the points do not fix the pose"), std::string::npos)
+      << on_a_line.rejection;
+
+  std::vector<CameraView> off_the_line = views;
+  keep(off_the_line[0], {0, 1, 2});
+  keep(off_the_line[1], {0, 2, 4});  // and (0.30, 0.20)
+  for (size_t c = 2; c < off_the_line.size(); ++c) keep(off_the_line[c], {});
+  const MultiCameraPose fixed = estimate_multi_camera_pose(off_the_line, truth);
+  ASSERT_TRUE(fixed.valid) << fixed.rejection;
+  EXPECT_LT(position_error(fixed.world_from_body, truth), 2e-3);
+  EXPECT_LT(rotation_error(fixed.world_from_body, truth), 0.5 * kPi / 180);
+}
+
 // A camera bumped by half a degree after calibration: its residuals stand out (by its index),
 // and the covariance is that of a 6-DoF pose.
 TEST(MultiCameraPose, ABumpedCameraStandsOutInItsResiduals) {

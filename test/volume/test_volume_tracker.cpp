@@ -314,6 +314,9 @@ TEST(VolumeTrackerOptions, NameTheFieldThatCannotBeUsed) {
   options.fusion.min_points = 2;
   EXPECT_EQ(options.problem(), "fusion.min_points: 2; three points at least fix a pose");
   options = {};
+  options.fusion.max_orientation_sigma_ratio = 0.5;
+  EXPECT_EQ(options.problem(), "fusion.max_orientation_sigma_ratio: 0.5 is below 1");
+  options = {};
   options.triangulation.tolerance_px = 0;
   EXPECT_EQ(options.problem(), "triangulation.tolerance_px: 0 is not above 0");
   options = {};

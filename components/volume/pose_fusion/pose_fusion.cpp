@@ -5,8 +5,10 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
+#include <Eigen/Eigenvalues>
 
 #include "tracking/pose_estimator/pose_refinement.hpp"
 
@@ -15,6 +17,18 @@ namespace {
 
 // A sigma this small or smaller counts as this: a zero from a detector cannot weigh infinitely.
 constexpr double kSmallestSigmaPx = 1e-3;
+
+// The standard deviations about the best and the worst axes of a 3x3 covariance block; the
+// worst infinite when the block is not finite or all zeros (pose_covariance's answer to points
+// that leave the information singular, which no sigma of at least min_variance gives).
+std::pair<double, double> best_and_worst_sigma(const Eigen::Matrix3d& covariance) {
+  if (!covariance.allFinite() || covariance.isZero(0)) {
+    return {0, std::numeric_limits<double>::infinity()};
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d variances = solver.eigenvalues().cwiseMax(0);
+  return {std::sqrt(variances.minCoeff()), std::sqrt(variances.maxCoeff())};
+}
 
 // Every view's pixel residuals, one after the other, at the body pose `world_from_body`;
 // `weighted`: each divided by its pixel's sigma.
@@ -89,6 +103,9 @@ std::optional<std::string> MultiCameraPoseOptions::problem() const {
     return fmt::format("min_points: {}; three points at least fix a pose", min_points);
   }
   if (max_iterations < 1) return fmt::format("max_iterations: {} is below 1", max_iterations);
+  if (!(max_orientation_sigma_ratio >= 1)) {
+    return fmt::format("max_orientation_sigma_ratio: {} is below 1", max_orientation_sigma_ratio);
+  }
   return std::nullopt;
 }
 
@@ -137,9 +154,16 @@ MultiCameraPose estimate_multi_camera_pose(const std::vector<CameraView>& views,
                    : 0.0);
     at += length;
   }
+  const auto [best_sigma, worst_sigma] =
+      best_and_worst_sigma(result.covariance.bottomRightCorner<3, 3>());
   if (result.reprojection_rms_px > options.max_reprojection_rms_px) {
     result.rejection = fmt::format("reprojection RMS {:.2f} px exceeds {:.2f} px",
                                    result.reprojection_rms_px, options.max_reprojection_rms_px);
+  } else if (!(worst_sigma <= options.max_orientation_sigma_ratio * best_sigma)) {
+    result.rejection = fmt::format(
+        "the points do not fix the pose (on one line of the body?): its orientation's sigma "
+        "about its worst axis, {:.3f} deg, is {:.0f} times that about its best",
+        worst_sigma * 180 / M_PI, worst_sigma / best_sigma);
   } else {
     result.valid = true;
   }
