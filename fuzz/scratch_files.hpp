@@ -1,7 +1,8 @@
 // For the harnesses whose parser opens the files an input names (calibration data files, a
 // rig's camera files): the input is several files separated by NUL bytes, written into a
 // folder of this process under the temporary directory. The folder is emptied for every input,
-// so that an input sees only the files it brings, and removed at exit.
+// so that an input sees only the files it brings, and removed at exit (not when libFuzzer is
+// stopped by SIGUSR1, which skips exit handlers: scripts/fuzz.sh removes its TMPDIR then).
 #pragma once
 
 #include <unistd.h>

@@ -60,9 +60,12 @@ run_one() {
   mkdir -p "$work" "$found" "$(dirname "$log")"
   local inputs=(fuzz/corpus/"$name")
   [ -d fuzz/regressions/"$name" ] && inputs+=(fuzz/regressions/"$name")
-  local start=$SECONDS budget ticks
+  local start=$SECONDS budget ticks scratch
   budget=$((seconds * $(getconf CLK_TCK)))
-  "$build/fuzz/fuzz_$name" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  # A temporary directory of its own, removed here: libFuzzer's stop on SIGUSR1 ends the
+  # process without its exit handlers, which remove the files a harness writes.
+  scratch=$(mktemp -d "/tmp/fuzz_$name.XXXXXX")
+  TMPDIR=$scratch "$build/fuzz/fuzz_$name" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$found/" "$work" "${inputs[@]}" > "$log" 2>&1 &
   local pid=$!
   # Its user and system time: fields 14 and 15 of /proc/PID/stat (12 and 13 after the name),
@@ -74,6 +77,7 @@ run_one() {
   kill -USR1 "$pid" 2> /dev/null
   local status=0
   wait "$pid" || status=$?
+  rm -rf "$scratch"
   echo $status > "$log.status"
   echo $((SECONDS - start)) > "$log.wall"
 }
