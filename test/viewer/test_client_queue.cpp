@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "viewer/foxglove_bridge/client_queue.hpp"
@@ -52,6 +54,24 @@ TEST(ClientQueue, AClientBehindForTooLongIsToBeDisconnected) {
   queue.pop();
   queue.pop();  // emptied: caught up
   EXPECT_FALSE(queue.should_disconnect(t0 + 60s));
+}
+
+// Options built in code get the checks the plugin's parameter range gives a launch file: the
+// queue refuses them, naming the field.
+TEST(ClientQueueOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(ClientQueueOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(ClientQueueOptions{.limit_bytes = 0}.problem(),
+            "limit_bytes: 0 leaves no room for a message");
+  EXPECT_EQ(ClientQueueOptions{.disconnect_after = -1500ms}.problem(),
+            "disconnect_after: -1.5 s is below 0");
+  EXPECT_EQ(ClientQueueOptions{.disconnect_after = 0s}.problem(), std::nullopt);  // at once
+  try {
+    ClientQueue queue({.limit_bytes = 0});
+    ADD_FAILURE() << "a queue without room accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "ClientQueueOptions::limit_bytes: 0 leaves no room for a message");
+  }
 }
 
 }  // namespace

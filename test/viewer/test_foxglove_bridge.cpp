@@ -13,8 +13,10 @@
 #include <csignal>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -22,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "test/test_support.hpp"
+#include "viewer/foxglove_bridge/websocket_server.hpp"
 
 namespace mocap {
 namespace {
@@ -771,6 +774,38 @@ TEST(FoxgloveBridgeSecurity, OnlyTheBridgesOwnPageAndListedOriginsConnect) {
   EXPECT_EQ(secure_client({bridge, "--origin", "https://app.foxglove.dev"})["op"], "serverInfo");
   EXPECT_EQ(secure_client({bridge, "--host", fmt::format("attacker.example:{}", port)})["op"],
             "serverInfo");
+}
+
+// Options built in code get the checks a launch file's parameters get from the plugin: the
+// server refuses them before it listens, naming the field.
+TEST(WebSocketServerOptions, NameTheFieldThatCannotBeUsed) {
+  using foxglove::WebSocketServerOptions;
+  WebSocketServerOptions usable;
+  usable.subprotocols = {"foxglove.websocket.v1"};
+  EXPECT_EQ(usable.problem(), std::nullopt);
+  WebSocketServerOptions options = usable;
+  options.address = "localhost";  // a name, not an address
+  EXPECT_EQ(options.problem()->rfind("address: 'localhost' is not an IP address: ", 0), 0u)
+      << *options.problem();
+  options = usable;
+  options.certificate_file = "cert.pem";
+  EXPECT_EQ(options.problem(),
+            "key_file: empty while certificate_file is set; TLS needs both (or neither, for "
+            "plain ws://)");
+  options = usable;
+  options.subprotocols.clear();
+  EXPECT_EQ(options.problem(), "subprotocols: none; every WebSocket client would be refused");
+  options = usable;
+  options.max_incoming_message_bytes = 0;
+  EXPECT_EQ(options.problem(), "max_incoming_message_bytes: 0 leaves no room for a message");
+  options.port = 0;  // were the options taken, any free port
+  try {
+    foxglove::WebSocketServer server(options, {});
+    ADD_FAILURE() << "a server that takes no message accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "WebSocketServerOptions::max_incoming_message_bytes: 0 leaves no room for a message");
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -136,9 +137,19 @@ TEST(FoxgloveBridgeOptions, NameTheFieldThatCannotBeUsed) {
             0u);
   EXPECT_EQ(FoxgloveBridgeOptions{.max_image_rate_hz = -1}.problem(),
             "max_image_rate_hz: -1 is not a rate (0: every image)");
+  FoxgloveBridgeOptions no_room;
+  no_room.queue.limit_bytes = 0;
+  EXPECT_EQ(no_room.problem(), "queue.limit_bytes: 0 leaves no room for a message");
   RecordingGraph graph;
   RecordingLinks links;
   Logger log("bridge_test");
+  try {
+    FoxgloveBridge bridge(no_room, {}, "graph", graph, links, log);
+    ADD_FAILURE() << "a queue without room accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "FoxgloveBridgeOptions::queue.limit_bytes: 0 leaves no room for a message");
+  }
   EXPECT_THROW(FoxgloveBridge({.topics = "("}, {}, "graph", graph, links, log),
                std::invalid_argument);
 }

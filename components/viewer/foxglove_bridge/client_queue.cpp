@@ -1,6 +1,25 @@
 #include "viewer/foxglove_bridge/client_queue.hpp"
 
+#include <stdexcept>
+
+#include <fmt/format.h>
+
 namespace mocap::foxglove {
+
+std::optional<std::string> ClientQueueOptions::problem() const {
+  if (limit_bytes == 0) return "limit_bytes: 0 leaves no room for a message";
+  if (disconnect_after < std::chrono::steady_clock::duration::zero()) {
+    return fmt::format("disconnect_after: {} s is below 0",
+                       std::chrono::duration<double>(disconnect_after).count());
+  }
+  return std::nullopt;
+}
+
+ClientQueue::ClientQueue(ClientQueueOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("ClientQueueOptions::" + *problem);
+  }
+}
 
 void ClientQueue::push(std::string frame, Clock::time_point now) {
   if (frame.size() > options_.limit_bytes) {

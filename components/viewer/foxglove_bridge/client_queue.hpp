@@ -15,12 +15,17 @@ struct ClientQueueOptions {
   size_t limit_bytes = 10'000'000;
   // Over the limit (dropping) for this long without a break: disconnect.
   std::chrono::steady_clock::duration disconnect_after = std::chrono::seconds(5);
+
+  // Why these options cannot be used, naming the field ("limit_bytes: 0 leaves no room for a
+  // message"); nullopt when they can. ClientQueue's constructor throws std::invalid_argument
+  // with it.
+  std::optional<std::string> problem() const;
 };
 
 class ClientQueue {
  public:
   using Clock = std::chrono::steady_clock;
-  explicit ClientQueue(ClientQueueOptions options = {}) : options_(options) {}
+  explicit ClientQueue(ClientQueueOptions options = {});
 
   // Appends a frame; drops the oldest frames while the queue would exceed the limit (a frame
   // larger than the limit on its own is dropped itself).

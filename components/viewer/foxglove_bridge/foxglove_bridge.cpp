@@ -43,7 +43,7 @@ std::optional<std::string> FoxgloveBridgeOptions::problem() const {
   if (!(max_image_rate_hz >= 0)) {
     return fmt::format("max_image_rate_hz: {} is not a rate (0: every image)", max_image_rate_hz);
   }
-  if (queue.limit_bytes == 0) return "queue.limit_bytes: 0 leaves no room for a message";
+  if (auto problem = queue.problem()) return "queue." + *problem;
   return std::nullopt;
 }
 
@@ -55,7 +55,9 @@ FoxgloveBridge::FoxgloveBridge(FoxgloveBridgeOptions options,
       graph_(graph),
       links_(links),
       log_(log) {
-  if (auto problem = options_.problem()) throw std::invalid_argument(*problem);
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("FoxgloveBridgeOptions::" + *problem);
+  }
   allowed_ = std::regex(options_.topics, std::regex::ECMAScript);
   if (options_.max_image_rate_hz > 0) {
     image_period_ = std::chrono::duration_cast<Clock::duration>(

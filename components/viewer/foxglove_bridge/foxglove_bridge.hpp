@@ -44,7 +44,8 @@ struct FoxgloveBridgeOptions {
   ClientQueueOptions queue = {};
 
   // Why these options cannot be used ("topics: '(' is not a regular expression: ..."), naming
-  // the field; nullopt when they can.
+  // the field (the queue's by its path: "queue.limit_bytes: ..."); nullopt when they can.
+  // FoxgloveBridge's constructor throws std::invalid_argument with it.
   std::optional<std::string> problem() const;
 };
 

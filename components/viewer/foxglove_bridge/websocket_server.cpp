@@ -14,6 +14,7 @@
 #include <thread>
 #include <type_traits>
 
+#include <fmt/format.h>
 #include <websocketpp/config/asio.hpp>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
@@ -152,10 +153,7 @@ class Server final : public detail::WebSocketBackend {
     });
 
     websocketpp::lib::error_code error;
-    asio::ip::address address = asio::ip::make_address(options_.address, error);
-    if (error) {
-      throw std::runtime_error("address: '" + options_.address + "': " + error.message());
-    }
+    const asio::ip::address address = asio::ip::make_address(options_.address);  // checked
     loopback_ = address.is_loopback();
     endpoint_.listen(asio::ip::tcp::endpoint(address, options_.port), error);
     if (!error) endpoint_.start_accept(error);
@@ -331,10 +329,25 @@ class Server final : public detail::WebSocketBackend {
 
 }  // namespace
 
+std::optional<std::string> WebSocketServerOptions::problem() const {
+  asio::error_code error;
+  asio::ip::make_address(address, error);
+  if (error) return fmt::format("address: '{}' is not an IP address: {}", address, error.message());
+  if (certificate_file.empty() != key_file.empty()) {
+    return fmt::format("{}: empty while {} is set; TLS needs both (or neither, for plain ws://)",
+                       key_file.empty() ? "key_file" : "certificate_file",
+                       key_file.empty() ? "certificate_file" : "key_file");
+  }
+  if (subprotocols.empty()) return "subprotocols: none; every WebSocket client would be refused";
+  if (max_incoming_message_bytes == 0) {
+    return "max_incoming_message_bytes: 0 leaves no room for a message";
+  }
+  return std::nullopt;
+}
+
 WebSocketServer::WebSocketServer(WebSocketServerOptions options, WebSocketHandlers handlers) {
-  if (options.certificate_file.empty() != options.key_file.empty()) {
-    throw std::runtime_error(
-        "certificate_file and key_file: TLS needs both (or neither, for plain ws://)");
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("WebSocketServerOptions::" + *problem);
   }
   if (options.certificate_file.empty()) {
     impl_ = std::make_unique<Server<Plain>>(std::move(options), std::move(handlers));

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,11 @@ struct WebSocketServerOptions {
   // from another page.
   std::vector<std::string> allowed_hosts;
   std::vector<std::string> allowed_origins;
+
+  // Why these options cannot be used, naming the field ("address: 'x' is not an IP address:
+  // ..."); nullopt when they can. WebSocketServer's constructor throws std::invalid_argument
+  // with it.
+  std::optional<std::string> problem() const;
 };
 
 // Called on the server's thread. A ClientId is never reused within one server.
@@ -58,7 +64,8 @@ struct WebSocketHandlers {
 
 class WebSocketServer {
  public:
-  // Listens and starts the thread. Throws std::runtime_error naming address:port when the
+  // Listens and starts the thread. Throws std::invalid_argument for options that cannot be
+  // used (WebSocketServerOptions::problem), std::runtime_error naming address:port when the
   // address cannot be bound (in use, not an address of this machine), or the TLS file that
   // cannot be used.
   WebSocketServer(WebSocketServerOptions options, WebSocketHandlers handlers);
