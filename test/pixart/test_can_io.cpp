@@ -19,6 +19,7 @@
 
 #include "common/can_io/adaptor_clock.hpp"
 #include "common/can_io/can_frame.hpp"
+#include "common/can_io/can_source.hpp"
 #include "common/can_io/candump_log.hpp"
 #include "common/can_io/slcan.hpp"
 #include "common/can_io/socketcan.hpp"
@@ -891,6 +892,65 @@ TEST(SocketCan, LiveRoundTripOnVcan0) {
     EXPECT_EQ(*received, expected);
   }
   EXPECT_FALSE(receiver.read(50ms).has_value());
+}
+
+// --- options ----------------------------------------------------------------------------------
+// Options built in code get the checks a launch file's parameters get from the plugins' ranges:
+// what takes them refuses them first, naming the field.
+
+constexpr const char* kSupportedBaudRates =
+    "9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 576000, 921600, 1000000, "
+    "2000000, 3000000";
+
+TEST(SerialPortOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(serial::SerialPortOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(serial::SerialPortOptions{.baud_rate = 12345}.problem(),
+            std::string("baud_rate: 12345 is not supported; supported: ") + kSupportedBaudRates);
+  EXPECT_EQ(serial::SerialPortOptions{.write_timeout = -1ms}.problem(),
+            "write_timeout: -1 ms is below 0");
+  EXPECT_EQ(serial::SerialPortOptions{.write_timeout = 0ms}.problem(), std::nullopt);  // no wait
+  EXPECT_EQ(serial::PseudoTerminalOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(serial::PseudoTerminalOptions{.write_timeout = -5ms}.problem(),
+            "write_timeout: -5 ms is below 0");
+
+  PseudoTerminal pty;
+  EXPECT_EQ(error_of<std::invalid_argument>(
+                [&] { SerialPort port(pty.slave_path(), {.write_timeout = -1ms}); }),
+            "SerialPortOptions::write_timeout: -1 ms is below 0");
+  EXPECT_EQ(error_of<std::invalid_argument>([] { PseudoTerminal other({.write_timeout = -5ms}); }),
+            "PseudoTerminalOptions::write_timeout: -5 ms is below 0");
+}
+
+TEST(SlcanParserOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(SlcanParserOptions{}.problem(), std::nullopt);
+  // The longest valid message (extended, 8 bytes, timestamp) must fit.
+  EXPECT_EQ(SlcanParserOptions{.max_message_length = 30}.problem(), std::nullopt);
+  EXPECT_EQ(SlcanParserOptions{.max_message_length = 29}.problem(),
+            "max_message_length: 29; the longest valid message has 30 characters");
+  EXPECT_EQ(error_of<std::invalid_argument>([] { SlcanParser parser({.max_message_length = 0}); }),
+            "SlcanParserOptions::max_message_length: 0; the longest valid message has 30 "
+            "characters");
+}
+
+TEST(CanSourceOptions, NameTheFieldThatCannotBeUsed) {
+  // A device and a file have no default: the options without them cannot be used.
+  EXPECT_EQ(SlcanSourceOptions{.device = "/dev/ttyACM0"}.problem(), std::nullopt);
+  EXPECT_EQ(SlcanSourceOptions{}.problem(),
+            "device: empty; the adaptor's serial device, e.g. /dev/ttyACM0");
+  EXPECT_EQ((SlcanSourceOptions{.device = "/dev/ttyACM0", .bitrate = 300000}.problem()),
+            "bitrate: 300000 bit/s is not an SLCAN bitrate; supported: 10000, 20000, 50000, "
+            "100000, 125000, 250000, 500000, 800000, 1000000");
+  EXPECT_EQ((SlcanSourceOptions{.device = "/dev/ttyACM0", .baud = 12345}.problem()),
+            std::string("baud: 12345 is not supported; supported: ") + kSupportedBaudRates);
+  EXPECT_EQ(CandumpSourceOptions{.file = "box.log"}.problem(), std::nullopt);
+  EXPECT_EQ(CandumpSourceOptions{}.problem(), "file: empty; a `candump -L` log to read");
+  // Refused before the device is looked for.
+  EXPECT_EQ(error_of<std::invalid_argument>(
+                [] { open_slcan({.device = "/nonexistent/tty", .bitrate = 300000}); }),
+            "SlcanSourceOptions::bitrate: 300000 bit/s is not an SLCAN bitrate; supported: 10000, "
+            "20000, 50000, 100000, 125000, 250000, 500000, 800000, 1000000");
+  EXPECT_EQ(error_of<std::invalid_argument>([] { open_candump({}); }),
+            "CandumpSourceOptions::file: empty; a `candump -L` log to read");
 }
 
 }  // namespace

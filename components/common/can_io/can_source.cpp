@@ -1,5 +1,7 @@
 #include "common/can_io/can_source.hpp"
 
+#include <algorithm>
+#include <stdexcept>
 #include <thread>
 
 #include <fmt/format.h>
@@ -16,6 +18,13 @@ int64_t now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
+}
+
+// "a, b, c": the values a setting may take, for its message.
+std::string listed(const std::vector<int>& values) {
+  std::string list;
+  for (int value : values) list += (list.empty() ? "" : ", ") + std::to_string(value);
+  return list;
 }
 
 class SlcanSource final : public CanSource {
@@ -141,7 +150,24 @@ class CandumpSource final : public CanSource {
 
 }  // namespace
 
+std::optional<std::string> SlcanSourceOptions::problem() const {
+  if (device.empty()) return "device: empty; the adaptor's serial device, e.g. /dev/ttyACM0";
+  const std::vector<int> bitrates = slcan_bitrates();
+  if (std::find(bitrates.begin(), bitrates.end(), bitrate) == bitrates.end()) {
+    return fmt::format("bitrate: {} bit/s is not an SLCAN bitrate; supported: {}", bitrate,
+                       listed(bitrates));
+  }
+  const std::vector<int> bauds = serial::supported_baud_rates();
+  if (std::find(bauds.begin(), bauds.end(), baud) == bauds.end()) {
+    return fmt::format("baud: {} is not supported; supported: {}", baud, listed(bauds));
+  }
+  return std::nullopt;
+}
+
 std::unique_ptr<CanSource> open_slcan(const SlcanSourceOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("SlcanSourceOptions::" + *problem);
+  }
   return std::make_unique<SlcanSource>(options);
 }
 
@@ -149,7 +175,15 @@ std::unique_ptr<CanSource> open_socketcan(const std::string& interface) {
   return std::make_unique<SocketCanSource>(interface);
 }
 
+std::optional<std::string> CandumpSourceOptions::problem() const {
+  if (file.empty()) return "file: empty; a `candump -L` log to read";
+  return std::nullopt;
+}
+
 std::unique_ptr<CanSource> open_candump(const CandumpSourceOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("CandumpSourceOptions::" + *problem);
+  }
   return std::make_unique<CandumpSource>(options);
 }
 

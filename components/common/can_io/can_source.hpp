@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,11 +40,17 @@ struct SlcanSourceOptions {
   std::string device;     // serial device of the adaptor, e.g. /dev/ttyACM0
   int bitrate = 1000000;  // of the CAN bus
   int baud = 115200;      // of the serial line (USB adaptors ignore it)
+
+  // Why these options cannot be used, naming the field ("bitrate: 300000 bit/s is not an
+  // SLCAN bitrate; ..."); nullopt when they can. open_slcan throws std::invalid_argument with
+  // it.
+  std::optional<std::string> problem() const;
 };
 // Opens the device and the CAN channel (close, set the bitrate, ask for timestamps, open: see
 // slcan_open_commands), and closes the channel again when destroyed, so no `slcand` or set-up
 // script is needed. Throws CanSourceError when the device cannot be opened,
-// std::invalid_argument for an unsupported bitrate or baud.
+// std::invalid_argument for options that cannot be used (no device, an unsupported bitrate or
+// baud).
 std::unique_ptr<CanSource> open_slcan(const SlcanSourceOptions& options);
 
 // Throws CanSourceError when the interface does not exist or the kernel has no CAN support.
@@ -53,8 +60,13 @@ struct CandumpSourceOptions {
   std::string file;
   // true: frames come at the pace they were recorded; false: as fast as they are read.
   bool recorded_timing = true;
+
+  // Why these options cannot be used, naming the field ("file: empty; ..."); nullopt when they
+  // can. open_candump throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
-// Reads the whole log first; throws CandumpError naming the file and line of a bad line.
+// Reads the whole log first; throws std::invalid_argument for options that cannot be used,
+// CandumpError naming the file and line of a bad line.
 std::unique_ptr<CanSource> open_candump(const CandumpSourceOptions& options);
 
 }  // namespace mocap::can

@@ -18,6 +18,8 @@ constexpr size_t kExtendedIdDigits = 8;
 constexpr size_t kTimestampDigits = 4;
 // The adaptor counts milliseconds within a minute: 0 .. 59,999.
 constexpr uint32_t kLastTimestamp = 0xEA5F;
+// The longest valid message: 'T', the ID, the DLC, 8 data bytes and a timestamp.
+constexpr size_t kLongestMessage = 1 + kExtendedIdDigits + 1 + 2 * 8 + kTimestampDigits;
 
 // Lawicel's "S<n>" bitrate codes.
 constexpr std::array<std::pair<int, char>, 9> kBitrateCodes{{{10000, '0'},
@@ -128,6 +130,12 @@ std::string encode_slcan(const CanFrame& frame) {
   return text + kCarriageReturn;
 }
 
+std::vector<int> slcan_bitrates() {
+  std::vector<int> bitrates;
+  for (const auto& [bitrate, code] : kBitrateCodes) bitrates.push_back(bitrate);
+  return bitrates;
+}
+
 std::vector<std::string> slcan_open_commands(int bitrate) {
   for (const auto& [supported, code] : kBitrateCodes) {
     if (supported == bitrate) {
@@ -145,7 +153,18 @@ std::vector<std::string> slcan_open_commands(int bitrate) {
 
 std::string slcan_close_command() { return std::string{'C', kCarriageReturn}; }
 
+std::optional<std::string> SlcanParserOptions::problem() const {
+  if (max_message_length < kLongestMessage) {
+    return fmt::format("max_message_length: {}; the longest valid message has {} characters",
+                       max_message_length, kLongestMessage);
+  }
+  return std::nullopt;
+}
+
 SlcanParser::SlcanParser(SlcanParserOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("SlcanParserOptions::" + *problem);
+  }
   message_.reserve(options_.max_message_length);
 }
 

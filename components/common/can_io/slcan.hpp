@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,8 @@ std::string encode_slcan(const CanFrame& frame);
 // the supported bitrates for any other: 10000, 20000, 50000, 100000, 125000, 250000, 500000,
 // 800000, 1000000.
 std::vector<std::string> slcan_open_commands(int bitrate);
+// The bitrates slcan_open_commands takes, ascending.
+std::vector<int> slcan_bitrates();
 // Closes the CAN channel: "C\r".
 std::string slcan_close_command();
 
@@ -43,6 +46,11 @@ struct SlcanParserOptions {
   // rest of it, up to the next terminator, skipped, so that a stream of garbage (a wrong baud
   // rate, another device on the port) cannot make the parser's buffer grow.
   size_t max_message_length = 64;
+
+  // Why these options cannot be used, naming the field ("max_message_length: 20; the longest
+  // valid message has 30 characters"); nullopt when they can. SlcanParser's constructor
+  // throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct SlcanStats {

@@ -5,6 +5,8 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 
@@ -38,16 +40,12 @@ constexpr std::array<std::pair<int, speed_t>, 13> kBaudRates{{{9600, B9600},
                                                               {2000000, B2000000},
                                                               {3000000, B3000000}}};
 
-speed_t baud_constant(int baud_rate) {
+// The termios constant of a baud rate; nullopt for one not in kBaudRates.
+std::optional<speed_t> baud_constant(int baud_rate) {
   for (const auto& [rate, constant] : kBaudRates) {
     if (rate == baud_rate) return constant;
   }
-  std::string supported;
-  for (int rate : supported_baud_rates()) {
-    supported += (supported.empty() ? "" : ", ") + std::to_string(rate);
-  }
-  throw std::invalid_argument(
-      fmt::format("unsupported serial baud rate {}; supported: {}", baud_rate, supported));
+  return std::nullopt;
 }
 
 std::string system_error_text(int error_number) { return std::strerror(error_number); }
@@ -111,9 +109,26 @@ std::vector<int> supported_baud_rates() {
 
 // --- SerialPort ------------------------------------------------------------------------------
 
+std::optional<std::string> SerialPortOptions::problem() const {
+  if (!baud_constant(baud_rate)) {
+    std::string supported;
+    for (int rate : supported_baud_rates()) {
+      supported += (supported.empty() ? "" : ", ") + std::to_string(rate);
+    }
+    return fmt::format("baud_rate: {} is not supported; supported: {}", baud_rate, supported);
+  }
+  if (write_timeout.count() < 0) {
+    return fmt::format("write_timeout: {} ms is below 0", write_timeout.count());
+  }
+  return std::nullopt;
+}
+
 SerialPort::SerialPort(std::string device, SerialPortOptions options)
     : device_(std::move(device)), options_(options) {
-  const speed_t speed = baud_constant(options_.baud_rate);
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("SerialPortOptions::" + *problem);
+  }
+  const speed_t speed = *baud_constant(options_.baud_rate);
   fd_ = ::open(device_.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) {
     throw SerialError(
@@ -194,7 +209,17 @@ void SerialPort::write_all(std::string_view bytes) {
 
 // --- PseudoTerminal --------------------------------------------------------------------------
 
+std::optional<std::string> PseudoTerminalOptions::problem() const {
+  if (write_timeout.count() < 0) {
+    return fmt::format("write_timeout: {} ms is below 0", write_timeout.count());
+  }
+  return std::nullopt;
+}
+
 PseudoTerminal::PseudoTerminal(PseudoTerminalOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("PseudoTerminalOptions::" + *problem);
+  }
   master_fd_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (master_fd_ < 0) {
     throw SerialError(fmt::format("cannot create a pseudo-terminal: {}", system_error_text(errno)));

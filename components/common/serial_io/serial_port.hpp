@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -34,6 +35,10 @@ struct SerialPortOptions {
   // Drop what the device received before it was opened: old frames, the tail of a message
   // cut off by the previous run.
   bool discard_pending_input = true;
+
+  // Why these options cannot be used, naming the field ("baud_rate: 12345 is not supported;
+  // ..."); nullopt when they can. SerialPort's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // An open serial device in raw mode: 8 data bits, no parity, no echo, no line editing, no
@@ -43,8 +48,9 @@ struct SerialPortOptions {
 class SerialPort {
  public:
   // Opens `device` (O_NOCTTY: never becomes our controlling terminal; O_CLOEXEC). Throws
-  // std::invalid_argument for an unsupported baud rate, and SerialError naming the device
-  // when it does not exist, cannot be opened (permissions, in use), or is not a terminal.
+  // std::invalid_argument for options that cannot be used (an unsupported baud rate, a
+  // negative timeout), and SerialError naming the device when it does not exist, cannot be
+  // opened (permissions, in use), or is not a terminal.
   explicit SerialPort(std::string device, SerialPortOptions options = {});
   ~SerialPort();
   SerialPort(SerialPort&& other) noexcept;
@@ -75,6 +81,10 @@ struct PseudoTerminalOptions {
   // write_all gives up, with a SerialError, when the pty takes no bytes for this long. Without
   // a reader on the slave side the pty buffers about 20 kB, then takes nothing more.
   std::chrono::milliseconds write_timeout{1000};
+
+  // Why these options cannot be used, naming the field ("write_timeout: -1 ms is below 0");
+  // nullopt when they can. PseudoTerminal's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // A pseudo-terminal pair: its master end stays here, its slave end (slave_path(), e.g.
@@ -83,7 +93,8 @@ struct PseudoTerminalOptions {
 // slave path disappear and the slave's reader see a hang-up: an unplugged adaptor.
 class PseudoTerminal {
  public:
-  // Throws SerialError when no pseudo-terminal can be created.
+  // Throws std::invalid_argument for options that cannot be used, SerialError when no
+  // pseudo-terminal can be created.
   explicit PseudoTerminal(PseudoTerminalOptions options = {});
   ~PseudoTerminal();
   PseudoTerminal(PseudoTerminal&& other) noexcept;
