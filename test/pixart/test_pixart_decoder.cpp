@@ -1,6 +1,10 @@
 // PixArt frame decoding (docs/pixart_can.md) and the grouping of frames into camera samples.
 #include <gtest/gtest.h>
 
+#include <optional>
+#include <stdexcept>
+#include <string>
+
 #include "pixart/pixart_bridge/camera_samples.hpp"
 #include "pixart/pixart_bridge/pixart_bridge.hpp"
 
@@ -127,6 +131,26 @@ TEST(CameraSampleAssembler, PairsHalvesAndSurvivesLostFrames) {
   EXPECT_FALSE(sample->complete);
   EXPECT_EQ(assembler.flush().size(), 1u);  // camera 4's
   EXPECT_EQ(assembler.incomplete_samples(), 3u);
+}
+
+// The bridge's parameter ranges keep a launch file's options usable; options built in code get
+// the same checks from the decoder, which names the field.
+TEST(PixartDecoderOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(PixartDecoderOptions{}.problem(), std::nullopt);
+  EXPECT_EQ((PixartDecoderOptions{.base_id = 0x100, .boxes = 0}.problem()), "boxes: 0 is below 1");
+  EXPECT_EQ((PixartDecoderOptions{.base_id = 0x100, .boxes = 300}.problem()),
+            "boxes: 300; at most 256 boxes of 8 IDs fit the 11-bit CAN IDs");
+  EXPECT_EQ((PixartDecoderOptions{.base_id = 0x7F0, .boxes = 8}.problem()),
+            "base_id: 0x7f0 with 8 boxes needs CAN IDs up to 0x82f, above 0x7ff");
+  // A base far beyond 11 bits does not wrap around into the range.
+  EXPECT_EQ((PixartDecoderOptions{.base_id = 0xFFFFFFFF, .boxes = 1}.problem()),
+            "base_id: 0xffffffff with 1 boxes needs CAN IDs up to 0x100000006, above 0x7ff");
+  try {
+    PixartDecoder decoder({.base_id = 0x100, .boxes = 0});
+    ADD_FAILURE() << "no boxes accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "PixartDecoderOptions::boxes: 0 is below 1");
+  }
 }
 
 }  // namespace

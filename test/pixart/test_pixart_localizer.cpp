@@ -11,7 +11,10 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include <mocap/calibration/camera_file.hpp>
@@ -1045,6 +1048,43 @@ TEST(PixartLocalizerPlugin, ABadRigIsAClearError) {
   } catch (const ComponentError& e) {
     EXPECT_NE(std::string(e.what()).find("rig.yaml:2"), std::string::npos) << e.what();
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Options built in code get the checks a launch file's parameters get from the plugin's ranges.
+
+TEST(LocalizerOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(LocalizerOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(MergeOptions{.merge_window_s = -0.001}.problem(), "merge_window_s: -0.001 is below 0");
+  EXPECT_EQ(MergeOptions{.merge_window_s = 0}.problem(), std::nullopt);  // same instant only
+  EXPECT_EQ(RecognitionOptions{.tracking_gate_m = 0}.problem(),
+            "tracking_gate_m: 0 is not above 0");
+  EXPECT_EQ(TrackingOptions{.lost_after_s = std::numeric_limits<double>::infinity()}.problem(),
+            "lost_after_s: inf is not finite");
+  LocalizerOptions options;
+  options.merging.stale_after_s = -1;
+  EXPECT_EQ(options.problem(), "merging.stale_after_s: -1 is not above 0");
+  options = {};
+  options.recognition.pattern_tolerance_m = 0;
+  EXPECT_EQ(options.problem(), "recognition.pattern_tolerance_m: 0 is not above 0");
+  options = {};
+  options.tracking.lost_after_s = 0;
+  try {
+    RobotLocalizer localizer(seed_rig(), options);
+    ADD_FAILURE() << "lost_after_s 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "LocalizerOptions::tracking.lost_after_s: 0 is not above 0");
+  }
+  // Each step checks its own, named by its own struct.
+  try {
+    merge_views({}, {.merge_distance_m = 0});
+    ADD_FAILURE() << "merge_distance_m 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "MergeOptions::merge_distance_m: 0 is not above 0");
+  }
+  EXPECT_THROW(RobotTracker({"robot_a"}, {.lost_after_s = -1}), std::invalid_argument);
+  EXPECT_THROW(RobotRecognizer(seed_rig().robots, {.pattern_tolerance_m = 0}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -3,15 +3,27 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 namespace mocap::pixart {
 
+std::optional<std::string> PixartDecoderOptions::problem() const {
+  if (boxes < 1) return fmt::format("boxes: {} is below 1", boxes);
+  // At most 256 boxes of 8 IDs fit the 11-bit range; the last ID in 64 bits cannot wrap.
+  if (boxes > 256) {
+    return fmt::format("boxes: {}; at most 256 boxes of 8 IDs fit the 11-bit CAN IDs", boxes);
+  }
+  const uint64_t last_id = uint64_t{base_id} + 8u * static_cast<uint64_t>(boxes) - 1;
+  if (last_id > can::kMaxStandardId) {
+    return fmt::format("base_id: {:#x} with {} boxes needs CAN IDs up to {:#x}, above {:#x}",
+                       base_id, boxes, last_id, can::kMaxStandardId);
+  }
+  return std::nullopt;
+}
+
 PixartDecoder::PixartDecoder(PixartDecoderOptions options) : options_(options) {
-  // At most 256 boxes of 8 IDs fit the 11-bit range; checked first so that 8·boxes cannot wrap.
-  if (options_.boxes < 1 || options_.boxes > 256 || options_.base_id > 0x7FF ||
-      options_.base_id + 8u * static_cast<uint32_t>(options_.boxes) - 1 > 0x7FF) {
-    throw std::invalid_argument("PixArt decoder: base_id " + std::to_string(options_.base_id) +
-                                " with " + std::to_string(options_.boxes) +
-                                " boxes leaves the 11-bit CAN ID range");
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("PixartDecoderOptions::" + *problem);
   }
 }
 

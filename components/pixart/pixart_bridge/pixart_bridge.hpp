@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/can_io/can_frame.hpp"
@@ -34,6 +35,10 @@ struct PixartDecoderOptions {
   uint32_t base_id = 0x100;
   // Boxes on the bus: IDs base .. base + 8·boxes − 1 are PixArt frames, others unknown.
   int boxes = 8;
+
+  // Why these options cannot be used, naming the field ("boxes: 0 is below 1"); nullopt when
+  // they can. PixartDecoder's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct PixartDecodeStats {
@@ -47,7 +52,8 @@ struct PixartDecodeStats {
 
 class PixartDecoder {
  public:
-  // Throws std::invalid_argument for a base or box count that leaves the 11-bit ID range.
+  // Throws std::invalid_argument for options that cannot be used (a base or box count that
+  // leaves the 11-bit ID range).
   explicit PixartDecoder(PixartDecoderOptions options = {});
 
   // Appends the valid points of `frame` to `points`. Returns the camera the frame belongs to,

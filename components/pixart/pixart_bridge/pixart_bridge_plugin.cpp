@@ -82,8 +82,12 @@ class PixartBridge final : public Component {
       fiducials_.push_back(create_publisher<mocap_msgs::msg::FiducialArray>(
           topics::member_of(topics::kPixartFiducials, camera_name(camera))));
     }
-    // A log must exist now: a typo is an error at start, not a retry loop.
+    // A log must exist now, and an adaptor's settings must be usable: a typo is an error at
+    // start, not a retry loop.
     if (settings_.source == "candump") source_ = open();
+    if (auto problem = settings_.slcan.problem(); settings_.source == "slcan" && problem) {
+      throw std::invalid_argument("SlcanSourceOptions::" + *problem);
+    }
     // Reading starts with the graph (once the host has started every component), so no frame
     // is published before the subscribers exist.
     create_worker("reader", [this](std::stop_token stop) { read_loop(stop); });

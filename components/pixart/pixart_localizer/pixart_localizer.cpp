@@ -1,6 +1,5 @@
 #include "pixart/pixart_localizer/pixart_localizer.hpp"
 
-#include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -14,26 +13,23 @@ std::vector<std::string> robot_names(const Rig& rig) {
   return names;
 }
 
-void require_positive(double value, const char* name) {
-  if (!(value > 0) || !std::isfinite(value)) {
-    throw std::invalid_argument(fmt::format("{} is {}; it must be a positive number", name, value));
-  }
-}
-
+// The options, once they are known to be usable: the recognizer and the tracker are built
+// from them.
 const LocalizerOptions& checked(const LocalizerOptions& options) {
-  require_positive(options.merging.merge_distance_m, "merge_distance_m");
-  require_positive(options.merging.stale_after_s, "stale_after_s");
-  require_positive(options.recognition.pattern_tolerance_m, "pattern_tolerance_m");
-  require_positive(options.recognition.tracking_gate_m, "tracking_gate_m");
-  require_positive(options.tracking.lost_after_s, "lost_after_s");
-  if (!(options.merging.merge_window_s >= 0)) {
-    throw std::invalid_argument(fmt::format("merge_window_s is {}; it must not be negative",
-                                            options.merging.merge_window_s));
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("LocalizerOptions::" + *problem);
   }
   return options;
 }
 
 }  // namespace
+
+std::optional<std::string> LocalizerOptions::problem() const {
+  if (auto problem = merging.problem()) return "merging." + *problem;
+  if (auto problem = recognition.problem()) return "recognition." + *problem;
+  if (auto problem = tracking.problem()) return "tracking." + *problem;
+  return std::nullopt;
+}
 
 RobotLocalizer::RobotLocalizer(Rig rig, LocalizerOptions options)
     : rig_(std::move(rig)),

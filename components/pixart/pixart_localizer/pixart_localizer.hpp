@@ -40,6 +40,11 @@ struct LocalizerOptions {
   MergeOptions merging;
   RecognitionOptions recognition;
   TrackingOptions tracking;
+
+  // Why these options cannot be used, naming the field by its path
+  // ("tracking.lost_after_s: 0 is not above 0"); nullopt when they can. RobotLocalizer's
+  // constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct LocalizerStats {

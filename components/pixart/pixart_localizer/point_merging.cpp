@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace mocap::pixart::localization {
 namespace {
@@ -20,9 +23,24 @@ struct CandidatePair {
 
 int64_t to_ns(double seconds) { return static_cast<int64_t>(std::llround(seconds * 1e9)); }
 
+// Why `value` cannot be a distance or a time that must be positive: not above 0, or infinite.
+std::optional<std::string> not_positive(const char* name, double value) {
+  if (!(value > 0)) return fmt::format("{}: {} is not above 0", name, value);
+  if (!std::isfinite(value)) return fmt::format("{}: {} is not finite", name, value);
+  return std::nullopt;
+}
+
 }  // namespace
 
+std::optional<std::string> MergeOptions::problem() const {
+  if (auto problem = not_positive("merge_distance_m", merge_distance_m)) return problem;
+  if (!(merge_window_s >= 0)) return fmt::format("merge_window_s: {} is below 0", merge_window_s);
+  if (auto problem = not_positive("stale_after_s", stale_after_s)) return problem;
+  return std::nullopt;
+}
+
 MergedPoints merge_views(const std::vector<CameraView>& views, const MergeOptions& options) {
+  if (auto problem = options.problem()) throw std::invalid_argument("MergeOptions::" + *problem);
   MergedPoints merged;
   bool any = false;
   for (const CameraView& view : views) {

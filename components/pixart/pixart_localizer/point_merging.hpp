@@ -15,6 +15,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -32,6 +34,10 @@ struct MergeOptions {
   // Views older than this, relative to the newest view, take no part (the sensors sample at
   // about 270 Hz, every 3.7 ms).
   double stale_after_s = 0.02;
+
+  // Why these options cannot be used, naming the field ("merge_distance_m: 0 is not above
+  // 0"); nullopt when they can. merge_views throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // The cameras that saw a point: bit i for the rig's camera i (rigs have at most 64 cameras).

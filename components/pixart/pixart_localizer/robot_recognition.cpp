@@ -13,6 +13,13 @@ namespace {
 const std::tuple<size_t, size_t, size_t> kPermutations[] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
                                                             {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
 
+// Why `value` cannot be a distance that must be positive: not above 0, or infinite.
+std::optional<std::string> not_positive(const char* name, double value) {
+  if (!(value > 0)) return fmt::format("{}: {} is not above 0", name, value);
+  if (!std::isfinite(value)) return fmt::format("{}: {} is not finite", name, value);
+  return std::nullopt;
+}
+
 std::optional<std::string> layout_problem(const RobotModel& robot, double tolerance) {
   if (robot.leds.size() != 3) {
     return fmt::format("has {} LEDs; the recognizer needs the seed's 3", robot.leds.size());
@@ -58,8 +65,17 @@ const char* to_string(PoseEvidence evidence) {
   return "?";
 }
 
+std::optional<std::string> RecognitionOptions::problem() const {
+  if (auto problem = not_positive("pattern_tolerance_m", pattern_tolerance_m)) return problem;
+  if (auto problem = not_positive("tracking_gate_m", tracking_gate_m)) return problem;
+  return std::nullopt;
+}
+
 RobotRecognizer::RobotRecognizer(const std::vector<RobotModel>& robots, RecognitionOptions options)
     : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("RecognitionOptions::" + *problem);
+  }
   for (const RobotModel& robot : robots) {
     if (auto problem = layout_problem(robot, options_.pattern_tolerance_m)) {
       unsupported_.push_back(fmt::format("robot '{}': {}", robot.name, *problem));

@@ -57,6 +57,10 @@ struct RecognitionOptions {
   double pattern_tolerance_m = 0.008;
   // How far a steady LED may be from where its tracked robot had it, for steps 2 and 3.
   double tracking_gate_m = 0.1;
+
+  // Why these options cannot be used, naming the field ("tracking_gate_m: 0 is not above 0");
+  // nullopt when they can. RobotRecognizer's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // How a pose was measured.

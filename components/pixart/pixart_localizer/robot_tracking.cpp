@@ -1,12 +1,26 @@
 #include "pixart/pixart_localizer/robot_tracking.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <utility>
+
+#include <fmt/format.h>
 
 namespace mocap::pixart::localization {
 
+std::optional<std::string> TrackingOptions::problem() const {
+  if (!(lost_after_s > 0)) return fmt::format("lost_after_s: {} is not above 0", lost_after_s);
+  if (!std::isfinite(lost_after_s)) {
+    return fmt::format("lost_after_s: {} is not finite", lost_after_s);
+  }
+  return std::nullopt;
+}
+
 RobotTracker::RobotTracker(std::vector<std::string> robot_names, TrackingOptions options)
     : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("TrackingOptions::" + *problem);
+  }
   for (std::string& name : robot_names) {
     TrackedRobot robot;
     robot.name = std::move(name);

@@ -19,6 +19,10 @@ namespace mocap::pixart::localization {
 
 struct TrackingOptions {
   double lost_after_s = 1.0;  // a robot not read for this long is dropped
+
+  // Why these options cannot be used, naming the field ("lost_after_s: 0 is not above 0");
+  // nullopt when they can. RobotTracker's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct TrackedRobot {
