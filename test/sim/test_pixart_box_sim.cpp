@@ -7,10 +7,14 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include <mocap/component_host.hpp>
@@ -820,6 +824,56 @@ TEST(PixartBoxSimPlugin, BadParametersAreClearErrors) {
       EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
     }
   }
+}
+
+// --- options ----------------------------------------------------------------------------------
+// Options built in code get the checks a launch file's parameters get from the plugin's ranges:
+// what takes them refuses them first, naming the field.
+
+TEST(PixartBoxSimulatorOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(PixartBoxSimulatorOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(PixartBoxSimulatorOptions{.noise_px = -1}.problem(), "noise_px: -1 is below 0");
+  EXPECT_EQ(
+      PixartBoxSimulatorOptions{.noise_px = std::numeric_limits<double>::infinity()}.problem(),
+      "noise_px: inf is not finite");
+  EXPECT_EQ(PixartBoxSimulatorOptions{.base_id = 0x7FF}.problem(),
+            "base_id: 0x7ff leaves no room for camera 0's second frame (IDs end at 0x7ff)");
+  // A base beyond 32 bits' reach of the 11-bit range does not wrap around into it.
+  EXPECT_EQ(PixartBoxSimulatorOptions{.base_id = 0xFFFFFFFF}.problem(),
+            "base_id: 0xffffffff leaves no room for camera 0's second frame (IDs end at 0x7ff)");
+  const Rig rig = test_rig();
+  try {
+    PixartBoxSimulator simulator(rig, scene_of("robots: []", rig), {.noise_px = -1});
+    ADD_FAILURE() << "negative noise accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "PixartBoxSimulatorOptions::noise_px: -1 is below 0");
+  }
+}
+
+TEST(CandumpRecordingOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(CandumpRecordingOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(CandumpRecordingOptions{.duration_s = -1}.problem(), "duration_s: -1 is below 0");
+  EXPECT_EQ(CandumpRecordingOptions{.rate_hz = 0}.problem(), "rate_hz: 0 is not above 0");
+  EXPECT_EQ(CandumpRecordingOptions{.rate_hz = 2e5}.problem(), "rate_hz: 200000 is above 100000");
+  EXPECT_EQ(CandumpRecordingOptions{.start_ns = -1}.problem(),
+            "start_ns: -1 is below 0 (candump stamps from 1970)");
+  EXPECT_EQ(CandumpRecordingOptions{.interface = "can 0"}.problem(),
+            "interface: 'can 0' is empty or holds blanks");
+  // The truth's rate counts only with a stream to write the truth to.
+  std::ostringstream truth;
+  EXPECT_EQ(CandumpRecordingOptions{.truth_rate_hz = 0}.problem(), std::nullopt);
+  EXPECT_EQ((CandumpRecordingOptions{.truth = &truth, .truth_rate_hz = 0}.problem()),
+            "truth_rate_hz: 0 is not above 0 (a truth stream is given)");
+  const Rig rig = test_rig();
+  PixartBoxSimulator simulator(rig, scene_of("robots: []", rig));
+  std::ostringstream log;
+  try {
+    write_candump_recording(simulator, log, {.rate_hz = 0});
+    ADD_FAILURE() << "rate 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "CandumpRecordingOptions::rate_hz: 0 is not above 0");
+  }
+  EXPECT_TRUE(log.str().empty());
 }
 
 }  // namespace

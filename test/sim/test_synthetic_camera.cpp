@@ -5,6 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -717,6 +720,22 @@ TEST(IrRenderer, ExposureScalesAndSaturatesMarkers) {
                      static_cast<int>(std::lround(marker.pixel.y())));
     EXPECT_EQ(a.image.at<uint8_t>(centre), 255);  // 8 + 255: saturated
     EXPECT_NEAR(b.image.at<uint8_t>(centre), 8 + 0.3 * 255, 1.0);
+  }
+}
+
+// A scene file's render options are checked as it loads; options built in code get the checks
+// from the renderer, which names the field.
+TEST(RenderOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(RenderOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(RenderOptions{.marker_diameter_m = 0}.problem(), "marker_diameter_m: 0 is not above 0");
+  EXPECT_EQ(RenderOptions{.noise_sigma_dn = -2}.problem(), "noise_sigma_dn: -2 is below 0");
+  EXPECT_EQ(RenderOptions{.supersampling = 0}.problem(), "supersampling: 0 is below 1");
+  EXPECT_EQ(RenderOptions{.motion_blur_steps = -1}.problem(), "motion_blur_steps: -1 is below 0");
+  try {
+    IrRenderer renderer(board_scene(StaticTrajectory{}, {.exposure = -1}), ideal_camera());
+    ADD_FAILURE() << "negative exposure accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "RenderOptions::exposure: -1 is below 0");
   }
 }
 

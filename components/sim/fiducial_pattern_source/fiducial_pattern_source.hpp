@@ -1,6 +1,8 @@
 // A synthetic fiducial pattern: a stand-in for a tracked target, for demos and tests.
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace mocap::demo {
@@ -16,6 +18,10 @@ struct PatternOptions {
   double image_height = 720;
   double radius_px = 200;
   double turns_per_second = 0.1;
+
+  // Why these options cannot be used, naming the field ("count: 0 is below 1"); nullopt when
+  // they can. fiducial_pattern throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // `options.count` points evenly spaced on a circle centred in the image, turning at

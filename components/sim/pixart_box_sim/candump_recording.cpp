@@ -24,10 +24,39 @@ void write_truth(const PixartBoxSimulator& simulator, double time_s, int64_t sta
   if (!out) throw std::runtime_error("cannot write the ground truth");
 }
 
+// Why `rate_hz` cannot be a rate of a SampleSchedule.
+std::optional<std::string> rate_problem(const char* name, double rate_hz) {
+  if (!(rate_hz > 0)) return fmt::format("{}: {} is not above 0", name, rate_hz);
+  if (rate_hz > kMaxSampleRate_hz) {
+    return fmt::format("{}: {} is above {}", name, rate_hz, kMaxSampleRate_hz);
+  }
+  return std::nullopt;
+}
+
 }  // namespace
+
+std::optional<std::string> CandumpRecordingOptions::problem() const {
+  if (!(duration_s >= 0)) return fmt::format("duration_s: {} is below 0", duration_s);
+  if (!std::isfinite(duration_s)) return fmt::format("duration_s: {} is not finite", duration_s);
+  if (auto problem = rate_problem("rate_hz", rate_hz)) return problem;
+  if (start_ns < 0) {
+    return fmt::format("start_ns: {} is below 0 (candump stamps from 1970)", start_ns);
+  }
+  if (interface.empty() || interface.find_first_of(" \t\r\n") != std::string::npos) {
+    return fmt::format("interface: '{}' is empty or holds blanks", interface);
+  }
+  // Without a stream the rate is not used.
+  if (auto problem = rate_problem("truth_rate_hz", truth_rate_hz); truth != nullptr && problem) {
+    return *problem + " (a truth stream is given)";
+  }
+  return std::nullopt;
+}
 
 uint64_t write_candump_recording(PixartBoxSimulator& simulator, std::ostream& out,
                                  const CandumpRecordingOptions& options, std::stop_token stop) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("CandumpRecordingOptions::" + *problem);
+  }
   const SampleSchedule schedule(options.rate_hz);
   const uint64_t samples = schedule.samples_before(options.duration_s);
   const size_t frames_per_sample = 2 * simulator.rig().cameras.size();
@@ -38,7 +67,7 @@ uint64_t write_candump_recording(PixartBoxSimulator& simulator, std::ostream& ou
           : std::min(kFrameOnBus_ns, period_ns / static_cast<int64_t>(frames_per_sample));
   can::CandumpRecord record;
   record.interface = options.interface;
-  const bool with_truth = options.truth != nullptr && options.truth_rate_hz > 0;
+  const bool with_truth = options.truth != nullptr;
   if (with_truth) *options.truth << kTruthCsvHeader << '\n';
   const SampleSchedule truth_schedule(with_truth ? options.truth_rate_hz : 1);
   uint64_t next_truth = 0;

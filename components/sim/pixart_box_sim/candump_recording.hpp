@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <stop_token>
 #include <string>
@@ -27,6 +28,10 @@ struct CandumpRecordingOptions {
   // `truth` (none when null).
   std::ostream* truth = nullptr;
   double truth_rate_hz = 50;
+
+  // Why these options cannot be used, naming the field ("rate_hz: 0 is not above 0"); nullopt
+  // when they can. write_candump_recording throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // The header line of the ground-truth CSV.
@@ -36,7 +41,8 @@ inline constexpr const char* kTruthCsvHeader = "stamp_ns,robot,x_m,y_m,theta_rad
 // frames follow each other on the bus: frame i of sample k is stamped start + k/rate plus
 // i · 130 µs (a classic 8-byte frame with stuffing at 1 Mbit/s), squeezed when the sample
 // period is too short for that. Stops early, between samples, when `stop` is requested.
-// Returns the number of frames written. Throws std::runtime_error when a stream fails.
+// Returns the number of frames written. Throws std::invalid_argument for options that cannot
+// be used, std::runtime_error when a stream fails.
 uint64_t write_candump_recording(PixartBoxSimulator& simulator, std::ostream& out,
                                  const CandumpRecordingOptions& options, std::stop_token stop = {});
 

@@ -9,12 +9,25 @@
 
 namespace mocap::pixart {
 
+std::optional<std::string> PixartBoxSimulatorOptions::problem() const {
+  // Camera 0's two frames at least; the rig's cameras are checked with the rig. In 64 bits,
+  // so that no base_id wraps.
+  if (uint64_t{base_id} + 1 > can::kMaxStandardId) {
+    return fmt::format(
+        "base_id: {:#x} leaves no room for camera 0's second frame (IDs end at "
+        "{:#x})",
+        base_id, can::kMaxStandardId);
+  }
+  if (!(noise_px >= 0)) return fmt::format("noise_px: {} is below 0", noise_px);
+  if (!std::isfinite(noise_px)) return fmt::format("noise_px: {} is not finite", noise_px);
+  return std::nullopt;
+}
+
 PixartBoxSimulator::PixartBoxSimulator(Rig rig, PixartScene scene,
                                        PixartBoxSimulatorOptions options)
     : rig_(std::move(rig)), scene_(std::move(scene)), options_(options), random_(options.seed) {
-  if (!(options_.noise_px >= 0) || !std::isfinite(options_.noise_px)) {
-    throw std::invalid_argument(
-        fmt::format("PixArt box simulator: noise_px is {}, must be >= 0", options_.noise_px));
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("PixartBoxSimulatorOptions::" + *problem);
   }
   for (const RigCamera& camera : rig_.cameras) {
     if (options_.base_id + 2u * static_cast<uint32_t>(camera.camera_id) + 1 > can::kMaxStandardId) {

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -30,6 +31,10 @@ struct PixartBoxSimulatorOptions {
   double noise_px = 0;
   // Seeds the noise: the same seed and the same calls give the same frames.
   uint64_t seed = 1;
+
+  // Why these options cannot be used, naming the field ("noise_px: -1 is below 0"); nullopt
+  // when they can. PixartBoxSimulator's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // An LED a camera reports, and which LED it is (for tests and diagnostics: the sensor itself
@@ -62,8 +67,8 @@ struct PixartBoxSimulatorStats {
 
 class PixartBoxSimulator {
  public:
-  // Throws std::invalid_argument when a camera's frames would leave the 11-bit CAN ID range
-  // (base_id + 2·camera_id + 1 > 0x7FF), or noise_px is negative.
+  // Throws std::invalid_argument for options that cannot be used, and when a camera's frames
+  // would leave the 11-bit CAN ID range (base_id + 2·camera_id + 1 > 0x7FF).
   PixartBoxSimulator(Rig rig, PixartScene scene, PixartBoxSimulatorOptions options = {});
 
   // Every camera's sample at scene time `time_s`, in the rig's camera order. Draws noise (when

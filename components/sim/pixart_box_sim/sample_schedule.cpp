@@ -11,14 +11,13 @@ namespace {
 // Sample times are index / rate; products like (index / rate) * rate land a hair below the
 // index, which must still count as the index.
 constexpr double kIndexTolerance = 1e-9;
-constexpr double kMaxRate_hz = 100000;
 
 }  // namespace
 
 SampleSchedule::SampleSchedule(double rate_hz) : rate_hz_(rate_hz) {
-  if (!(rate_hz > 0 && rate_hz <= kMaxRate_hz)) {
-    throw std::invalid_argument(
-        fmt::format("sample rate {} Hz: must be above 0 and at most {} Hz", rate_hz, kMaxRate_hz));
+  if (!(rate_hz > 0 && rate_hz <= kMaxSampleRate_hz)) {
+    throw std::invalid_argument(fmt::format("sample rate {} Hz: must be above 0 and at most {} Hz",
+                                            rate_hz, kMaxSampleRate_hz));
   }
 }
 

@@ -8,9 +8,12 @@
 
 namespace mocap::pixart {
 
+// The highest sample rate a schedule takes.
+inline constexpr double kMaxSampleRate_hz = 100000;
+
 class SampleSchedule {
  public:
-  // Throws std::invalid_argument unless 0 < rate_hz <= 100 kHz.
+  // Throws std::invalid_argument unless 0 < rate_hz <= kMaxSampleRate_hz.
   explicit SampleSchedule(double rate_hz);
 
   double rate_hz() const { return rate_hz_; }

@@ -42,6 +42,15 @@ double pixel_coverage(int u, int v, int samples, Inside inside) {
   return static_cast<double>(count) / (samples * samples);
 }
 
+// The scene, once its render options are known to be usable: the members built from them (the
+// noise, the markers' radius) need it.
+Scene checked(Scene scene) {
+  if (auto problem = scene.render.problem()) {
+    throw std::invalid_argument("RenderOptions::" + *problem);
+  }
+  return scene;
+}
+
 }  // namespace
 
 int ObjectTruth::visible_markers() const {
@@ -57,19 +66,13 @@ struct IrRenderer::DiscView {
 };
 
 IrRenderer::IrRenderer(Scene scene, std::shared_ptr<const calibration::CameraModel> camera)
-    : scene_(std::move(scene)),
+    : scene_(checked(std::move(scene))),
       camera_(camera ? std::move(camera)
                      : throw std::invalid_argument("IrRenderer: no camera model")),
       rays_(camera_),
       noise_(camera_->width(), camera_->height(), scene_.render.noise_sigma_dn, scene_.seed),
       marker_radius_m_(0.5 * scene_.render.marker_diameter_m),
       peak_dn_(255.0 * scene_.render.exposure) {
-  if (scene_.render.supersampling < 1 || !(scene_.render.marker_diameter_m > 0) ||
-      scene_.render.blur_sigma_px < 0 || scene_.render.motion_blur_steps < 0) {
-    throw std::invalid_argument(
-        "IrRenderer: supersampling must be >= 1, marker_diameter_m > 0, blur_sigma_px and "
-        "motion_blur_steps >= 0");
-  }
   draw_static_layer();
   for (int pattern = 0; pattern < noise_.patterns(); ++pattern) {
     cv::Mat sum;

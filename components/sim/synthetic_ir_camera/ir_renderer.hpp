@@ -75,8 +75,8 @@ class IrRenderer {
   // A frame is then that background copied, and drawn in floating point only where something
   // moves or changes (markers, occluders, hot points): the same pixels as drawing the whole
   // frame in floating point, at a fraction of the cost (four 1280x720 cameras at 120 Hz on
-  // two cores). Throws std::invalid_argument for a null camera or render options out of range
-  // (load_scene checks those of a file).
+  // two cores). Throws std::invalid_argument for a null camera or render options that cannot
+  // be used (RenderOptions::problem; load_scene checks those of a file).
   IrRenderer(Scene scene, std::shared_ptr<const calibration::CameraModel> camera);
 
   // The frame whose exposure is centred on scene time `time_s`. `frame_number` selects the

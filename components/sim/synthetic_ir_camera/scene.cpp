@@ -231,6 +231,21 @@ class SceneReader : YamlReader<SceneError> {
 
 }  // namespace
 
+std::optional<std::string> RenderOptions::problem() const {
+  if (!(marker_diameter_m > 0)) {
+    return fmt::format("marker_diameter_m: {} is not above 0", marker_diameter_m);
+  }
+  if (!(exposure >= 0)) return fmt::format("exposure: {} is below 0", exposure);
+  if (!(noise_sigma_dn >= 0)) return fmt::format("noise_sigma_dn: {} is below 0", noise_sigma_dn);
+  if (!(blur_sigma_px >= 0)) return fmt::format("blur_sigma_px: {} is below 0", blur_sigma_px);
+  if (!(motion_blur_s >= 0)) return fmt::format("motion_blur_s: {} is below 0", motion_blur_s);
+  if (motion_blur_steps < 0) {
+    return fmt::format("motion_blur_steps: {} is below 0", motion_blur_steps);
+  }
+  if (supersampling < 1) return fmt::format("supersampling: {} is below 1", supersampling);
+  return std::nullopt;
+}
+
 Scene parse_scene(const std::string& text, const std::string& source,
                   const constellations::ConstellationDatabase& database) {
   YAML::Node root = YamlReader<SceneError>(source).parse(text);

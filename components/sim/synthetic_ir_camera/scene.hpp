@@ -52,6 +52,10 @@ struct RenderOptions {
   double motion_blur_s = 0;    // exposure time; 0 = instantaneous
   int motion_blur_steps = 0;   // sub-poses over the exposure; 0 = enough for 0.25 px steps
   int supersampling = 4;       // rays per pixel side on a marker's edge (4 = 16 rays)
+
+  // Why these options cannot be used, naming the field ("supersampling: 0 is below 1");
+  // nullopt when they can. IrRenderer's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // A bright shape that is not a marker: a reflection, a screen, a strip light.
