@@ -16,7 +16,10 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include <fmt/format.h>
@@ -351,8 +354,8 @@ TEST(VrpnServer, BadAddressesAreNamed) {
   try {
     TrackerServer server({.address = "localhost"});
     ADD_FAILURE() << "accepted a host name";
-  } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "address: 'localhost' is not an IPv4 address");
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "TrackerServerOptions::address: 'localhost' is not an IPv4 address");
   }
   TrackerServer first({.port = 0});
   EXPECT_TRUE(first.loopback_only());
@@ -363,6 +366,24 @@ TEST(VrpnServer, BadAddressesAreNamed) {
     EXPECT_EQ(std::string(e.what()),
               fmt::format("address/port: cannot listen on TCP 127.0.0.1:{}: Address already in use",
                           first.port()));
+  }
+}
+
+// Options built in code get the checks a launch file's parameters get from the plugin's ranges:
+// the server refuses them before it listens, naming the field.
+TEST(TrackerServerOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(TrackerServerOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(TrackerServerOptions{.address = "::1"}.problem(),
+            "address: '::1' is not an IPv4 address");
+  EXPECT_EQ(TrackerServerOptions{.max_queued_bytes = 0}.problem(),
+            "max_queued_bytes: 0 leaves no room for a report");
+  EXPECT_EQ(TrackerServerOptions{.max_clients = 0}.problem(),
+            "max_clients: 0; every client would be refused");
+  try {
+    TrackerServer server({.port = 0, .max_clients = 0});
+    ADD_FAILURE() << "a server for no client accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "TrackerServerOptions::max_clients: 0; every client would be refused");
   }
 }
 

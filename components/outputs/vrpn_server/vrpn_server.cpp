@@ -123,9 +123,7 @@ struct TrackerServer::Impl {
     address.sin_family = AF_INET;
     address.sin_port = htons(requested.port);
     const std::string where = fmt::format("{}:{}", requested.address, requested.port);
-    if (inet_pton(AF_INET, requested.address.c_str(), &address.sin_addr) != 1) {
-      throw std::runtime_error("address: '" + requested.address + "' is not an IPv4 address");
-    }
+    inet_pton(AF_INET, requested.address.c_str(), &address.sin_addr);  // checked by problem()
     loopback = (ntohl(address.sin_addr.s_addr) >> 24) == 127;
     tcp_fd = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     const int on = 1;
@@ -398,7 +396,21 @@ struct TrackerServer::Impl {
   }
 };
 
-TrackerServer::TrackerServer(TrackerServerOptions options) : impl_(std::make_unique<Impl>()) {
+std::optional<std::string> TrackerServerOptions::problem() const {
+  in_addr parsed{};
+  if (inet_pton(AF_INET, address.c_str(), &parsed) != 1) {
+    return fmt::format("address: '{}' is not an IPv4 address", address);
+  }
+  if (max_queued_bytes == 0) return "max_queued_bytes: 0 leaves no room for a report";
+  if (max_clients == 0) return "max_clients: 0; every client would be refused";
+  return std::nullopt;
+}
+
+TrackerServer::TrackerServer(TrackerServerOptions options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("TrackerServerOptions::" + *problem);
+  }
+  impl_ = std::make_unique<Impl>();
   impl_->options = options;
   impl_->listen(options);
   impl_->thread = std::thread([impl = impl_.get()] { impl->run(); });

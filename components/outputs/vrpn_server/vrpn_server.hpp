@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -31,6 +32,11 @@ struct TrackerServerOptions {
   uint16_t port = kDefaultPort;       // TCP and UDP; 0: any free port (port() tells which)
   size_t max_queued_bytes = 1 << 20;  // per client
   size_t max_clients = 64;
+
+  // Why these options cannot be used, naming the field ("address: 'localhost' is not an IPv4
+  // address"); nullopt when they can. TrackerServer's constructor throws std::invalid_argument
+  // with it.
+  std::optional<std::string> problem() const;
 };
 
 struct TrackerServerStats {
@@ -61,8 +67,9 @@ struct TrackerReport {
 
 class TrackerServer {
  public:
-  // Listens and starts the thread. Throws std::runtime_error naming address:port when the
-  // address is not this machine's IPv4 address or the port is taken.
+  // Listens and starts the thread. Throws std::invalid_argument for options that cannot be used
+  // (an address that is not an IPv4 address), std::runtime_error naming address:port when the
+  // address is not this machine's or the port is taken.
   explicit TrackerServer(TrackerServerOptions options);
   // Closes every connection and joins the thread.
   ~TrackerServer();
