@@ -315,8 +315,10 @@ TEST(DriveFollowerPlugin, WrongParametersAreClearErrors) {
   message = error({{"max_linear_mps", std::string("fast")}});
   EXPECT_NE(message.find("max_linear_mps"), std::string::npos) << message;
   message = error({{"arrival_tolerance_m", 0.5}});
-  EXPECT_NE(message.find("arrival_tolerance_m (0.5"), std::string::npos) << message;
-  EXPECT_NE(message.find("goal_tolerance_m (0.25"), std::string::npos) << message;
+  EXPECT_NE(message.find("FollowerOptions::drive.arrival_tolerance_m: 0.5 is above "
+                         "goal_tolerance_m (0.25)"),
+            std::string::npos)
+      << message;
   message = error({{"tilt_joint", std::string("pan")}});
   EXPECT_NE(message.find("pan_joint and tilt_joint are both 'pan'"), std::string::npos) << message;
   message = error({{"turret", std::string("/nonexistent/turret.yaml")}});

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -263,10 +265,26 @@ TEST(DynamixelBus, UnpluggedAdaptorIsPortGone) {
 }
 
 TEST(DynamixelBus, RefusesBadOptions) {
+  EXPECT_EQ(DynamixelBusOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(DynamixelBusOptions{.retries = -1}.problem(), "retries: -1 is below 0");
+  EXPECT_EQ(DynamixelBusOptions{.status_return_level = 3}.problem(),
+            "status_return_level: 3 is not 0, 1 or 2");
+  EXPECT_EQ(DynamixelBusOptions{.reply_timeout = std::chrono::milliseconds(-1)}.problem(),
+            "reply_timeout: -1 ms is below 0");
+  // The serial port's fields, named as the bus names them.
+  EXPECT_EQ(DynamixelBusOptions{.write_timeout = std::chrono::milliseconds(-2)}.problem(),
+            "write_timeout: -2 ms is below 0");
+  EXPECT_EQ(DynamixelBusOptions{.baud_rate = 12345}.problem()->rfind(
+                "baud_rate: 12345 is not supported; supported: 9600, ", 0),
+            0u);
   SimulatedServos servos({{"ids", std::vector<int64_t>{1}}});
+  try {
+    DynamixelBus bus(servos.device(), DynamixelBusOptions{.retries = -1});
+    ADD_FAILURE() << "negative retries accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "DynamixelBusOptions::retries: -1 is below 0");
+  }
   EXPECT_THROW(DynamixelBus(servos.device(), DynamixelBusOptions{.baud_rate = 12345}),
-               std::invalid_argument);
-  EXPECT_THROW(DynamixelBus(servos.device(), DynamixelBusOptions{.retries = -1}),
                std::invalid_argument);
   EXPECT_THROW(DynamixelBus(servos.device(), DynamixelBusOptions{.status_return_level = 3}),
                std::invalid_argument);

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -359,6 +361,21 @@ TEST(Ax12ControlTable, SpeedLoadVoltageAndTemperatureConversions) {
   EXPECT_NEAR(ax12::present_load_to_fraction(1024 + 512), -512 / 1023.0, 1e-12);
   EXPECT_NEAR(ax12::voltage_to_volts(121), 12.1, 1e-12);
   EXPECT_EQ(ax12::temperature_to_celsius(70), 70.0);
+}
+
+// Below 2 every LEN would be a length error: the parser would find no packet at all.
+TEST(PacketParserOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(PacketParserOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(PacketParserOptions{.max_length = 2}.problem(), std::nullopt);
+  EXPECT_EQ(PacketParserOptions{.max_length = 1}.problem(),
+            "max_length: 1; a packet's LEN is 2 at least");
+  try {
+    PacketParser parser({.max_length = 0});
+    ADD_FAILURE() << "max_length 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "PacketParserOptions::max_length: 0; a packet's LEN is 2 at least");
+  }
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "follower/follower_monitor/follower_monitor.hpp"
 
@@ -61,6 +64,22 @@ TEST(Spread, MedianPercentileAndMaximum) {
   EXPECT_EQ(s.p95, 96);
   EXPECT_EQ(s.max, 100);
   EXPECT_TRUE(std::isnan(spread({}).median));
+}
+
+// A negative speed would count the object as walking forever, and no distance as steady.
+TEST(FollowEvaluationOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(FollowEvaluationOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(FollowEvaluationOptions{.walking_speed_mps = -0.1}.problem(),
+            "walking_speed_mps: -0.1 is below 0");
+  EXPECT_EQ(FollowEvaluationOptions{.speed_window_s = -1}.problem(),
+            "speed_window_s: -1 is below 0");
+  EXPECT_EQ(FollowEvaluationOptions{.settle_s = 0}.problem(), std::nullopt);  // steady at once
+  try {
+    FollowEvaluator evaluator({.settle_s = -4});
+    ADD_FAILURE() << "a negative settle time accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "FollowEvaluationOptions::settle_s: -4 is below 0");
+  }
 }
 
 }  // namespace

@@ -8,8 +8,12 @@
 #include <cmath>
 #include <condition_variable>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -346,6 +350,24 @@ TEST(DynamixelFollowerPlugin, BadParametersAreClearErrors) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent.yaml: cannot read the turret"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// The plugin's parameter ranges keep a launch file's options usable; options built in code get
+// the same checks from the follower, which names the field.
+TEST(TurretFollowerOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(TurretFollowerOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(TurretFollowerOptions{.pan_speed_rps = 0}.problem(), "pan_speed_rps: 0 is not above 0");
+  EXPECT_EQ(TurretFollowerOptions{.max_lead_s = -0.1}.problem(), "max_lead_s: -0.1 is below 0");
+  EXPECT_EQ(TurretFollowerOptions{.max_lead_s = 0}.problem(), std::nullopt);  // aim where seen
+  EXPECT_EQ(
+      TurretFollowerOptions{.velocity_window_s = std::numeric_limits<double>::infinity()}.problem(),
+      "velocity_window_s: inf is not finite");
+  try {
+    TurretFollower follower(shipped_turret(), {.hold_s = -1});
+    ADD_FAILURE() << "a negative hold accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "TurretFollowerOptions::hold_s: -1 is below 0");
   }
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 namespace mocap::drive {
 namespace {
 
@@ -13,10 +15,19 @@ double step_toward(double from, double to, double max_step) {
 
 }  // namespace
 
+std::optional<std::string> AccelerationLimits::problem() const {
+  if (!(max_linear_accel_mps2 > 0)) {
+    return fmt::format("max_linear_accel_mps2: {} is not above 0", max_linear_accel_mps2);
+  }
+  if (!(max_angular_accel_rps2 > 0)) {
+    return fmt::format("max_angular_accel_rps2: {} is not above 0", max_angular_accel_rps2);
+  }
+  return std::nullopt;
+}
+
 AccelerationLimiter::AccelerationLimiter(AccelerationLimits limits) : limits_(limits) {
-  if (!(limits_.max_linear_accel_mps2 > 0) || !(limits_.max_angular_accel_rps2 > 0)) {
-    throw std::invalid_argument(
-        "max_linear_accel_mps2 and max_angular_accel_rps2 must be positive");
+  if (auto problem = limits_.problem()) {
+    throw std::invalid_argument("AccelerationLimits::" + *problem);
   }
 }
 

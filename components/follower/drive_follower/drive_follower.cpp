@@ -5,19 +5,33 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 namespace mocap::drive {
+namespace {
+
+// The options, once they are known to be usable: the rules and the limiter are built from them.
+const FollowerOptions& checked(const FollowerOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("FollowerOptions::" + *problem);
+  }
+  return options;
+}
+
+}  // namespace
+
+std::optional<std::string> FollowerOptions::problem() const {
+  if (auto problem = drive.problem()) return "drive." + *problem;
+  if (auto problem = acceleration.problem()) return "acceleration." + *problem;
+  if (!(lost_after_s > 0)) return fmt::format("lost_after_s: {} is not above 0", lost_after_s);
+  if (!(control_period_s > 0)) {
+    return fmt::format("control_period_s: {} is not above 0", control_period_s);
+  }
+  return std::nullopt;
+}
 
 DriveFollower::DriveFollower(FollowerOptions options)
-    : options_(options), rules_(options.drive), limiter_(options.acceleration) {
-  if (!(options_.lost_after_s > 0)) {
-    throw std::invalid_argument("lost_after_s must be positive, not " +
-                                std::to_string(options_.lost_after_s));
-  }
-  if (!(options_.control_period_s > 0)) {
-    throw std::invalid_argument("control_period_s must be positive, not " +
-                                std::to_string(options_.control_period_s));
-  }
-}
+    : options_(checked(options)), rules_(options_.drive), limiter_(options_.acceleration) {}
 
 void DriveFollower::observe(const ObjectInBase& object, double time_s) {
   object_ = object;

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include "follower/drive_follower/acceleration_limiter.hpp"
 #include "follower/drive_follower/drive_rules.hpp"
@@ -25,6 +26,11 @@ struct FollowerOptions {
   // The nominal time between steps. The acceleration limits use the time since the previous
   // step but at most two periods, so a loop that stalled does not allow a jump.
   double control_period_s = 0.05;
+
+  // Why these options cannot be used, naming the field (nested ones by their path:
+  // "drive.linear_gain: 0 is not above 0"); nullopt when they can. DriveFollower's constructor
+  // throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 enum class TrackEvent {
@@ -41,7 +47,7 @@ struct FollowerStep {
 
 class DriveFollower {
  public:
-  // Validates the options (std::invalid_argument naming the option).
+  // Throws std::invalid_argument, naming the field, for options that cannot be used.
   explicit DriveFollower(FollowerOptions options = {});
 
   void observe(const ObjectInBase& object, double time_s);

@@ -5,14 +5,17 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 namespace mocap::drive {
 namespace {
 
-void require_positive(double value, const char* name) {
-  if (!(value > 0) || !std::isfinite(value)) {
-    throw std::invalid_argument(std::string(name) + " must be a positive number, not " +
-                                std::to_string(value));
-  }
+// Why `value` cannot be a distance, a gain or a limit, which must be positive: not above 0, or
+// infinite.
+std::optional<std::string> not_positive(const char* name, double value) {
+  if (!(value > 0)) return fmt::format("{}: {} is not above 0", name, value);
+  if (!std::isfinite(value)) return fmt::format("{}: {} is not finite", name, value);
+  return std::nullopt;
 }
 
 double wrap_angle(double angle) {
@@ -24,20 +27,20 @@ double clamp_magnitude(double value, double limit) { return std::clamp(value, -l
 
 }  // namespace
 
-void validate(const DriveOptions& options) {
-  require_positive(options.goal_distance_m, "goal_distance_m");
-  require_positive(options.goal_tolerance_m, "goal_tolerance_m");
-  require_positive(options.arrival_tolerance_m, "arrival_tolerance_m");
-  require_positive(options.linear_gain, "linear_gain");
-  require_positive(options.angular_gain, "angular_gain");
-  require_positive(options.max_linear_mps, "max_linear_mps");
-  require_positive(options.max_angular_rps, "max_angular_rps");
-  if (options.arrival_tolerance_m > options.goal_tolerance_m) {
-    throw std::invalid_argument("arrival_tolerance_m (" +
-                                std::to_string(options.arrival_tolerance_m) +
-                                ") must not be larger than goal_tolerance_m (" +
-                                std::to_string(options.goal_tolerance_m) + ")");
+std::optional<std::string> DriveOptions::problem() const {
+  if (auto problem = not_positive("goal_distance_m", goal_distance_m)) return problem;
+  if (auto problem = not_positive("goal_tolerance_m", goal_tolerance_m)) return problem;
+  if (auto problem = not_positive("arrival_tolerance_m", arrival_tolerance_m)) return problem;
+  if (auto problem = not_positive("linear_gain", linear_gain)) return problem;
+  if (auto problem = not_positive("angular_gain", angular_gain)) return problem;
+  if (auto problem = not_positive("max_linear_mps", max_linear_mps)) return problem;
+  if (auto problem = not_positive("max_angular_rps", max_angular_rps)) return problem;
+  // Rule 2 would stop outside the circle in which rule 1 holds, and start again at once.
+  if (arrival_tolerance_m > goal_tolerance_m) {
+    return fmt::format("arrival_tolerance_m: {} is above goal_tolerance_m ({})",
+                       arrival_tolerance_m, goal_tolerance_m);
   }
+  return std::nullopt;
 }
 
 std::string_view to_string(DriveRule rule) {
@@ -87,7 +90,9 @@ DriveCommand drive_command(const ObjectInBase& object, const DriveOptions& optio
   return command;
 }
 
-DriveRules::DriveRules(DriveOptions options) : options_(options) { validate(options_); }
+DriveRules::DriveRules(DriveOptions options) : options_(options) {
+  if (auto problem = options_.problem()) throw std::invalid_argument("DriveOptions::" + *problem);
+}
 
 DriveCommand DriveRules::command(const ObjectInBase& object) {
   const double face_within = holding_ ? options_.goal_tolerance_m : options_.arrival_tolerance_m;

@@ -19,6 +19,8 @@
 // every small movement of the object, yet it ends up close to the goal.
 #pragma once
 
+#include <optional>
+#include <string>
 #include <string_view>
 
 #include <Eigen/Core>
@@ -35,11 +37,13 @@ struct DriveOptions {
   double angular_gain = 2.0;          // rad/s per radian of heading error
   double max_linear_mps = 0.6;
   double max_angular_rps = 1.5;
-};
 
-// Throws std::invalid_argument naming the option: distances and gains must be positive, the
-// arrival tolerance no larger than the goal tolerance.
-void validate(const DriveOptions& options);
+  // Why these options cannot be used, naming the field ("linear_gain: 0 is not above 0"):
+  // distances, gains and limits must be positive, the arrival tolerance no larger than the goal
+  // tolerance; nullopt when they can. DriveRules' constructor throws std::invalid_argument
+  // with it.
+  std::optional<std::string> problem() const;
+};
 
 // The tracked object on the floor plane, in the base frame.
 struct ObjectInBase {
@@ -75,7 +79,7 @@ DriveCommand drive_command(const ObjectInBase& object, const DriveOptions& optio
 // The rules with hysteresis between the arrival and the goal tolerance (see above).
 class DriveRules {
  public:
-  explicit DriveRules(DriveOptions options = {});  // validates
+  explicit DriveRules(DriveOptions options = {});  // checks problem()
 
   DriveCommand command(const ObjectInBase& object);
   // True after the base arrived, until the goal moves beyond the goal tolerance.

@@ -15,18 +15,17 @@ constexpr size_t kEmptyStatusLength = 6;
 // 8 data bits, a start and a stop bit.
 constexpr double kBitsPerByte = 10;
 
+serial::SerialPortOptions port_options(const DynamixelBusOptions& options) {
+  return {.baud_rate = options.baud_rate,
+          .write_timeout = options.write_timeout,
+          .discard_pending_input = true};
+}
+
 serial::SerialPort open_port(std::string device, const DynamixelBusOptions& options) {
-  if (options.retries < 0) {
-    throw std::invalid_argument(fmt::format("Dynamixel bus: retries {} < 0", options.retries));
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("DynamixelBusOptions::" + *problem);
   }
-  if (options.status_return_level < 0 || options.status_return_level > 2) {
-    throw std::invalid_argument(fmt::format(
-        "Dynamixel bus: status return level {} is not 0, 1 or 2", options.status_return_level));
-  }
-  return serial::SerialPort(std::move(device),
-                            serial::SerialPortOptions{.baud_rate = options.baud_rate,
-                                                      .write_timeout = options.write_timeout,
-                                                      .discard_pending_input = true});
+  return serial::SerialPort(std::move(device), port_options(options));
 }
 
 std::string prefix(uint8_t id, uint8_t instruction) {
@@ -34,6 +33,22 @@ std::string prefix(uint8_t id, uint8_t instruction) {
 }
 
 }  // namespace
+
+std::optional<std::string> DynamixelBusOptions::problem() const {
+  // The port's own fields have the same names: baud_rate, write_timeout.
+  if (auto problem = port_options(*this).problem()) return problem;
+  if (reply_timeout.count() < 0) {
+    return fmt::format("reply_timeout: {} ms is below 0", reply_timeout.count());
+  }
+  if (retries < 0) return fmt::format("retries: {} is below 0", retries);
+  if (return_delay.count() < 0) {
+    return fmt::format("return_delay: {} us is below 0", return_delay.count());
+  }
+  if (status_return_level < 0 || status_return_level > 2) {
+    return fmt::format("status_return_level: {} is not 0, 1 or 2", status_return_level);
+  }
+  return std::nullopt;
+}
 
 std::string_view to_string(BusErrorKind kind) {
   switch (kind) {

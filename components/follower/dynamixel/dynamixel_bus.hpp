@@ -83,6 +83,10 @@ struct DynamixelBusOptions {
   int status_return_level = 2;
   // write_all gives up (kPortGone) when the device takes no bytes for this long.
   std::chrono::milliseconds write_timeout{200};
+
+  // Why these options cannot be used, naming the field ("retries: -1 is below 0"); nullopt
+  // when they can. DynamixelBus's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct DynamixelBusStats {
@@ -100,8 +104,8 @@ struct DynamixelBusStats {
 class DynamixelBus {
  public:
   // Opens `device` in raw mode at options.baud_rate. Throws serial::SerialError when it
-  // cannot be opened, std::invalid_argument for an unsupported baud rate, retries below 0 or a
-  // status return level outside 0..2.
+  // cannot be opened, std::invalid_argument for options that cannot be used (an unsupported
+  // baud rate, retries below 0, a status return level outside 0..2, a negative time).
   explicit DynamixelBus(std::string device, DynamixelBusOptions options = {});
 
   // Whether servo `id` answers. Returns its error bits (0 when all is well) rather than

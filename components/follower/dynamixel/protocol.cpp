@@ -129,7 +129,19 @@ std::string encode_status(uint8_t id, uint8_t errors, std::span<const uint8_t> p
 
 // --- PacketParser --------------------------------------------------------------------------
 
-PacketParser::PacketParser(PacketParserOptions options) : options_(options) {}
+std::optional<std::string> PacketParserOptions::problem() const {
+  // LEN counts the instruction (or error) byte and the checksum.
+  if (max_length < 2) {
+    return fmt::format("max_length: {}; a packet's LEN is 2 at least", max_length);
+  }
+  return std::nullopt;
+}
+
+PacketParser::PacketParser(PacketParserOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("PacketParserOptions::" + *problem);
+  }
+}
 
 void PacketParser::feed(std::string_view bytes) {
   buffer_.append(bytes);

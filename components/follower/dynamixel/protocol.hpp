@@ -112,6 +112,11 @@ struct PacketParserOptions {
   // LEN above this is a length error: the header is dropped and the search goes on. LEN below
   // 2 always is one.
   size_t max_length = kMaxParameters + 2;
+
+  // Why these options cannot be used, naming the field ("max_length: 1; a packet's LEN is 2 at
+  // least"); nullopt when they can. PacketParser's constructor throws std::invalid_argument
+  // with it.
+  std::optional<std::string> problem() const;
 };
 
 struct PacketParserStats {

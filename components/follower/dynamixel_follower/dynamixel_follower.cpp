@@ -5,14 +5,16 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 namespace mocap::turret {
 namespace {
 
-void require_positive(double value, const char* name) {
-  if (!(value > 0) || !std::isfinite(value)) {
-    throw std::invalid_argument(std::string(name) + " is " + std::to_string(value) +
-                                "; it must be a positive number");
-  }
+// Why `value` cannot be a speed or a time that must be positive: not above 0, or infinite.
+std::optional<std::string> not_positive(const char* name, double value) {
+  if (!(value > 0)) return fmt::format("{}: {} is not above 0", name, value);
+  if (!std::isfinite(value)) return fmt::format("{}: {} is not finite", name, value);
+  return std::nullopt;
 }
 
 }  // namespace
@@ -31,15 +33,22 @@ const char* to_string(TurretMode mode) {
   return "?";
 }
 
+std::optional<std::string> TurretFollowerOptions::problem() const {
+  if (auto problem = not_positive("pan_speed_rps", pan_speed_rps)) return problem;
+  if (auto problem = not_positive("tilt_speed_rps", tilt_speed_rps)) return problem;
+  if (auto problem = not_positive("lost_after_s", lost_after_s)) return problem;
+  if (!(max_lead_s >= 0)) return fmt::format("max_lead_s: {} is below 0", max_lead_s);
+  if (auto problem = not_positive("velocity_window_s", velocity_window_s)) return problem;
+  if (!(hold_s >= 0)) return fmt::format("hold_s: {} is below 0", hold_s);
+  if (auto problem = not_positive("search_speed_rps", search_speed_rps)) return problem;
+  return std::nullopt;
+}
+
 TurretFollower::TurretFollower(TurretModel turret, TurretFollowerOptions options)
     : turret_(std::move(turret)), options_(options) {
-  require_positive(options_.pan_speed_rps, "pan_speed_rps");
-  require_positive(options_.tilt_speed_rps, "tilt_speed_rps");
-  require_positive(options_.lost_after_s, "lost_after_s");
-  require_positive(options_.search_speed_rps, "search_speed_rps");
-  require_positive(options_.velocity_window_s, "velocity_window_s");
-  if (!(options_.hold_s >= 0)) throw std::invalid_argument("hold_s must not be negative");
-  if (!(options_.max_lead_s >= 0)) throw std::invalid_argument("max_lead_s must not be negative");
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("TurretFollowerOptions::" + *problem);
+  }
 }
 
 void TurretFollower::observe(int64_t stamp_ns, const Eigen::Vector3d& in_camera,

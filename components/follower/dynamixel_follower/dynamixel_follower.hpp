@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <utility>
 
 #include <Eigen/Core>
@@ -42,6 +43,12 @@ struct TurretFollowerOptions {
   // Searching sweeps the pan joint between its limits at search_speed_rps, tilt level.
   bool search = false;
   double search_speed_rps = 0.3;
+
+  // Why these options cannot be used, naming the field ("pan_speed_rps: 0 is not above 0"):
+  // speeds, lost_after_s and velocity_window_s must be positive, max_lead_s and hold_s not
+  // negative; nullopt when they can. TurretFollower's constructor throws std::invalid_argument
+  // with it.
+  std::optional<std::string> problem() const;
 };
 
 enum class TurretMode {
@@ -65,7 +72,7 @@ struct TurretCommand {
 
 class TurretFollower {
  public:
-  // Throws std::invalid_argument for speeds or times that are not positive.
+  // Throws std::invalid_argument for options that cannot be used (problem()).
   explicit TurretFollower(TurretModel turret, TurretFollowerOptions options = {});
 
   // The object seen at `stamp_ns` at `in_camera` (camera frame, metres), when the joints were

@@ -3,8 +3,27 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace mocap::evaluation {
+
+std::optional<std::string> FollowEvaluationOptions::problem() const {
+  // A negative speed would count every object as walking, and none would ever stand.
+  if (!(walking_speed_mps >= 0)) {
+    return fmt::format("walking_speed_mps: {} is below 0", walking_speed_mps);
+  }
+  if (!(speed_window_s >= 0)) return fmt::format("speed_window_s: {} is below 0", speed_window_s);
+  if (!(settle_s >= 0)) return fmt::format("settle_s: {} is below 0", settle_s);
+  return std::nullopt;
+}
+
+FollowEvaluator::FollowEvaluator(FollowEvaluationOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("FollowEvaluationOptions::" + *problem);
+  }
+}
 
 void FollowEvaluator::add_truth(int64_t stamp_ns, const Eigen::Vector3d& object_in_camera,
                                 const Eigen::Isometry3d& world_from_camera, bool trackable) {

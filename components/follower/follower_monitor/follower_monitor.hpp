@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -22,6 +23,10 @@ struct FollowEvaluationOptions {
   double speed_window_s = 0.5;
   // Standing this long: the follower has had time to settle, distances count as steady.
   double settle_s = 4.0;
+
+  // Why these options cannot be used, naming the field ("settle_s: -1 is below 0"); nullopt
+  // when they can. FollowEvaluator's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct FollowFigures {
@@ -37,7 +42,7 @@ struct FollowFigures {
 
 class FollowEvaluator {
  public:
-  explicit FollowEvaluator(FollowEvaluationOptions options = {}) : options_(options) {}
+  explicit FollowEvaluator(FollowEvaluationOptions options = {});
 
   // A ground-truth frame: the object in the camera frame, the camera in the world, whether
   // the object can be tracked in it.
