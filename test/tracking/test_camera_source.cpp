@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -299,6 +301,20 @@ TEST_F(CameraSourcePlugin, NeedsExactlyOneSource) {
   EXPECT_NE(code, 0);
   EXPECT_NE(output.find(dir_.path().string() + "/missing' does not exist"), std::string::npos)
       << output;
+}
+
+// A negative size is not "the device's own" (0): the options are refused before the device is
+// opened, naming the field.
+TEST(VideoDeviceOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(VideoDeviceOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(VideoDeviceOptions{.width = -640}.problem(), "width: -640 is below 0");
+  EXPECT_EQ((VideoDeviceOptions{.width = 640, .height = -1}.problem()), "height: -1 is below 0");
+  try {
+    VideoDeviceSource source("/nonexistent/video0", {.width = -640});
+    ADD_FAILURE() << "a negative width accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "VideoDeviceOptions::width: -640 is below 0");
+  }
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 // the pipeline without images (test_tracking_pipeline.cpp runs it on rendered images).
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Geometry>
 #include <mocap/calibration/camera_file.hpp>
@@ -356,6 +359,66 @@ TEST(PlanarPose, MatchToModelMergesSharedCorners) {
   pose::Correspondences pairs = pose::match_to_model(model, lines);
   EXPECT_EQ(pairs.object_points.size(), 12u);
   EXPECT_EQ(pairs.unknown_lines, std::vector<std::string>{"nonexistent"});
+}
+
+// Options built in code get the checks a launch file's parameters get from the plugins' ranges:
+// what takes them refuses them first, naming the field (the line search's by its path).
+TEST(IdentifierOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(IdentifierOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(LineSearchOptions{}.problem(), std::nullopt);
+  // Compared squared, a negative length would pass for a positive one.
+  EXPECT_EQ(LineSearchOptions{.min_length_px = -8}.problem(), "min_length_px: -8 is below 0");
+  EXPECT_EQ(LineSearchOptions{.min_points = 1}.problem(),
+            "min_points: 1; a line takes two points at least");
+  IdentifierOptions options;
+  options.line_search.tolerance_px = 0;
+  EXPECT_EQ(options.problem(), "line_search.tolerance_px: 0 is not above 0");
+  options = {};
+  options.cross_ratio_tolerance = -0.03;
+  EXPECT_EQ(options.problem(), "cross_ratio_tolerance: -0.03 is not above 0");
+  options = {};
+  options.candidate_window = 3;
+  EXPECT_EQ(options.problem(), "candidate_window: 3; a line's four points need four at least");
+  options = {};
+  options.focal_length_px = -1;
+  EXPECT_EQ(options.problem(), "focal_length_px: -1 is below 0");
+  options = {};
+  options.min_lines = 0;
+  const ConstellationDatabase database = shipped_database();
+  try {
+    ConstellationIdentifier identifier(database, options);
+    ADD_FAILURE() << "min_lines 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "IdentifierOptions::min_lines: 0 is below 1");
+  }
+  try {
+    find_collinear_groups({}, {.tolerance_px = 0});
+    ADD_FAILURE() << "tolerance 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "LineSearchOptions::tolerance_px: 0 is not above 0");
+  }
+}
+
+// Fewer than four points cannot fix a plane's pose: refused, not a rejection of the points.
+TEST(PlanarPoseOptions, NameTheFieldThatCannotBeUsed) {
+  using pose::PlanarPoseOptions;
+  EXPECT_EQ(PlanarPoseOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(PlanarPoseOptions{.min_points = 3}.problem(),
+            "min_points: 3; four points at least fix a plane's pose");
+  EXPECT_EQ(PlanarPoseOptions{.max_reprojection_rms_px = 0}.problem(),
+            "max_reprojection_rms_px: 0 is not above 0");
+  EXPECT_EQ(PlanarPoseOptions{.max_iterations = 0}.problem(), "max_iterations: 0 is below 1");
+  const PinholeCamera camera = test_camera();
+  try {
+    pose::estimate_planar_pose(camera, {}, {}, {.min_points = 3});
+    ADD_FAILURE() << "min_points 3 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "PlanarPoseOptions::min_points: 3; four points at least fix a plane's pose");
+  }
+  EXPECT_THROW(pose::refine_planar_pose(camera, Eigen::Isometry3d::Identity(), {}, {},
+                                        {.max_iterations = 0}),
+               std::invalid_argument);
 }
 
 }  // namespace

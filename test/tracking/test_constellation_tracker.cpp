@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Geometry>
 #include <mocap/calibration/camera_file.hpp>
@@ -521,6 +524,87 @@ TEST(SequenceEvaluator, CountsSwapsFalseIdentificationsAndEpisodes) {
   // 0.1..0.5; a again: 1 of 1.
   EXPECT_EQ(score.frames_after_acquisition, 3 + 5 + 1);
   EXPECT_EQ(score.tracked_after_acquisition, 2 + 3 + 1);
+}
+
+// Options built in code get the checks a launch file's parameters get from the plugin's ranges:
+// the tracker refuses them at construction, naming the field (its parts' by their path), rather
+// than failing in the middle of a frame.
+TEST(TrackerOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(TrackerOptions{}.problem(), std::nullopt);
+  TrackerOptions options;
+  options.identification.line_search.min_length_px = -1;
+  EXPECT_EQ(options.problem(), "identification.line_search.min_length_px: -1 is below 0");
+  options = {};
+  options.pose.max_iterations = 0;
+  EXPECT_EQ(options.problem(), "pose.max_iterations: 0 is below 1");
+  options = {};
+  options.motion.angular_acceleration_density = -8;
+  EXPECT_EQ(options.problem(), "motion.angular_acceleration_density: -8 is below 0");
+  options = {};
+  options.visibility.max_view_angle_deg = 120;
+  EXPECT_EQ(options.problem(), "visibility.max_view_angle_deg: 120 is not in [0, 90]");
+  options = {};
+  options.min_size_ratio = 2;
+  EXPECT_EQ(options.problem(), "min_size_ratio: 2 is not in [0, 1]");
+  options = {};
+  options.relock_min_markers = 3;
+  EXPECT_EQ(options.problem(), "relock_min_markers: 3; four markers at least fix a plane's pose");
+  // Three markers would have thrown from the pose fit of the first tracked frame.
+  options = {};
+  options.min_tracked_markers = 3;
+  try {
+    ConstellationTracker tracker(database(), camera(), options);
+    ADD_FAILURE() << "three tracked markers accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "TrackerOptions::min_tracked_markers: 3; four markers at least fix a plane's pose");
+  }
+}
+
+TEST(VisibilityOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(VisibilityOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(VisibilityOptions{.max_view_angle_deg = 91}.problem(),
+            "max_view_angle_deg: 91 is not in [0, 90]");
+  EXPECT_EQ(VisibilityOptions{.border_margin_px = -3}.problem(), "border_margin_px: -3 is below 0");
+  try {
+    marker_images(*camera(), database().constellations()[0], Eigen::Isometry3d::Identity(),
+                  {.max_view_angle_deg = -70});
+    ADD_FAILURE() << "a negative angle accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "VisibilityOptions::max_view_angle_deg: -70 is not in [0, 90]");
+  }
+}
+
+// A negative density would take uncertainty away: the covariance would stop being one.
+TEST(BodyMotionOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(BodyMotionOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(BodyMotionOptions{.angular_acceleration_density = -1}.problem(),
+            "angular_acceleration_density: -1 is below 0");
+  EXPECT_EQ(BodyMotionOptions{.initial_linear_velocity_sigma_mps = -2}.problem(),
+            "initial_linear_velocity_sigma_mps: -2 is below 0");
+  try {
+    BodyMotionFilter filter(Eigen::Isometry3d::Identity(), Matrix6d::Identity(), 0,
+                            {.linear_acceleration_density = -2});
+    ADD_FAILURE() << "a negative density accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "BodyMotionOptions::linear_acceleration_density: -2 is below 0");
+  }
+}
+
+TEST(SequenceOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(evaluation::SequenceOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(evaluation::SequenceOptions{.position_bound_m = 0}.problem(),
+            "position_bound_m: 0 is not above 0");
+  EXPECT_EQ(evaluation::SequenceOptions{.orientation_bound_deg = 0}.problem(),
+            "orientation_bound_deg: 0 is not above 0");
+  try {
+    evaluation::SequenceEvaluator evaluator({.position_bound_m = -0.05});
+    ADD_FAILURE() << "a negative bound accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "SequenceOptions::position_bound_m: -0.05 is not above 0");
+  }
 }
 
 }  // namespace

@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
 
 #include <mocap/calibration/pinhole_camera.hpp>
 #include <opencv2/core.hpp>
@@ -108,6 +111,28 @@ TEST(Overlay, DrawsFiducialsLinesAndAxes) {
   cv::inRange(broken(cv::Rect(0, 0, 200, 200)), cv::Scalar(0, 150, 0), cv::Scalar(60, 255, 60),
               green);
   EXPECT_EQ(cv::countNonZero(green), 0);
+}
+
+// With no frame kept pending, a truth and its estimate could never meet: nothing would be
+// evaluated. Options built in code are refused, naming the field.
+TEST(EvaluationOptions, NameTheFieldThatCannotBeUsed) {
+  using evaluation::EvaluationOptions;
+  EXPECT_EQ(EvaluationOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(EvaluationOptions{.min_visible_markers = 0}.problem(), std::nullopt);  // any object
+  EXPECT_EQ(EvaluationOptions{.min_visible_markers = -1}.problem(),
+            "min_visible_markers: -1 is below 0");
+  EXPECT_EQ(EvaluationOptions{.false_position_error_m = 0}.problem(),
+            "false_position_error_m: 0 is not above 0");
+  EXPECT_EQ(EvaluationOptions{.max_pending_frames = 0}.problem(),
+            "max_pending_frames: 0; a frame's truth and estimate could never meet");
+  try {
+    evaluation::PoseEvaluator evaluator({.max_pending_frames = 0});
+    ADD_FAILURE() << "no pending frames accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "EvaluationOptions::max_pending_frames: 0; a frame's truth and estimate could never "
+              "meet");
+  }
 }
 
 }  // namespace

@@ -63,8 +63,17 @@ bool is_image_file_name(const fs::path& path) {
 
 // --- VideoDeviceSource --------------------------------------------------------------------
 
+std::optional<std::string> VideoDeviceOptions::problem() const {
+  if (width < 0) return fmt::format("width: {} is below 0", width);
+  if (height < 0) return fmt::format("height: {} is below 0", height);
+  return std::nullopt;
+}
+
 VideoDeviceSource::VideoDeviceSource(const std::string& device, const VideoDeviceOptions& options)
     : device_(device) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("VideoDeviceOptions::" + *problem);
+  }
   if (is_index(device)) {
     capture_.open(std::stoi(device), cv::CAP_V4L2);
   } else {

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,10 +45,15 @@ struct VideoDeviceOptions {
   // the frames' size, not this.
   int width = 0;
   int height = 0;
+
+  // Why these options cannot be used, naming the field ("width: -1 is below 0"); nullopt when
+  // they can. VideoDeviceSource's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // A V4L2 camera through cv::VideoCapture: `device` is a path ("/dev/video0") or an index
-// ("0"). Throws std::runtime_error naming the device when it cannot be opened.
+// ("0"). Throws std::invalid_argument for options that cannot be used, std::runtime_error
+// naming the device when it cannot be opened.
 class VideoDeviceSource final : public FrameSource {
  public:
   explicit VideoDeviceSource(const std::string& device, const VideoDeviceOptions& options = {});

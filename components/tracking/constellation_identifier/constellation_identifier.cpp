@@ -6,6 +6,9 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 #include "tracking/constellation_database/cross_ratio.hpp"
 #include "tracking/constellation_database/plane_homography.hpp"
@@ -427,9 +430,37 @@ int IdentifiedConstellation::points_identified() const {
       std::count_if(image_point_of.begin(), image_point_of.end(), [](int i) { return i >= 0; }));
 }
 
+std::optional<std::string> IdentifierOptions::problem() const {
+  if (auto problem = line_search.problem()) return "line_search." + *problem;
+  if (!(cross_ratio_tolerance > 0)) {
+    return fmt::format("cross_ratio_tolerance: {} is not above 0", cross_ratio_tolerance);
+  }
+  if (min_lines < 1) return fmt::format("min_lines: {} is below 1", min_lines);
+  if (min_extra_markers < 0) {
+    return fmt::format("min_extra_markers: {} is below 0", min_extra_markers);
+  }
+  if (!(max_fit_error_px > 0)) {
+    return fmt::format("max_fit_error_px: {} is not above 0", max_fit_error_px);
+  }
+  if (candidate_window < 4) {
+    return fmt::format("candidate_window: {}; a line's four points need four at least",
+                       candidate_window);
+  }
+  if (!(focal_length_px >= 0)) {
+    return fmt::format("focal_length_px: {} is below 0", focal_length_px);
+  }
+  if (min_loose_markers < 0) {
+    return fmt::format("min_loose_markers: {} is below 0", min_loose_markers);
+  }
+  return std::nullopt;
+}
+
 ConstellationIdentifier::ConstellationIdentifier(const ConstellationDatabase& database,
                                                  IdentifierOptions options)
     : database_(database), options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("IdentifierOptions::" + *problem);
+  }
   for (const ConstellationModel& model : database_.constellations()) {
     std::vector<int> types;
     for (const ConstellationLine& line : model.lines) {

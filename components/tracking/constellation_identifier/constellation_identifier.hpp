@@ -12,6 +12,8 @@
 #pragma once
 
 #include <array>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -50,6 +52,11 @@ struct IdentifierOptions {
   // space and one turn about it put them, for a constellation seen by one line only; 0 turns
   // that search off. Needs focal_length_px.
   int min_loose_markers = 3;
+
+  // Why these options cannot be used, naming the field (the line search's by its path:
+  // "line_search.tolerance_px: 0 is not above 0"); nullopt when they can.
+  // ConstellationIdentifier's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct IdentifiedLine {
@@ -83,7 +90,8 @@ struct IdentificationStats {
 
 class ConstellationIdentifier {
  public:
-  // Keeps a reference to `database`, which must outlive the identifier.
+  // Keeps a reference to `database`, which must outlive the identifier. Throws
+  // std::invalid_argument for options that cannot be used.
   explicit ConstellationIdentifier(const ConstellationDatabase& database,
                                    IdentifierOptions options = {});
 

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+
+#include <fmt/format.h>
 
 namespace mocap::constellations {
 
@@ -70,8 +73,21 @@ int count_near_segment(const AxisOrder& order, int first, int last, const Eigen:
 
 }  // namespace
 
+std::optional<std::string> LineSearchOptions::problem() const {
+  if (!(tolerance_px > 0)) return fmt::format("tolerance_px: {} is not above 0", tolerance_px);
+  if (min_points < 2) {
+    return fmt::format("min_points: {}; a line takes two points at least", min_points);
+  }
+  // Compared squared: a negative length would pass for its opposite.
+  if (!(min_length_px >= 0)) return fmt::format("min_length_px: {} is below 0", min_length_px);
+  return std::nullopt;
+}
+
 std::vector<CollinearGroup> find_collinear_groups(const std::vector<Eigen::Vector2d>& points,
                                                   const LineSearchOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("LineSearchOptions::" + *problem);
+  }
   std::vector<CollinearGroup> groups;
   const int n = static_cast<int>(points.size());
   if (n < options.min_points) return groups;

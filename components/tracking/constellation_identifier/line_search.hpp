@@ -11,6 +11,8 @@
 // between them gets the full test; see bench/tracking_pipeline_bench for the figures.
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -25,6 +27,10 @@ struct LineSearchOptions {
   int min_points = 4;
   // Shorter groups (end to end, pixels) are too small to measure a cross-ratio on.
   double min_length_px = 8.0;
+
+  // Why these options cannot be used, naming the field ("tolerance_px: 0 is not above 0");
+  // nullopt when they can. find_collinear_groups throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct CollinearGroup {

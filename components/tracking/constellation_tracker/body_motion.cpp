@@ -1,7 +1,9 @@
 #include "tracking/constellation_tracker/body_motion.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
+#include <fmt/format.h>
 #include <Eigen/Cholesky>
 
 namespace mocap::tracking {
@@ -35,10 +37,32 @@ Eigen::Vector3d vector_from_rotation(const Eigen::Matrix3d& rotation) {
   return angle_axis.angle() * angle_axis.axis();
 }
 
+std::optional<std::string> BodyMotionOptions::problem() const {
+  // A negative density would take uncertainty away: the covariance would stop being one.
+  if (!(linear_acceleration_density >= 0)) {
+    return fmt::format("linear_acceleration_density: {} is below 0", linear_acceleration_density);
+  }
+  if (!(angular_acceleration_density >= 0)) {
+    return fmt::format("angular_acceleration_density: {} is below 0", angular_acceleration_density);
+  }
+  if (!(initial_linear_velocity_sigma_mps >= 0)) {
+    return fmt::format("initial_linear_velocity_sigma_mps: {} is below 0",
+                       initial_linear_velocity_sigma_mps);
+  }
+  if (!(initial_angular_velocity_sigma_rps >= 0)) {
+    return fmt::format("initial_angular_velocity_sigma_rps: {} is below 0",
+                       initial_angular_velocity_sigma_rps);
+  }
+  return std::nullopt;
+}
+
 BodyMotionFilter::BodyMotionFilter(const Eigen::Isometry3d& camera_from_body,
                                    const Matrix6d& pose_covariance, int64_t stamp_ns,
                                    BodyMotionOptions options)
     : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("BodyMotionOptions::" + *problem);
+  }
   state_.stamp_ns = stamp_ns;
   state_.camera_from_body = camera_from_body;
   state_.covariance.setZero();

@@ -14,6 +14,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -34,6 +36,11 @@ struct BodyMotionOptions {
   // deviation, until the next frames measure it.
   double initial_linear_velocity_sigma_mps = 2.0;
   double initial_angular_velocity_sigma_rps = 4.0;
+
+  // Why these options cannot be used, naming the field ("linear_acceleration_density: -1 is
+  // below 0"); nullopt when they can. BodyMotionFilter's constructor throws
+  // std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // A body's pose and velocities at one instant, with their joint covariance over

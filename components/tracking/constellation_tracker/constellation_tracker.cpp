@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -120,12 +121,62 @@ struct ConstellationTracker::Candidate {
   bool relocked = false;            // found by an image shift: its motion starts afresh
 };
 
+std::optional<std::string> TrackerOptions::problem() const {
+  if (auto problem = identification.problem()) return "identification." + *problem;
+  if (auto problem = pose.problem()) return "pose." + *problem;
+  if (auto problem = motion.problem()) return "motion." + *problem;
+  if (auto problem = visibility.problem()) return "visibility." + *problem;
+  // The association's covariances are inverted: each needs the fiducial's own share.
+  if (!(fiducial_sigma_px > 0)) {
+    return fmt::format("fiducial_sigma_px: {} is not above 0", fiducial_sigma_px);
+  }
+  if (!(association_gate > 0)) {
+    return fmt::format("association_gate: {} is not above 0", association_gate);
+  }
+  if (!(max_motion_surprise > 0)) {
+    return fmt::format("max_motion_surprise: {} is not above 0", max_motion_surprise);
+  }
+  // Both replace pose.min_points for their fits, which take four at least.
+  if (min_tracked_markers < 4) {
+    return fmt::format("min_tracked_markers: {}; four markers at least fix a plane's pose",
+                       min_tracked_markers);
+  }
+  // Compared squared: a negative radius would pass for its opposite.
+  if (!(relock_radius_px >= 0)) {
+    return fmt::format("relock_radius_px: {} is below 0", relock_radius_px);
+  }
+  if (relock_min_markers < 4) {
+    return fmt::format("relock_min_markers: {}; four markers at least fix a plane's pose",
+                       relock_min_markers);
+  }
+  if (!(max_marker_error_px > 0)) {
+    return fmt::format("max_marker_error_px: {} is not above 0", max_marker_error_px);
+  }
+  if (!(merge_distance_px >= 0)) {
+    return fmt::format("merge_distance_px: {} is below 0", merge_distance_px);
+  }
+  if (spare_missing_markers < 0) {
+    return fmt::format("spare_missing_markers: {} is below 0", spare_missing_markers);
+  }
+  if (!(side_tolerance_px >= 0)) {
+    return fmt::format("side_tolerance_px: {} is below 0", side_tolerance_px);
+  }
+  // Above 1 no size would fit: at least min_size_ratio and at most its inverse of the median.
+  if (!(min_size_ratio >= 0 && min_size_ratio <= 1)) {
+    return fmt::format("min_size_ratio: {} is not in [0, 1]", min_size_ratio);
+  }
+  return std::nullopt;
+}
+
 ConstellationTracker::ConstellationTracker(const constellations::ConstellationDatabase& database,
                                            std::shared_ptr<const calibration::CameraModel> camera,
                                            TrackerOptions options)
     : database_(database),
       camera_(std::move(camera)),
       options_([&] {
+        if (auto problem = options.problem()) {
+          throw std::invalid_argument("TrackerOptions::" + *problem);
+        }
         options.identification.focal_length_px = camera_ ? camera_->focal_length_px() : 0;
         return options;
       }()),

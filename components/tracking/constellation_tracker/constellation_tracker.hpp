@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,11 @@ struct TrackerOptions {
   // centroid is off): it counts as seen but is left out of the pose. Larger than the inverse
   // share, it has merged with another blob. Needs sizes; 0 turns it off.
   double min_size_ratio = 0.5;
+
+  // Why these options cannot be used, naming the field (nested ones by their path:
+  // "pose.min_points: 3; ..."); nullopt when they can. ConstellationTracker's constructor
+  // throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 // How a pose was found.
@@ -130,7 +136,8 @@ struct TrackerStats {
 
 class ConstellationTracker {
  public:
-  // Keeps a reference to `database`, which must outlive the tracker.
+  // Keeps a reference to `database`, which must outlive the tracker. Throws
+  // std::invalid_argument for a null camera or options that cannot be used.
   ConstellationTracker(const constellations::ConstellationDatabase& database,
                        std::shared_ptr<const calibration::CameraModel> camera,
                        TrackerOptions options = {});

@@ -3,13 +3,31 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace mocap::tracking {
+
+std::optional<std::string> VisibilityOptions::problem() const {
+  // Beyond 90 degrees a disc faces away from the camera; the cosine would not tell a negative
+  // angle from its opposite.
+  if (!(max_view_angle_deg >= 0 && max_view_angle_deg <= 90)) {
+    return fmt::format("max_view_angle_deg: {} is not in [0, 90]", max_view_angle_deg);
+  }
+  if (!(border_margin_px >= 0)) {
+    return fmt::format("border_margin_px: {} is below 0", border_margin_px);
+  }
+  return std::nullopt;
+}
 
 std::vector<MarkerImage> marker_images(const calibration::CameraModel& camera,
                                        const constellations::ConstellationModel& model,
                                        const Eigen::Isometry3d& camera_from_body,
                                        const VisibilityOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("VisibilityOptions::" + *problem);
+  }
   const double min_cosine = std::cos(options.max_view_angle_deg * M_PI / 180);
   const Eigen::Vector3d normal = camera_from_body.linear().col(2);
   const double margin = options.border_margin_px;

@@ -3,6 +3,8 @@
 // of the pose estimator, made to hold the markers that are missing as well as the ones found).
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -33,6 +35,10 @@ struct VisibilityOptions {
   double max_view_angle_deg = 70;
   // A marker imaged this close to the image border may be cut by it: not expected.
   double border_margin_px = 3;
+
+  // Why these options cannot be used, naming the field ("max_view_angle_deg: 100 is not in
+  // [0, 90]"); nullopt when they can. marker_images throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 std::vector<MarkerImage> marker_images(const calibration::CameraModel& camera,

@@ -67,11 +67,6 @@ UsablePoints usable_points(const calibration::CameraModel& camera,
 }
 
 bool enough_points(const PlanarPoseOptions& options, PlanarPose& result) {
-  if (options.min_points < 4) {
-    throw std::invalid_argument(
-        fmt::format("PlanarPoseOptions::min_points is {}: four points at least fix a pose",
-                    options.min_points));
-  }
   if (result.points_used >= options.min_points) return true;
   result.rejection =
       fmt::format("{} usable points, {} needed", result.points_used, options.min_points);
@@ -95,10 +90,24 @@ void accept_if_valid(const Refined& best, const PlanarPoseOptions& options, Plan
 
 }  // namespace
 
+std::optional<std::string> PlanarPoseOptions::problem() const {
+  if (!(max_reprojection_rms_px > 0)) {
+    return fmt::format("max_reprojection_rms_px: {} is not above 0", max_reprojection_rms_px);
+  }
+  if (min_points < 4) {
+    return fmt::format("min_points: {}; four points at least fix a plane's pose", min_points);
+  }
+  if (max_iterations < 1) return fmt::format("max_iterations: {} is below 1", max_iterations);
+  return std::nullopt;
+}
+
 PlanarPose estimate_planar_pose(const calibration::CameraModel& camera,
                                 const std::vector<Eigen::Vector3d>& object_points,
                                 const std::vector<Eigen::Vector2d>& pixels,
                                 const PlanarPoseOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("PlanarPoseOptions::" + *problem);
+  }
   PlanarPose result;
   // Points the camera model cannot unproject (or non-finite ones) are left out.
   UsablePoints usable = usable_points(camera, object_points, pixels);
@@ -161,6 +170,9 @@ PlanarPose refine_planar_pose(const calibration::CameraModel& camera,
                               const std::vector<Eigen::Vector3d>& object_points,
                               const std::vector<Eigen::Vector2d>& pixels,
                               const PlanarPoseOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("PlanarPoseOptions::" + *problem);
+  }
   PlanarPose result;
   UsablePoints usable = usable_points(camera, object_points, pixels);
   result.points_used = static_cast<int>(usable.object.size());

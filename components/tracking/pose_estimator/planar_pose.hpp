@@ -6,6 +6,7 @@
 // better one is kept. Any CameraModel works, so calibrated EUCM cameras plug in.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,11 @@ struct PlanarPoseOptions {
   // plane's pose, more average the noise.
   int min_points = 4;
   int max_iterations = 15;
+
+  // Why these options cannot be used, naming the field ("min_points: 3; four points at least
+  // fix a plane's pose"); nullopt when they can. estimate_planar_pose and refine_planar_pose
+  // throw std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct PlanarPose {

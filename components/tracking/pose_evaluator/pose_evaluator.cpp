@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace mocap::evaluation {
 namespace {
@@ -35,6 +38,30 @@ void merge(EvaluationSummary& into, const EvaluationSummary& from) {
 }
 
 }  // namespace
+
+std::optional<std::string> EvaluationOptions::problem() const {
+  if (min_visible_markers < 0) {
+    return fmt::format("min_visible_markers: {} is below 0", min_visible_markers);
+  }
+  if (!(false_position_error_m > 0)) {
+    return fmt::format("false_position_error_m: {} is not above 0", false_position_error_m);
+  }
+  if (!(false_orientation_error_deg > 0)) {
+    return fmt::format("false_orientation_error_deg: {} is not above 0",
+                       false_orientation_error_deg);
+  }
+  // With none pending, a truth frame and its estimate could never meet.
+  if (max_pending_frames == 0) {
+    return "max_pending_frames: 0; a frame's truth and estimate could never meet";
+  }
+  return std::nullopt;
+}
+
+PoseEvaluator::PoseEvaluator(EvaluationOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("EvaluationOptions::" + *problem);
+  }
+}
 
 double EvaluationSummary::tracked_percent() const {
   return expected == 0 ? std::numeric_limits<double>::quiet_NaN() : 100.0 * tracked / expected;

@@ -22,6 +22,10 @@ struct EvaluationOptions {
   double false_orientation_error_deg = 5.0;
   // Frames whose estimate has not arrived after this many newer truth frames count as lost.
   size_t max_pending_frames = 200;
+
+  // Why these options cannot be used, naming the field ("max_pending_frames: 0; ..."); nullopt
+  // when they can. PoseEvaluator's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct ObjectPose {
@@ -63,7 +67,7 @@ struct EvaluationSummary {
 // Pairs truth and estimates by their stamp (both carry the image's), in any arrival order.
 class PoseEvaluator {
  public:
-  explicit PoseEvaluator(EvaluationOptions options = {}) : options_(options) {}
+  explicit PoseEvaluator(EvaluationOptions options = {});
 
   void add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects);
   void add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects);

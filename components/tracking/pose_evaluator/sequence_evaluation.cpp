@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace mocap::evaluation {
 namespace {
@@ -18,6 +21,22 @@ double percent(int part, int whole) {
 }
 
 }  // namespace
+
+std::optional<std::string> SequenceOptions::problem() const {
+  if (!(position_bound_m > 0)) {
+    return fmt::format("position_bound_m: {} is not above 0", position_bound_m);
+  }
+  if (!(orientation_bound_deg > 0)) {
+    return fmt::format("orientation_bound_deg: {} is not above 0", orientation_bound_deg);
+  }
+  return std::nullopt;
+}
+
+SequenceEvaluator::SequenceEvaluator(SequenceOptions options) : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("SequenceOptions::" + *problem);
+  }
+}
 
 double SequenceScore::acquired_percent() const { return percent(acquired, episodes); }
 double SequenceScore::tracked_after_acquisition_percent() const {

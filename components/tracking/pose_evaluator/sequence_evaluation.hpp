@@ -37,6 +37,11 @@ struct SequenceOptions {
   // board's truth it is an identity swap; near none, a false identification.
   double position_bound_m = 0.05;
   double orientation_bound_deg = 5.0;
+
+  // Why these options cannot be used, naming the field ("position_bound_m: 0 is not above 0");
+  // nullopt when they can. SequenceEvaluator's constructor throws std::invalid_argument with
+  // it.
+  std::optional<std::string> problem() const;
 };
 
 struct SequenceScore {
@@ -59,7 +64,7 @@ struct SequenceScore {
 
 class SequenceEvaluator {
  public:
-  explicit SequenceEvaluator(SequenceOptions options = {}) : options_(options) {}
+  explicit SequenceEvaluator(SequenceOptions options = {});
 
   // One frame at scene time `time_s` (increasing).
   void add_frame(double time_s, const std::vector<SequenceTruth>& truth,
