@@ -3,7 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <optional>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "volume/frame_assembly/frame_assembler.hpp"
@@ -113,6 +117,24 @@ TEST(FrameAssembler, ASilentCameraIsLeftOutUntilItComesBack) {
   ASSERT_EQ(back.size(), 1u);
   EXPECT_FALSE(back[0].silent[1]);
   EXPECT_EQ(count_messages(back[0]), 2);
+}
+
+// Not above 0, every camera would be silent and every frame complete at once; negative, no two
+// stamps would be one capture time. Refused, naming the field.
+TEST(FrameAssemblerOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(FrameAssemblerOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(FrameAssemblerOptions{.same_capture = std::chrono::microseconds(-1500)}.problem(),
+            "same_capture: -1.5 ms is below 0");
+  EXPECT_EQ(FrameAssemblerOptions{.wait = milliseconds(0)}.problem(), std::nullopt);  // no wait
+  EXPECT_EQ(FrameAssemblerOptions{.wait = milliseconds(-5)}.problem(), "wait: -5 ms is below 0");
+  EXPECT_EQ(FrameAssemblerOptions{.silent_after = milliseconds(0)}.problem(),
+            "silent_after: 0 ms is not above 0");
+  try {
+    Frames frames(2, {.silent_after = milliseconds(0)});
+    ADD_FAILURE() << "silent_after 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "FrameAssemblerOptions::silent_after: 0 ms is not above 0");
+  }
 }
 
 }  // namespace

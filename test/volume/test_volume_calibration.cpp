@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "test/volume/synthetic_volume.hpp"
@@ -205,6 +208,25 @@ TEST(VolumeCalibration, MissingDataIsSaid) {
     FAIL() << "calibrated from two marks";
   } catch (const VolumeCalibrationError& e) {
     EXPECT_NE(std::string(e.what()).find("two marks"), std::string::npos) << e.what();
+  }
+}
+
+// Options built in code are refused before any solve, naming the field.
+TEST(VolumeCalibrationOptions, NameTheFieldThatCannotBeUsed) {
+  EXPECT_EQ(VolumeCalibrationOptions{}.problem(), std::nullopt);
+  EXPECT_EQ(VolumeCalibrationOptions{.same_capture_s = -0.002}.problem(),
+            "same_capture_s: -0.002 is below 0");
+  EXPECT_EQ(VolumeCalibrationOptions{.max_frames = 0}.problem(),
+            "max_frames: 0 leaves no capture time for the solve");
+  EXPECT_EQ(VolumeCalibrationOptions{.robust_scale_px = 0}.problem(), std::nullopt);  // no Huber
+  EXPECT_EQ(VolumeCalibrationOptions{.robust_scale_px = -1}.problem(),
+            "robust_scale_px: -1 is below 0");
+  try {
+    calibrate_volume({}, {}, {}, {}, {.max_frames = 0});
+    ADD_FAILURE() << "max_frames 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "VolumeCalibrationOptions::max_frames: 0 leaves no capture time for the solve");
   }
 }
 

@@ -16,6 +16,8 @@
 #include <cstdlib>
 #include <map>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace mocap::volume {
@@ -28,6 +30,10 @@ struct FrameAssemblerOptions {
   std::chrono::nanoseconds wait{std::chrono::milliseconds(5)};
   // A camera with no message for this long is left out of the frames that follow.
   std::chrono::nanoseconds silent_after{std::chrono::milliseconds(500)};
+
+  // Why these options cannot be used, naming the field ("silent_after: 0 ms is not above 0");
+  // nullopt when they can. FrameAssembler's constructor throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 template <class Message>
@@ -45,7 +51,11 @@ class FrameAssembler {
   using Clock = std::chrono::steady_clock;
 
   FrameAssembler(int cameras, FrameAssemblerOptions options = {})
-      : options_(options), last_heard_(static_cast<size_t>(cameras)) {}
+      : options_(options), last_heard_(static_cast<size_t>(cameras)) {
+    if (auto problem = options_.problem()) {
+      throw std::invalid_argument("FrameAssemblerOptions::" + *problem);
+    }
+  }
 
   // A camera's message for the capture time `stamp_ns`, arriving at `now`. A message for a
   // capture time already handed out is dropped (counted in late_drops()).

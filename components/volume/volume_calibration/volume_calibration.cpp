@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
@@ -180,11 +181,24 @@ Eigen::Isometry3d board_on_floor(const std::vector<CalibrationCamera>& cameras,
 
 }  // namespace
 
+std::optional<std::string> VolumeCalibrationOptions::problem() const {
+  // Negative, no two sightings would be one capture time, and no shot would tie two cameras.
+  if (!(same_capture_s >= 0)) return fmt::format("same_capture_s: {} is below 0", same_capture_s);
+  if (max_frames == 0) return "max_frames: 0 leaves no capture time for the solve";
+  if (!(robust_scale_px >= 0)) {
+    return fmt::format("robust_scale_px: {} is below 0", robust_scale_px);
+  }
+  return std::nullopt;
+}
+
 VolumeCalibration calibrate_volume(const std::vector<CalibrationCamera>& cameras,
                                    const std::vector<Eigen::Vector3d>& board,
                                    const std::vector<BoardSighting>& waved,
                                    const std::vector<FloorPlacement>& on_floor,
                                    const VolumeCalibrationOptions& options) {
+  if (auto problem = options.problem()) {
+    throw std::invalid_argument("VolumeCalibrationOptions::" + *problem);
+  }
   if (cameras.empty()) throw VolumeCalibrationError("no cameras");
   if (board.size() < 4) throw VolumeCalibrationError("the board needs 4 markers or more");
   if (on_floor.empty()) {

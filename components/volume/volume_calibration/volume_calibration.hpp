@@ -51,7 +51,12 @@ struct VolumeCalibrationOptions {
   // 1,300 on one core), and every one of a few minutes' waving still counts.
   size_t max_frames = 6000;
   // Huber loss scale on each point's pixel error: a mis-detected marker cannot drag the fit.
+  // 0: plain least squares.
   double robust_scale_px = 1.0;
+
+  // Why these options cannot be used, naming the field ("max_frames: 0; ..."); nullopt when
+  // they can. calibrate_volume throws std::invalid_argument with it.
+  std::optional<std::string> problem() const;
 };
 
 struct VolumeCalibration {
@@ -81,7 +86,7 @@ class VolumeCalibrationError : public std::runtime_error {
 // `board`: the board's markers in its frame (metres, planar), indexing the sightings' pixels;
 // camera 0 is the reference of the solve. `on_floor`: one placement, whose board's axes are the
 // room's, or three or more at marks not in a line, whose centres alone set the frame.
-// Throws VolumeCalibrationError.
+// Throws VolumeCalibrationError, and std::invalid_argument for options that cannot be used.
 VolumeCalibration calibrate_volume(const std::vector<CalibrationCamera>& cameras,
                                    const std::vector<Eigen::Vector3d>& board,
                                    const std::vector<BoardSighting>& waved,
