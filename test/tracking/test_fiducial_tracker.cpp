@@ -525,7 +525,16 @@ TEST(FiducialDetector, RejectsBadOptionsAndImages) {
   FiducialDetectorOptions options;
   EXPECT_EQ(options.problem(), std::nullopt);
   options.connectivity = 6;
-  EXPECT_EQ(options.problem(), "connectivity must be 4 or 8, got 6");
+  EXPECT_EQ(options.problem(), "connectivity: 6; 4 or 8");
+  options = {};
+  options.max_area_px = 2;
+  EXPECT_EQ(options.problem(), "max_area_px: 2 is below min_area_px, 3");
+  try {
+    FiducialDetector detector(options);
+    ADD_FAILURE() << "max_area_px below min_area_px accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "FiducialDetectorOptions::max_area_px: 2 is below min_area_px, 3");
+  }
   EXPECT_THROW(detect_fiducials(cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(0))),
                std::invalid_argument);
   EXPECT_THROW(detect_fiducials(cv::Mat(10, 10, CV_16U, cv::Scalar(0))), std::invalid_argument);

@@ -495,9 +495,8 @@ std::vector<IdentifiedConstellation> ConstellationIdentifier::identify(
 
   std::vector<double> type_ratios;
   for (const LineType& type : line_types_) type_ratios.push_back(type.cross_ratio);
-  const std::vector<std::vector<Candidate>> by_type =
-      candidates_by_type(points, groups, type_ratios, std::max(4, options_.candidate_window),
-                         options_.cross_ratio_tolerance, s);
+  const std::vector<std::vector<Candidate>> by_type = candidates_by_type(
+      points, groups, type_ratios, options_.candidate_window, options_.cross_ratio_tolerance, s);
 
   std::vector<TypeChoices> choices_by_type;
   choices_by_type.reserve(by_type.size());

@@ -132,32 +132,38 @@ std::optional<std::string> FiducialDetectorOptions::problem() const {
     return !(value >= low && value <= high);
   };
   if (outside(threshold_ratio, 0, 1)) {
-    return fmt::format("threshold_ratio must be in [0, 1], got {}", threshold_ratio);
+    return fmt::format("threshold_ratio: {} is outside [0, 1]", threshold_ratio);
   }
   if (outside(min_threshold, 0, 255)) {
-    return fmt::format("min_threshold must be in [0, 255], got {}", min_threshold);
+    return fmt::format("min_threshold: {} is outside [0, 255]", min_threshold);
   }
-  if (min_area_px < 1) return fmt::format("min_area_px must be at least 1, got {}", min_area_px);
+  if (min_area_px < 1) return fmt::format("min_area_px: {} is below 1", min_area_px);
   if (max_area_px < min_area_px) {
-    return fmt::format("max_area_px ({}) must be at least min_area_px ({})", max_area_px,
-                       min_area_px);
+    return fmt::format("max_area_px: {} is below min_area_px, {}", max_area_px, min_area_px);
   }
   if (outside(min_circularity, 0, 1)) {
-    return fmt::format("min_circularity must be in [0, 1], got {}", min_circularity);
+    return fmt::format("min_circularity: {} is outside [0, 1]", min_circularity);
   }
-  if (circularity_min_area_px < 0) return "circularity_min_area_px must not be negative";
+  if (circularity_min_area_px < 0) {
+    return fmt::format("circularity_min_area_px: {} is below 0", circularity_min_area_px);
+  }
   if (region_of_interest.width < 0 || region_of_interest.height < 0) {
-    return "region_of_interest must not have a negative size";
+    return fmt::format("region_of_interest: {} x {} has a negative size", region_of_interest.width,
+                       region_of_interest.height);
   }
   if (connectivity != 4 && connectivity != 8) {
-    return fmt::format("connectivity must be 4 or 8, got {}", connectivity);
+    return fmt::format("connectivity: {}; 4 or 8", connectivity);
   }
-  if (centroid_margin_px < 0) return "centroid_margin_px must not be negative";
+  if (centroid_margin_px < 0) {
+    return fmt::format("centroid_margin_px: {} is below 0", centroid_margin_px);
+  }
   if (outside(centroid_level, 0, 1)) {
-    return fmt::format("centroid_level must be in [0, 1], got {}", centroid_level);
+    return fmt::format("centroid_level: {} is outside [0, 1]", centroid_level);
   }
-  if (!(pixel_noise >= 0)) return "pixel_noise must not be negative";
-  if (!(sampling_error_px >= 0)) return "sampling_error_px must not be negative";
+  if (!(pixel_noise >= 0)) return fmt::format("pixel_noise: {} is below 0", pixel_noise);
+  if (!(sampling_error_px >= 0)) {
+    return fmt::format("sampling_error_px: {} is below 0", sampling_error_px);
+  }
   return std::nullopt;
 }
 
@@ -165,7 +171,7 @@ FiducialDetector::FiducialDetector(FiducialDetectorOptions options) { set_option
 
 void FiducialDetector::set_options(const FiducialDetectorOptions& options) {
   if (auto problem = options.problem()) {
-    throw std::invalid_argument("FiducialDetectorOptions: " + *problem);
+    throw std::invalid_argument("FiducialDetectorOptions::" + *problem);
   }
   options_ = options;
 }

@@ -80,7 +80,7 @@ struct FiducialDetectorOptions {
   // their centroid pulled inward. false: keep them, flagged touches_border; true: reject.
   bool reject_border_regions = false;
 
-  // Why these options cannot be used, naming the field ("connectivity must be 4 or 8, got 5");
+  // Why these options cannot be used, naming the field ("connectivity: 5; 4 or 8");
   // nullopt when they can. FiducialDetector's constructor throws std::invalid_argument with it.
   std::optional<std::string> problem() const;
 };
