@@ -5,8 +5,8 @@
 #
 #   scripts/run_tests.sh BUILD PART [CTEST ARGS]      (MOCAP_TEST_PARALLEL: tests at once)
 #
-# Then the part's slowest tests. One line per run, "PART: N tests run, M skipped", goes to the file MOCAP_TEST_SUMMARY names
-# (.ci/run prints them together at the end).
+# Then the part's slowest tests. One line per run, "PART: N tests run, M skipped", goes to the
+# file MOCAP_TEST_SUMMARY names (.ci/run prints them together at the end).
 set -euo pipefail
 build=$1
 part=$2
@@ -38,7 +38,7 @@ done <<< "$skipped"
 # Where the part's time went: its slowest tests.
 echo "$part: slowest tests (s):"
 awk '/^[0-9]+\/[0-9]+ Testing: / { name = $3 } /^Test time = / { print $4, name }' \
-  "$build/Testing/Temporary/LastTest.log" | sort -rn | head -n 8 | sed 's/^/  /'
+  "$build/Testing/Temporary/LastTest.log" | sort -rn | awk 'NR <= 8 { print "  " $0 }'
 # ctest counts a skipped test among the passed ones.
 line="$part: $((${total:-0} - count)) tests run, $count skipped"
 echo "$line"
