@@ -3,7 +3,7 @@
 # turret, drive, base, monitor, viewer bridge) with `mocap_bag record` taking its poses,
 # fiducials, joint states, velocities and base poses in another process. Every few seconds it
 # samples, for both processes, resident memory, open file descriptors and threads, and the
-# machine's /dev/shm use (Fast DDS's shared-memory segments). Prints the trend (first sample
+# shared memory both map from /dev/shm (Fast DDS's segments). Prints the trend (first sample
 # after the warm-up, each quarter, the last) and what was lost: samples the runtime dropped
 # (its "dropped" warnings) and messages the recorder dropped, beside the pose arrays in the bag.
 # With --check it exits non-zero when a bound is passed:
@@ -49,7 +49,14 @@ recorder_pid=$!
   --set viewer.port=0 > "$work/demo.log" 2>&1 &
 demo_pid=$!
 
-shm_kb() { du -sk /dev/shm 2>/dev/null | awk '{ print $1 }'; }
+# The shared memory the demo and the recorder map (Fast DDS's segments and port queues), in
+# kB: theirs alone, not what other programs on the machine hold (CI runs the container test,
+# with DDS participants of its own on this machine, beside the soak).
+shm_kb() {
+  cat "/proc/$demo_pid/maps" "/proc/$recorder_pid/maps" 2>/dev/null |
+    grep -o '/dev/shm/[^ ]*$' | sort -u | xargs -r du -ck 2>/dev/null |
+    awk '/\ttotal$/ { total = $1 } END { print total + 0 }'
+}
 sample() {  # PID -> "rss_kb fds threads"
   local rss threads fds
   rss=$(awk '/^VmRSS/ { print $2 }' "/proc/$1/status" 2>/dev/null)
