@@ -14,15 +14,15 @@
 #include <Eigen/Geometry>
 #include <mocap/calibration/camera_file.hpp>
 
+#include "common/min_cost_assignment/min_cost_assignment.hpp"
 #include "sim/synthetic_ir_camera/ir_renderer.hpp"
 #include "test/draw_order.hpp"
 #include "test/test_support.hpp"
+#include "tracking/body_motion/body_motion.hpp"
 #include "tracking/constellation_identifier/one_line_search.hpp"
-#include "tracking/constellation_tracker/body_motion.hpp"
 #include "tracking/constellation_tracker/constellation_tracker.hpp"
 #include "tracking/constellation_tracker/marker_association.hpp"
 #include "tracking/constellation_tracker/marker_visibility.hpp"
-#include "tracking/constellation_tracker/min_cost_assignment.hpp"
 #include "tracking/fiducial_tracker/fiducial_tracker.hpp"
 #include "tracking/pose_evaluator/pose_evaluator.hpp"
 #include "tracking/pose_evaluator/sequence_evaluation.hpp"
@@ -88,6 +88,35 @@ TEST(BodyMotionFilter, MeasuresTheVelocitiesOfASteadyMotion) {
             0.003);
 }
 
+TEST(PointMotionFilter, SmoothsAPointAndMeasuresItsVelocity) {
+  // A marker at 240 Hz measured to 0.07 mm per axis, moving steadily.
+  const Eigen::Vector3d v(0.5, -0.2, 0.1);
+  std::mt19937 random(6);
+  std::normal_distribution<double> noise(0, 0.00007);
+  const Eigen::Matrix3d measured = 0.00007 * 0.00007 * Eigen::Matrix3d::Identity();
+  BodyMotionOptions options;
+  options.linear_acceleration_density = 0.3;
+  auto truth_at = [&](double t) -> Eigen::Vector3d { return Eigen::Vector3d(0, 0, 1) + v * t; };
+  PointMotionFilter filter(truth_at(0), measured, 0, options);
+  std::vector<double> raw, filtered;
+  for (int k = 1; k <= 480; ++k) {
+    const int64_t stamp = k * 4'166'667LL;
+    const Eigen::Vector3d truth = truth_at(stamp * 1e-9);
+    const Eigen::Vector3d seen = truth + test::draw_last_first<3>(noise, random);
+    filter.correct(stamp, seen, measured);
+    if (k < 240) continue;  // settled
+    raw.push_back((seen - truth).norm());
+    filtered.push_back((filter.state().position - truth).norm());
+  }
+  // A density that follows a quadrotor's changes of speed smooths a little (8 % here).
+  EXPECT_LT(median(filtered), 0.95 * median(raw));
+  EXPECT_LT((filter.state().velocity - v).norm(), 0.05);
+  EXPECT_LT((filter.state().velocity - v).norm(),
+            4 * std::sqrt(filter.state().covariance.bottomRightCorner<3, 3>().trace()));
+  EXPECT_LT((filter.predicted(481 * 4'166'667LL).position - truth_at(481 * 4'166'667e-9)).norm(),
+            0.0003);
+}
+
 TEST(MinCostAssignment, EqualsTheBestOfEveryPermutation) {
   std::mt19937 random(9);
   std::uniform_real_distribution<double> cost(0, 10);
@@ -112,6 +141,48 @@ TEST(MinCostAssignment, EqualsTheBestOfEveryPermutation) {
     std::vector<int> sorted = assignment;
     std::sort(sorted.begin(), sorted.end());
     EXPECT_EQ(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  }
+}
+
+// Over gated pairs, group by group, a row may stay without a column at its own cost: the same
+// total as the whole matrix with a "none" column per row and the pairs not allowed priced out.
+TEST(MinCostAssignment, OverAllowedPairsEqualsTheWholeMatrix) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> cost(0, 10);
+  std::bernoulli_distribution allowed_pair(0.3);
+  for (int trial = 0; trial < 100; ++trial) {
+    const int rows = 1 + trial % 7, columns = 1 + trial % 5;
+    std::vector<AllowedPair> allowed;
+    std::vector<double> none(rows);
+    const double forbidden = 1e6;
+    Eigen::MatrixXd whole = Eigen::MatrixXd::Constant(rows, columns + rows, forbidden);
+    for (int r = 0; r < rows; ++r) {
+      none[r] = cost(random);
+      whole(r, columns + r) = none[r];
+      for (int c = 0; c < columns; ++c) {
+        if (!allowed_pair(random)) continue;
+        allowed.push_back({r, c, cost(random)});
+        whole(r, c) = allowed.back().cost;
+      }
+    }
+    const std::vector<int> assignment = min_cost_assignment(rows, columns, allowed, none);
+    double total = 0;
+    std::vector<int> taken;
+    for (int r = 0; r < rows; ++r) {
+      if (assignment[r] < 0) {
+        total += none[r];
+        continue;
+      }
+      ASSERT_LT(whole(r, assignment[r]), forbidden) << "a pair not allowed, trial " << trial;
+      total += whole(r, assignment[r]);
+      taken.push_back(assignment[r]);
+    }
+    const std::vector<int> best = min_cost_assignment(whole);
+    double best_total = 0;
+    for (int r = 0; r < rows; ++r) best_total += whole(r, best[r]);
+    EXPECT_NEAR(total, best_total, 1e-9) << "trial " << trial;
+    std::sort(taken.begin(), taken.end());
+    EXPECT_EQ(std::unique(taken.begin(), taken.end()), taken.end());
   }
 }
 

@@ -31,9 +31,9 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
+#include "tracking/body_motion/body_motion.hpp"
 #include "tracking/constellation_database/constellation_database.hpp"
 #include "tracking/constellation_identifier/constellation_identifier.hpp"
-#include "tracking/constellation_tracker/body_motion.hpp"
 #include "tracking/constellation_tracker/marker_association.hpp"
 #include "tracking/constellation_tracker/marker_visibility.hpp"
 #include "tracking/pose_estimator/planar_pose.hpp"

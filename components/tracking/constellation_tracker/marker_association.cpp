@@ -6,7 +6,7 @@
 
 #include <Eigen/LU>
 
-#include "tracking/constellation_tracker/min_cost_assignment.hpp"
+#include "common/min_cost_assignment/min_cost_assignment.hpp"
 
 namespace mocap::tracking {
 namespace {

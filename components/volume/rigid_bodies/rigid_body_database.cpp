@@ -44,11 +44,48 @@ RigidBody read_body(const Reader& reader, const YAML::Node& node,
   return body;
 }
 
-// A way `count` markers of `seen` could be taken for `count` of `taken_for`'s: their distances
-// differ by up to twice the tolerance and a rotation maps one set onto the other (a mirror
-// image does not confuse). With `same` (one body against itself), the markers taken for
-// themselves do not count. The markers of each side, or nothing.
-std::optional<std::pair<std::vector<int>, std::vector<int>>> confusion(
+std::string listed(const std::vector<int>& markers) {
+  return fmt::format("{}", fmt::join(markers, ", "));
+}
+
+RigidBodyDatabase read_bodies(const Reader& reader, const YAML::Node& root, double tolerance,
+                              int min_markers) {
+  reader.check_keys(root, {"bodies"}, "the file");
+  RigidBodyDatabase database;
+  for (const YAML::Node& node : reader.list(root, "bodies")) {
+    database.bodies.push_back(read_body(reader, node, database.bodies));
+  }
+  const YAML::Node nodes = root["bodies"];
+  const size_t count = static_cast<size_t>(min_markers);
+  for (size_t later = 0; later < database.bodies.size(); ++later) {
+    const RigidBody& b = database.bodies[later];
+    if (auto self = marker_confusion(b, b, count, tolerance, true)) {
+      reader.fail(nodes[later],
+                  fmt::format("body '{}': its markers {} could be taken for its markers {} "
+                              "(distances within {} m), so its pose is ambiguous when only {} "
+                              "are seen; move a marker, or identify bodies from more markers "
+                              "(min_markers)",
+                              b.name, listed(self->first), listed(self->second), 2 * tolerance,
+                              min_markers));
+    }
+    for (size_t earlier = 0; earlier < later; ++earlier) {
+      const RigidBody& a = database.bodies[earlier];
+      if (marker_confusion(a, b, count, tolerance, false)) {
+        reader.fail(nodes[later],
+                    fmt::format("body '{}' cannot be told apart from '{}' (line {}): {} or more "
+                                "markers of one match the other's distances within {} m; move "
+                                "a marker",
+                                b.name, a.name, Reader::line_of(nodes[earlier]), min_markers,
+                                2 * tolerance));
+      }
+    }
+  }
+  return database;
+}
+
+}  // namespace
+
+std::optional<std::pair<std::vector<int>, std::vector<int>>> marker_confusion(
     const RigidBody& seen, const RigidBody& taken_for, size_t count, double tolerance, bool same) {
   const double within = 2 * tolerance;
   std::vector<int> from(count), to(count);
@@ -89,47 +126,6 @@ std::optional<std::pair<std::vector<int>, std::vector<int>>> confusion(
   if (seen.markers.size() < count || taken_for.markers.size() < count) return std::nullopt;
   return place(0);
 }
-
-std::string listed(const std::vector<int>& markers) {
-  return fmt::format("{}", fmt::join(markers, ", "));
-}
-
-RigidBodyDatabase read_bodies(const Reader& reader, const YAML::Node& root, double tolerance,
-                              int min_markers) {
-  reader.check_keys(root, {"bodies"}, "the file");
-  RigidBodyDatabase database;
-  for (const YAML::Node& node : reader.list(root, "bodies")) {
-    database.bodies.push_back(read_body(reader, node, database.bodies));
-  }
-  const YAML::Node nodes = root["bodies"];
-  const size_t count = static_cast<size_t>(min_markers);
-  for (size_t later = 0; later < database.bodies.size(); ++later) {
-    const RigidBody& b = database.bodies[later];
-    if (auto self = confusion(b, b, count, tolerance, true)) {
-      reader.fail(nodes[later],
-                  fmt::format("body '{}': its markers {} could be taken for its markers {} "
-                              "(distances within {} m), so its pose is ambiguous when only {} "
-                              "are seen; move a marker, or identify bodies from more markers "
-                              "(min_markers)",
-                              b.name, listed(self->first), listed(self->second), 2 * tolerance,
-                              min_markers));
-    }
-    for (size_t earlier = 0; earlier < later; ++earlier) {
-      const RigidBody& a = database.bodies[earlier];
-      if (confusion(a, b, count, tolerance, false)) {
-        reader.fail(nodes[later],
-                    fmt::format("body '{}' cannot be told apart from '{}' (line {}): {} or more "
-                                "markers of one match the other's distances within {} m; move "
-                                "a marker",
-                                b.name, a.name, Reader::line_of(nodes[earlier]), min_markers,
-                                2 * tolerance));
-      }
-    }
-  }
-  return database;
-}
-
-}  // namespace
 
 RigidBodyDatabase parse_rigid_bodies(const std::string& text, const std::string& source,
                                      double tolerance, int min_markers) {

@@ -13,8 +13,10 @@
 // both names: in a volume they would be taken for each other.
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -47,5 +49,13 @@ inline constexpr double kMinMarkerSeparation = 0.01;  // metres
 RigidBodyDatabase parse_rigid_bodies(const std::string& text, const std::string& source,
                                      double tolerance, int min_markers);
 RigidBodyDatabase load_rigid_bodies(const std::string& path, double tolerance, int min_markers);
+
+// A way `count` markers of `seen` could be taken for `count` of `taken_for`'s: their distances
+// differ by up to twice `tolerance` and a rotation maps one set onto the other (a mirror image
+// does not confuse). With `same` (one body against itself), the markers taken for themselves
+// do not count: a body that maps onto itself so is symmetric, its orientation ambiguous. The
+// markers of each side, or nothing.
+std::optional<std::pair<std::vector<int>, std::vector<int>>> marker_confusion(
+    const RigidBody& seen, const RigidBody& taken_for, size_t count, double tolerance, bool same);
 
 }  // namespace mocap::volume

@@ -6,8 +6,10 @@
 //   motion.correct(next_stamp_ns, measured_pose, measured_covariance);
 //
 // The state is the pose, the linear velocity of the body's origin and the angular velocity,
-// all in the camera frame; its error is (δp, δθ, δv, δω) with the rotation error a small angle
-// vector applied on the left, R = exp(δθ) R̂, as in PlanarPose::covariance. Between frames the
+// all in the frame the poses are measured in (a camera's, or a volume's world: where this file
+// says camera_from_body, read the pose in that frame); its error is (δp, δθ, δv, δω) with the
+// rotation error a small angle vector applied on the left, R = exp(δθ) R̂, as in
+// PlanarPose::covariance. Between frames the
 // velocities change by white-noise accelerations of the densities below; a measured pose
 // corrects the whole state, so the velocities come out of the track, not of a difference of
 // two noisy poses.
@@ -84,6 +86,33 @@ class BodyMotionFilter {
   BodyMotionOptions options_;
   BodyState state_;
   int corrections_ = 1;
+};
+
+// A point's position and velocity at one instant, with their joint covariance over (p, v).
+struct PointState {
+  int64_t stamp_ns = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Matrix6d covariance = Matrix6d::Identity();
+};
+
+// The same constant-velocity model for a point that has no orientation (a robot of one marker):
+// BodyMotionFilter's linear half, with its linear density and initial velocity sigma.
+class PointMotionFilter {
+ public:
+  PointMotionFilter(const Eigen::Vector3d& position, const Eigen::Matrix3d& position_covariance,
+                    int64_t stamp_ns, BodyMotionOptions options = {});
+
+  PointState predicted(int64_t stamp_ns) const;
+  // As BodyMotionFilter::correct, over 3 degrees of freedom.
+  double correct(int64_t stamp_ns, const Eigen::Vector3d& measured,
+                 const Eigen::Matrix3d& position_covariance);
+
+  const PointState& state() const { return state_; }
+
+ private:
+  BodyMotionOptions options_;
+  PointState state_;
 };
 
 // exp and log of rotations as angle vectors (radians).

@@ -1,4 +1,4 @@
-#include "tracking/constellation_tracker/body_motion.hpp"
+#include "tracking/body_motion/body_motion.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -14,14 +14,15 @@ using Vector12d = Eigen::Matrix<double, 12, 1>;
 
 // White-noise acceleration of density q over dt: the covariance it adds to (position, velocity)
 // along one axis block.
-void add_acceleration_noise(Matrix12d& covariance, int position, int velocity, double q,
+template <class Covariance>
+void add_acceleration_noise(Covariance& covariance, int position, int velocity, double q,
                             double dt) {
   const double adt = std::abs(dt);
   const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
-  covariance.block<3, 3>(position, position) += q * adt * adt * adt / 3 * identity;
-  covariance.block<3, 3>(position, velocity) += q * dt * adt / 2 * identity;
-  covariance.block<3, 3>(velocity, position) += q * dt * adt / 2 * identity;
-  covariance.block<3, 3>(velocity, velocity) += q * adt * identity;
+  covariance.template block<3, 3>(position, position) += q * adt * adt * adt / 3 * identity;
+  covariance.template block<3, 3>(position, velocity) += q * dt * adt / 2 * identity;
+  covariance.template block<3, 3>(velocity, position) += q * dt * adt / 2 * identity;
+  covariance.template block<3, 3>(velocity, velocity) += q * adt * identity;
 }
 
 }  // namespace
@@ -134,6 +135,53 @@ double BodyMotionFilter::correct(int64_t stamp_ns, const Eigen::Isometry3d& meas
   state_.covariance =
       keep * prior.covariance * keep.transpose() + gain * pose_covariance * gain.transpose();
   ++corrections_;
+  return residual.dot(solver.solve(residual));
+}
+
+PointMotionFilter::PointMotionFilter(const Eigen::Vector3d& position,
+                                     const Eigen::Matrix3d& position_covariance, int64_t stamp_ns,
+                                     BodyMotionOptions options)
+    : options_(options) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("BodyMotionOptions::" + *problem);
+  }
+  state_.stamp_ns = stamp_ns;
+  state_.position = position;
+  state_.covariance.setZero();
+  state_.covariance.topLeftCorner<3, 3>() = position_covariance;
+  const double sv = options_.initial_linear_velocity_sigma_mps;
+  state_.covariance.bottomRightCorner<3, 3>() = sv * sv * Eigen::Matrix3d::Identity();
+}
+
+PointState PointMotionFilter::predicted(int64_t stamp_ns) const {
+  const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
+  PointState next = state_;
+  next.stamp_ns = stamp_ns;
+  if (dt == 0) return next;
+  next.position += state_.velocity * dt;
+  Matrix6d f = Matrix6d::Identity();
+  f.block<3, 3>(0, 3) = dt * Eigen::Matrix3d::Identity();
+  next.covariance = f * state_.covariance * f.transpose();
+  add_acceleration_noise(next.covariance, 0, 3, options_.linear_acceleration_density, dt);
+  return next;
+}
+
+double PointMotionFilter::correct(int64_t stamp_ns, const Eigen::Vector3d& measured,
+                                  const Eigen::Matrix3d& position_covariance) {
+  const PointState prior = predicted(stamp_ns);
+  const Eigen::Vector3d residual = measured - prior.position;
+  const Eigen::Matrix3d innovation = prior.covariance.topLeftCorner<3, 3>() + position_covariance;
+  const Eigen::LDLT<Eigen::Matrix3d> solver(innovation);
+  const Eigen::Matrix<double, 6, 3> gain =
+      solver.solve(prior.covariance.leftCols<3>().transpose()).transpose();
+  const Vector6d delta = gain * residual;
+  state_ = prior;
+  state_.position += delta.head<3>();
+  state_.velocity += delta.tail<3>();
+  Matrix6d keep = Matrix6d::Identity();
+  keep.leftCols<3>() -= gain;
+  state_.covariance =
+      keep * prior.covariance * keep.transpose() + gain * position_covariance * gain.transpose();
   return residual.dot(solver.solve(residual));
 }
 

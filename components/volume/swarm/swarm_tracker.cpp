@@ -1,0 +1,405 @@
+#include "volume/swarm/swarm_tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "common/min_cost_assignment/min_cost_assignment.hpp"
+#include "volume/rigid_bodies/rigid_body_identification.hpp"
+
+namespace mocap::volume {
+namespace {
+
+// A robot not looked for by its track costs this many times its search radius squared when it
+// is left without what was found: any find within the radius is taken before none.
+constexpr double kUnfoundCostFactor = 4;
+// The most instances of a layout looked for around one robot: two identical robots side by
+// side, and a third.
+constexpr int kMostInstancesPerSearch = 3;
+
+// Cloud markers by grid cell, for the markers near a point without looking at all of them.
+class PointGrid {
+ public:
+  PointGrid(const std::vector<CloudMarker>& cloud, double cell_m)
+      : cloud_(&cloud), cell_m_(cell_m) {
+    cells_.reserve(cloud.size());
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      cells_.emplace_back(key(cell_of(cloud[i].position)), static_cast<int>(i));
+    }
+    std::sort(cells_.begin(), cells_.end());
+  }
+
+  // Calls visit(index, squared distance) for each marker within `radius_m` (at most the cell
+  // size) of `at`.
+  template <class Visit>
+  void near(const Eigen::Vector3d& at, double radius_m, Visit visit) const {
+    const Eigen::Vector3<int64_t> cell = cell_of(at);
+    const double limit = radius_m * radius_m;
+    for (int64_t z = cell.z() - 1; z <= cell.z() + 1; ++z) {
+      for (int64_t y = cell.y() - 1; y <= cell.y() + 1; ++y) {
+        const int64_t first = key({cell.x() - 1, y, z}), last = key({cell.x() + 1, y, z});
+        for (auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(first, -1));
+             it != cells_.end() && it->first <= last; ++it) {
+          const double squared = ((*cloud_)[it->second].position - at).squaredNorm();
+          if (squared <= limit) visit(it->second, squared);
+        }
+      }
+    }
+  }
+
+ private:
+  static constexpr int64_t kSpan = int64_t{1} << 20;
+  Eigen::Vector3<int64_t> cell_of(const Eigen::Vector3d& point) const {
+    Eigen::Vector3<int64_t> cell;
+    for (int i = 0; i < 3; ++i) {
+      cell[i] = static_cast<int64_t>(
+                    std::clamp(std::floor(point[i] / cell_m_), -kSpan / 4.0, kSpan / 4.0)) +
+                kSpan / 2;
+    }
+    return cell;
+  }
+  static int64_t key(const Eigen::Vector3<int64_t>& cell) {
+    return (cell.z() * kSpan + cell.y()) * kSpan + cell.x();
+  }
+
+  const std::vector<CloudMarker>* cloud_;
+  double cell_m_;
+  std::vector<std::pair<int64_t, int>> cells_;  // (cell key, marker), sorted
+};
+
+// A marker's sigma (metres): the mean of its covariance's axes.
+double sigma_of(const CloudMarker& marker) { return std::sqrt(marker.covariance.trace() / 3); }
+
+}  // namespace
+
+std::optional<std::string> SwarmTrackerOptions::problem() const {
+  if (!(gate_m > 0)) return fmt::format("gate_m: {} is not above 0", gate_m);
+  if (!(layout_tolerance_m > 0))
+    return fmt::format("layout_tolerance_m: {} is not above 0", layout_tolerance_m);
+  if (!(max_fit_sigmas > 0))
+    return fmt::format("max_fit_sigmas: {} is not above 0", max_fit_sigmas);
+  if (min_markers < 3) return fmt::format("min_markers: {} is below 3", min_markers);
+  if (!(start_radius_m > 0))
+    return fmt::format("start_radius_m: {} is not above 0", start_radius_m);
+  if (!(lost_after_s >= 0)) return fmt::format("lost_after_s: {} is below 0", lost_after_s);
+  if (!(max_search_radius_m >= start_radius_m)) {
+    return fmt::format("max_search_radius_m: {} is below start_radius_m ({})", max_search_radius_m,
+                       start_radius_m);
+  }
+  if (auto problem = motion.problem()) return "motion." + *problem;
+  return std::nullopt;
+}
+
+SwarmTracker::SwarmTracker(SwarmDatabase swarm, SwarmTrackerOptions options)
+    : swarm_(std::move(swarm)), options_(options), robots_(swarm_.robots.size()) {
+  if (auto problem = options_.problem()) {
+    throw std::invalid_argument("SwarmTrackerOptions::" + *problem);
+  }
+  for (size_t r = 0; r < robots_.size(); ++r) {
+    if (swarm_.robots[r].layout >= swarm_.layouts.size()) {
+      throw std::invalid_argument("robot '" + swarm_.robots[r].name + "' has no layout");
+    }
+    robots_[r].anchor = swarm_.robots[r].initial_position;
+  }
+}
+
+bool SwarmTracker::reseed(const std::string& name, const Eigen::Vector3d& position) {
+  for (size_t r = 0; r < robots_.size(); ++r) {
+    if (swarm_.robots[r].name != name) continue;
+    Robot& robot = robots_[r];
+    robot.forget();
+    robot.anchor = position;
+    robot.lost_since_ns.reset();
+    return true;
+  }
+  return false;
+}
+
+double SwarmTracker::search_radius(const Robot& robot, size_t layout, int64_t stamp_ns) const {
+  if (!robot.lost_since_ns) return options_.start_radius_m;
+  const double lost_s = static_cast<double>(stamp_ns - *robot.lost_since_ns) * 1e-9;
+  return std::min(options_.max_search_radius_m,
+                  options_.start_radius_m + swarm_.layouts[layout].top_speed_mps * lost_s);
+}
+
+std::optional<SwarmTracker::Found> SwarmTracker::fit(size_t layout, std::vector<int> markers,
+                                                     const std::vector<CloudMarker>& cloud) const {
+  const std::vector<Eigen::Vector3d>& model = swarm_.layouts[layout].markers;
+  Found found;
+  if (model.size() == 1) {
+    if (markers[0] < 0) return std::nullopt;
+    const CloudMarker& marker = cloud[markers[0]];
+    found.world_from_body.translation() = marker.position - model[0];
+    found.covariance.topLeftCorner<3, 3>() = marker.covariance;
+    found.covariance.bottomRightCorner<3, 3>() =
+        Eigen::Matrix3d::Identity() * kUnknownOrientationVariance;
+    found.markers = std::move(markers);
+    return found;
+  }
+  const int needed = std::min(options_.min_markers, static_cast<int>(model.size()));
+  // The layout fitted to the markers given, and the furthest off of them in its own sigmas.
+  auto fitted = [&](const std::vector<int>& given, Eigen::Isometry3d& pose, double& rms_m) {
+    std::vector<Eigen::Vector3d> from, to;
+    for (size_t k = 0; k < given.size(); ++k) {
+      if (given[k] < 0) continue;
+      from.push_back(model[k]);
+      to.push_back(cloud[given[k]].position);
+    }
+    if (static_cast<int>(from.size()) < needed) return std::numeric_limits<double>::infinity();
+    rms_m = best_fit_rms(from, to, &pose);
+    double worst = 0;
+    for (size_t k = 0; k < given.size(); ++k) {
+      if (given[k] < 0) continue;
+      const CloudMarker& marker = cloud[given[k]];
+      worst = std::max(worst, (pose * model[k] - marker.position).norm() / sigma_of(marker));
+    }
+    return worst;
+  };
+  double worst = fitted(markers, found.world_from_body, found.rms_m);
+  // One marker that is not the robot's bends a fit of four so that another may look the worst:
+  // the marker whose leaving out fits the rest best goes, one at a time.
+  while (std::isfinite(worst) && worst > options_.max_fit_sigmas) {
+    size_t best = markers.size();
+    double best_worst = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < markers.size(); ++k) {
+      if (markers[k] < 0) continue;
+      std::vector<int> fewer = markers;
+      fewer[k] = -1;
+      Eigen::Isometry3d pose;
+      double rms_m = 0;
+      const double without = fitted(fewer, pose, rms_m);
+      if (without < best_worst) {
+        best_worst = without;
+        best = k;
+      }
+    }
+    if (best == markers.size()) return std::nullopt;
+    markers[best] = -1;
+    worst = fitted(markers, found.world_from_body, found.rms_m);
+  }
+  if (!std::isfinite(worst)) return std::nullopt;
+  {
+    std::vector<Eigen::Vector3d> to;
+    std::vector<double> variances;
+    for (int m : markers) {
+      if (m < 0) continue;
+      to.push_back(cloud[m].position);
+      variances.push_back(cloud[m].covariance.trace() / 3);
+    }
+    // The markers' own variances: the position is their mean's, the orientation's information
+    // their spread about the centre (a rigid body's inertia), in the world frame.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& point : to) centre += point;
+    centre /= static_cast<double>(to.size());
+    Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+    double variance = 0;
+    for (size_t i = 0; i < to.size(); ++i) {
+      variance += variances[i];
+      const Eigen::Vector3d arm = to[i] - centre;
+      spread += arm.squaredNorm() * Eigen::Matrix3d::Identity() - arm * arm.transpose();
+    }
+    variance /= static_cast<double>(to.size());
+    found.covariance.setZero();
+    found.covariance.topLeftCorner<3, 3>() =
+        Eigen::Matrix3d::Identity() * variance / static_cast<double>(to.size());
+    found.covariance.bottomRightCorner<3, 3>() = variance * spread.inverse();
+  }
+  found.markers = std::move(markers);
+  return found;
+}
+
+std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
+                                                const std::vector<CloudMarker>& cloud,
+                                                const std::vector<char>& claimed) {
+  if (!claimed.empty() && claimed.size() != cloud.size()) {
+    throw std::invalid_argument("SwarmTracker::track: `claimed` needs one entry per marker");
+  }
+  counts_ = {};
+  std::vector<char> used = claimed.empty() ? std::vector<char>(cloud.size(), 0) : claimed;
+  std::vector<std::optional<SwarmRobotPose>> poses(robots_.size());
+
+  // 1. Tracked robots, all at once.
+  const PointGrid grid(cloud, options_.gate_m);
+  std::vector<AllowedPair> allowed;
+  std::vector<double> unassigned;
+  std::vector<size_t> rows;  // each tracked robot's markers, robot by robot: the robot
+  for (size_t r = 0; r < robots_.size(); ++r) {
+    Robot& robot = robots_[r];
+    if (!robot.tracked()) continue;
+    const double dt_s = static_cast<double>(stamp_ns - robot.stamp_ns) * 1e-9;
+    if (dt_s > options_.lost_after_s) {
+      robot.anchor = robot.body ? robot.body->state().camera_from_body.translation()
+                                : robot.point->state().position;
+      robot.lost_since_ns = robot.stamp_ns;
+      robot.forget();
+      continue;
+    }
+    Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+    if (robot.body) {
+      start = robot.body->predicted(stamp_ns).camera_from_body;
+    } else {
+      start.translation() = robot.point->predicted(stamp_ns).position;
+    }
+    for (const Eigen::Vector3d& marker : swarm_.layouts[swarm_.robots[r].layout].markers) {
+      const int row = static_cast<int>(rows.size());
+      grid.near(start * marker, options_.gate_m, [&](int m, double squared) {
+        if (!used[m]) allowed.push_back({row, m, squared});
+      });
+      rows.push_back(r);
+      unassigned.push_back(options_.gate_m * options_.gate_m);
+    }
+  }
+  const std::vector<int> assigned = min_cost_assignment(
+      static_cast<int>(rows.size()), static_cast<int>(cloud.size()), allowed, unassigned);
+  for (size_t first = 0; first < rows.size();) {
+    const size_t r = rows[first];
+    const size_t count = swarm_.layouts[swarm_.robots[r].layout].markers.size();
+    std::vector<int> markers(assigned.begin() + static_cast<long>(first),
+                             assigned.begin() + static_cast<long>(first + count));
+    first += count;
+    if (auto found = fit(swarm_.robots[r].layout, std::move(markers), cloud)) {
+      for (int m : found->markers) {
+        if (m >= 0) used[m] = 1;
+      }
+      poses[r] = posed(r, stamp_ns, *found, false);
+      ++counts_.tracked;
+    }
+  }
+
+  // 2. Robots to find, among the markers no robot took: layouts of several markers first.
+  for (const bool several : {true, false}) {
+    std::vector<size_t> searching;
+    for (size_t r = 0; r < robots_.size(); ++r) {
+      const bool has_several = swarm_.layouts[swarm_.robots[r].layout].markers.size() > 1;
+      if (!robots_[r].tracked() && has_several == several) searching.push_back(r);
+    }
+    if (searching.empty()) continue;
+    std::vector<Found> finds;
+    allowed.clear();
+    unassigned.clear();
+    for (size_t row = 0; row < searching.size(); ++row) {
+      const size_t r = searching[row];
+      const Robot& robot = robots_[r];
+      const size_t layout = swarm_.robots[r].layout;
+      const double radius = search_radius(robot, layout, stamp_ns);
+      unassigned.push_back(kUnfoundCostFactor * radius * radius);
+      std::vector<int> candidates;
+      for (size_t m = 0; m < cloud.size(); ++m) {
+        if (!used[m] && (cloud[m].position - robot.anchor).norm() <= radius) {
+          candidates.push_back(static_cast<int>(m));
+        }
+      }
+      std::vector<Found> around;
+      if (!several) {
+        for (int m : candidates) around.push_back(*fit(layout, {m}, cloud));
+      } else {
+        RigidBodyDatabase one{
+            {RigidBody{swarm_.layouts[layout].name, swarm_.layouts[layout].markers}}};
+        const RigidBodyIdentificationOptions identification{options_.layout_tolerance_m,
+                                                            options_.min_markers};
+        for (int instance = 0; instance < kMostInstancesPerSearch; ++instance) {
+          std::vector<Eigen::Vector3d> positions;
+          for (int m : candidates) positions.push_back(cloud[m].position);
+          const std::vector<IdentifiedBody> identified =
+              identify_rigid_bodies(one, positions, identification);
+          if (identified.empty()) break;
+          std::vector<int> markers;
+          for (int measured : identified[0].measured) {
+            markers.push_back(measured < 0 ? -1 : candidates[measured]);
+          }
+          std::vector<int> rest;
+          for (int m : candidates) {
+            if (std::find(markers.begin(), markers.end(), m) == markers.end()) rest.push_back(m);
+          }
+          candidates = std::move(rest);
+          if (auto found = fit(layout, std::move(markers), cloud)) around.push_back(*found);
+        }
+      }
+      for (Found& found : around) {
+        const double off = (found.world_from_body.translation() - robot.anchor).norm();
+        if (off > radius) continue;
+        // One find seen from two robots' searches is one column.
+        auto same = std::find_if(finds.begin(), finds.end(), [&](const Found& other) {
+          return other.markers == found.markers;
+        });
+        const int column = static_cast<int>(same - finds.begin());
+        if (same == finds.end()) finds.push_back(std::move(found));
+        allowed.push_back({static_cast<int>(row), column, off * off});
+      }
+    }
+    const std::vector<int> given = min_cost_assignment(
+        static_cast<int>(searching.size()), static_cast<int>(finds.size()), allowed, unassigned);
+    for (size_t row = 0; row < searching.size(); ++row) {
+      if (given[row] < 0) continue;
+      const Found& found = finds[given[row]];
+      // Two finds may share a marker (the same markers in two orders): the first given keeps it.
+      if (std::any_of(found.markers.begin(), found.markers.end(),
+                      [&](int m) { return m >= 0 && used[m]; })) {
+        continue;
+      }
+      for (int m : found.markers) {
+        if (m >= 0) used[m] = 1;
+      }
+      poses[searching[row]] = posed(searching[row], stamp_ns, found, true);
+      ++counts_.found;
+    }
+  }
+
+  std::vector<SwarmRobotPose> result;
+  for (auto& pose : poses) {
+    if (pose) result.push_back(std::move(*pose));
+  }
+  counts_.searching = static_cast<int>(robots_.size() - result.size());
+  return result;
+}
+
+SwarmRobotPose SwarmTracker::posed(size_t r, int64_t stamp_ns, const Found& found, bool afresh) {
+  Robot& robot = robots_[r];
+  const bool several = swarm_.layouts[swarm_.robots[r].layout].markers.size() > 1;
+  SwarmRobotPose pose;
+  pose.robot = r;
+  pose.orientation_known = several;
+  pose.markers = found.markers;
+  for (int m : found.markers) pose.markers_used += m >= 0 ? 1 : 0;
+  pose.fit_rms_m = found.rms_m;
+  pose.found_afresh = afresh;
+  if (afresh) robot.lost_since_ns.reset();
+  robot.stamp_ns = stamp_ns;
+  if (several) {
+    if (afresh) {
+      robot.body.emplace(found.world_from_body, found.covariance, stamp_ns, options_.motion);
+    } else {
+      robot.body->correct(stamp_ns, found.world_from_body, found.covariance);
+    }
+    const tracking::BodyState& state = robot.body->state();
+    pose.world_from_body = state.camera_from_body;
+    pose.covariance = state.pose_covariance();
+    pose.linear_velocity = state.linear_velocity;
+    pose.angular_velocity = state.angular_velocity;
+    pose.velocity_covariance = state.velocity_covariance();
+  } else {
+    const Eigen::Matrix3d covariance = found.covariance.topLeftCorner<3, 3>();
+    const Eigen::Vector3d measured = found.world_from_body.translation();
+    if (afresh) {
+      robot.point.emplace(measured, covariance, stamp_ns, options_.motion);
+    } else {
+      robot.point->correct(stamp_ns, measured, covariance);
+    }
+    const tracking::PointState& state = robot.point->state();
+    pose.world_from_body.translation() = state.position;
+    pose.covariance.topLeftCorner<3, 3>() = state.covariance.topLeftCorner<3, 3>();
+    pose.covariance.bottomRightCorner<3, 3>() =
+        Eigen::Matrix3d::Identity() * kUnknownOrientationVariance;
+    pose.linear_velocity = state.velocity;
+    pose.velocity_covariance.topLeftCorner<3, 3>() = state.covariance.bottomRightCorner<3, 3>();
+    pose.velocity_covariance.bottomRightCorner<3, 3>() =
+        Eigen::Matrix3d::Identity() * kUnknownOrientationVariance;
+  }
+  pose.velocity_known = !afresh;
+  return pose;
+}
+
+}  // namespace mocap::volume

@@ -1,0 +1,153 @@
+// The marker cloud: a hundred markers and more in 3D from eight cameras' centroids (0.05 px of
+// noise: about 0.07 mm per axis at 3.5 m), found from scratch without ghosts, then tracked with
+// persistent ids and honest covariances; merged blobs and markers one camera sees are counted,
+// never triangulated.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <vector>
+
+#include "test/test_support.hpp"
+#include "test/volume/swarm_rig.hpp"
+#include "volume/marker_cloud/marker_cloud.hpp"
+
+namespace mocap::volume {
+namespace {
+
+using synthetic::SwarmScene;
+
+constexpr double kRate_hz = 240;
+
+synthetic::CentroidCameraOptions noise(double px) {
+  synthetic::CentroidCameraOptions options;
+  options.noise_px = px;
+  return options;
+}
+
+test::SwarmRig eight_cameras(double noise_px = 0.05, uint64_t seed = 1) {
+  return test::SwarmRig((mocap::test::source_dir() / "config").string(), 8, noise(noise_px), seed);
+}
+
+// The true marker nearest `position` and how far it is.
+std::pair<size_t, double> nearest_truth(const std::vector<Eigen::Vector3d>& truth,
+                                        const Eigen::Vector3d& position) {
+  size_t best = 0;
+  for (size_t i = 1; i < truth.size(); ++i) {
+    if ((truth[i] - position).norm() < (truth[best] - position).norm()) best = i;
+  }
+  return {best, (truth[best] - position).norm()};
+}
+
+TEST(MarkerCloud, AHundredMarkersFromScratchAreFoundWithoutGhosts) {
+  test::SwarmRig rig = eight_cameras();
+  const SwarmScene scene =
+      synthetic::random_flight(synthetic::single_marker_layout(), 100, 3.0, 1.0, 0.1, 1.0, 3);
+  for (int frame = 0; frame < 5; ++frame) {
+    const double time_s = 0.2 * frame;
+    const std::vector<Eigen::Vector3d> truth = scene.markers(time_s);
+    MarkerCloudTracker cloud;  // no tracks: every frame from scratch
+    const std::vector<CloudMarker> markers = cloud.track(0, rig.frame(scene, time_s));
+    EXPECT_EQ(markers.size(), 100u) << "frame " << frame;
+    std::set<size_t> found;
+    for (const CloudMarker& marker : markers) {
+      const auto [which, off_m] = nearest_truth(truth, marker.position);
+      EXPECT_LT(off_m, 0.5e-3) << "a marker 0.5 mm or more from any true one: a ghost";
+      found.insert(which);
+      EXPECT_GE(std::popcount(marker.cameras), 3);
+      EXPECT_EQ(static_cast<int>(marker.observations.size()), std::popcount(marker.cameras));
+    }
+    EXPECT_EQ(found.size(), markers.size()) << "two markers for one true marker";
+    EXPECT_EQ(cloud.counts().started, static_cast<int>(markers.size()));
+  }
+}
+
+TEST(MarkerCloud, TracksKeepTheirIdsAsTheMarkersMove) {
+  test::SwarmRig rig = eight_cameras();
+  const SwarmScene scene =
+      synthetic::random_flight(synthetic::single_marker_layout(), 100, 3.0, 1.0, 0.1, 1.0, 5);
+  MarkerCloudTracker cloud;
+  std::map<uint32_t, size_t> truth_of_id;
+  for (int f = 0; f < 240; ++f) {
+    const double time_s = f / kRate_hz;
+    const std::vector<Eigen::Vector3d> truth = scene.markers(time_s);
+    const std::vector<CloudMarker> markers =
+        cloud.track(static_cast<int64_t>(time_s * 1e9), rig.frame(scene, time_s));
+    ASSERT_EQ(markers.size(), 100u) << "frame " << f;
+    if (f > 0) {
+      EXPECT_EQ(cloud.counts().tracked, 100) << "frame " << f;
+      EXPECT_EQ(cloud.counts().started, 0) << "frame " << f;
+    }
+    for (const CloudMarker& marker : markers) {
+      const auto [which, off_m] = nearest_truth(truth, marker.position);
+      EXPECT_LT(off_m, 1e-3);
+      // Its covariance says how far off it may be: within six sigmas (3 degrees of freedom:
+      // one in ten million beyond), over 24,000 markers.
+      const Eigen::Vector3d error = marker.position - truth[which];
+      EXPECT_LT(error.dot(marker.covariance.inverse() * error), 36) << "marker " << marker.id;
+      const auto [it, added] = truth_of_id.emplace(marker.id, which);
+      EXPECT_EQ(it->second, which) << "marker " << marker.id << " changed which marker it is";
+    }
+  }
+  EXPECT_EQ(truth_of_id.size(), 100u);
+  EXPECT_EQ(cloud.totals().dropped, 0);
+}
+
+TEST(MarkerCloud, ADetectionOneCameraAloneSeesIsCountedNotTriangulated) {
+  test::SwarmRig rig = eight_cameras();
+  const SwarmScene scene =
+      synthetic::random_flight(synthetic::single_marker_layout(), 20, 3.0, 1.0, 0.1, 1.0, 4);
+  MarkerCloudTracker cloud;
+  std::vector<CameraDetections> frame = rig.frame(scene, 0);
+  frame[3].pixels.emplace_back(640, 300);  // a glint, or a marker only camera 3 sees
+  frame[3].pixel_sigma_px.push_back(0.05);
+  EXPECT_EQ(cloud.track(0, frame).size(), 20u);
+  EXPECT_EQ(cloud.counts().unexplained, 1);
+}
+
+TEST(MarkerCloud, DetectionsWhereTwoMarkersMergeAreLeftOut) {
+  // Two markers 25 mm apart along x: the two cameras on the x axis see them nearly end on, their
+  // images merged; the others see them apart.
+  synthetic::SwarmScene scene;
+  scene.duration_s = 1;
+  for (double x : {0.0, 0.025}) {
+    synthetic::SwarmSceneRobot robot;
+    robot.name = "m" + std::to_string(scene.robots.size());
+    robot.markers = synthetic::single_marker_layout();
+    synthetic::SwarmLeg leg;
+    leg.from = Eigen::Vector3d(x - 0.2, 0, 1);
+    leg.to = Eigen::Vector3d(x + 0.2, 0.1, 1);
+    robot.legs.push_back(leg);
+    scene.robots.push_back(robot);
+  }
+  test::SwarmRig rig = eight_cameras();
+  MarkerCloudTracker cloud;
+  int merged = 0;
+  for (int f = 0; f < 240; ++f) {
+    const double time_s = f / kRate_hz;
+    const std::vector<CloudMarker> markers =
+        cloud.track(static_cast<int64_t>(time_s * 1e9), rig.frame(scene, time_s));
+    merged += cloud.counts().merged;
+    ASSERT_EQ(markers.size(), 2u) << "frame " << f;
+    for (const CloudMarker& marker : markers) {
+      EXPECT_LT(nearest_truth(scene.markers(time_s), marker.position).second, 0.5e-3);
+    }
+  }
+  EXPECT_GT(merged, 0) << "no camera saw the two markers merged: the test tests nothing";
+  EXPECT_EQ(cloud.totals().started, 2);
+}
+
+TEST(MarkerCloud, BadOptionsAreRefusedNamingTheField) {
+  MarkerCloudOptions options;
+  options.min_cameras_to_start = 1;
+  try {
+    MarkerCloudTracker cloud(options);
+    FAIL() << "one camera accepted to start a marker";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "MarkerCloudOptions::min_cameras_to_start: 1 is below 2");
+  }
+}
+
+}  // namespace
+}  // namespace mocap::volume

@@ -1,0 +1,221 @@
+// Swarms in the volume: identical quadrotors told apart by their tracks, single-marker robots,
+// each from the marker cloud of eight cameras sending centroids at 240 Hz with 0.05 px of
+// noise. Short scenes of the swarm issue's kinds, each held to its targets: no identity swap,
+// 99.9 % of robot-frames tracked, position error median 0.1 mm, orientation 0.2 degrees.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "test/test_support.hpp"
+#include "test/volume/swarm_rig.hpp"
+#include "volume/swarm/swarm_database.hpp"
+#include "volume/swarm/swarm_tracker.hpp"
+
+namespace mocap::volume {
+namespace {
+
+using synthetic::SwarmScene;
+
+constexpr double kRate_hz = 240;
+
+test::SwarmRig eight_cameras(uint64_t seed = 1) {
+  synthetic::CentroidCameraOptions options;
+  options.noise_px = 0.05;
+  return test::SwarmRig((mocap::test::source_dir() / "config").string(), 8, options, seed);
+}
+
+// The swarm issue's targets.
+void expect_targets(const test::SwarmFigures& figures, bool oriented) {
+  fmt::print(
+      "{} robot-frames, {} tracked ({:.3f} %), {} identity swaps, position median {:.4f} mm, "
+      "orientation median {:.4f} deg\n",
+      figures.robot_frames, figures.tracked, 100 * figures.tracked_fraction(),
+      figures.identity_swaps, 1e3 * test::SwarmFigures::median(figures.position_errors_m),
+      test::SwarmFigures::median(figures.orientation_errors_deg));
+  EXPECT_EQ(figures.identity_swaps, 0);
+  EXPECT_GE(figures.tracked_fraction(), 0.999)
+      << figures.tracked << " of " << figures.robot_frames << " robot-frames";
+  EXPECT_LE(test::SwarmFigures::median(figures.position_errors_m), 0.1e-3);
+  if (oriented) {
+    EXPECT_LE(test::SwarmFigures::median(figures.orientation_errors_deg), 0.2);
+  }
+}
+
+TEST(SwarmDatabase, ReadsLayoutsAndRobots) {
+  const SwarmDatabase swarm = parse_swarm(R"(
+layouts:
+  - name: deck
+    markers: [[0, 0.021, 0.012], [0.019, -0.008, 0.018], [-0.016, -0.013, 0.014], [0.004, 0.001, 0.034]]
+    top_speed_mps: 2
+  - name: single
+    markers: [[0, 0, 0]]
+robots:
+  - {name: cf01, layout: deck, initial_position: [-1, -1, 0]}
+  - {name: cf02, layout: deck, initial_position: [-0.7, -1, 0]}
+  - {name: rover, layout: single, initial_position: [0.5, 0, 0.1]}
+)",
+                                          "robots.yaml", 0.002);
+  ASSERT_EQ(swarm.layouts.size(), 2u);
+  EXPECT_EQ(swarm.layouts[0].top_speed_mps, 2);
+  EXPECT_EQ(swarm.layouts[1].top_speed_mps, 3);
+  ASSERT_EQ(swarm.robots.size(), 3u);
+  EXPECT_EQ(swarm.robots[1].name, "cf02");
+  EXPECT_EQ(swarm.robots[2].layout, 1u);
+  EXPECT_EQ(swarm.robots[1].initial_position, Eigen::Vector3d(-0.7, -1, 0));
+}
+
+TEST(SwarmDatabase, RefusesWhatCannotBeToldApartWithOneLineNamingIt) {
+  const std::string deck =
+      "layouts:\n"
+      "  - name: deck\n"
+      "    markers: [[0, 0.021, 0.012], [0.019, -0.008, 0.018], [-0.016, -0.013, 0.014], "
+      "[0.004, 0.001, 0.034]]\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"layouts:\n  - {name: pair, markers: [[0, 0, 0], [0.05, 0, 0]]}\n",
+       "robots.yaml:2: layout 'pair' needs 1 marker, or 3 or more, not a list of 2"},
+      {"layouts:\n  - {name: square, markers: [[0, 0, 0], [0.05, 0, 0], [0.05, 0.05, 0], "
+       "[0, 0.05, 0]]}\n",
+       "robots.yaml:2: layout 'square' is symmetric"},
+      {deck + "robots:\n  - {name: a, layout: deck, initial_position: [0, 0, 0]}\n"
+              "  - {name: b, layout: deck, initial_position: [0.03, 0, 0]}\n",
+       "robots.yaml:6: robots 'a' and 'b' (line 5) of layout 'deck' start 0.030 m apart, closer "
+       "than the layout's size (0.038 m): which is which could not be told"},
+      {deck + "robots:\n  - {name: a, layout: plate, initial_position: [0, 0, 0]}\n",
+       "robots.yaml:5: robot 'a': no layout 'plate' in the file"},
+      {deck + "robots:\n  - {name: a, layout: deck, initial_position: [0, 0, 0]}\n"
+              "  - {name: a, layout: deck, initial_position: [1, 0, 0]}\n",
+       "robots.yaml:6: robot 'a' is declared twice"},
+  };
+  for (const auto& [text, expected] : cases) {
+    try {
+      parse_swarm(text, "robots.yaml", 0.002);
+      ADD_FAILURE() << "accepted:\n" << text;
+    } catch (const RigidBodyError& e) {
+      EXPECT_EQ(std::string(e.what()).substr(0, expected.size()), expected) << e.what();
+    }
+  }
+}
+
+TEST(SwarmTracker, IdenticalQuadrotorsCrossingFiveCentimetresApartKeepTheirNames) {
+  test::SwarmRig rig = eight_cameras();
+  const SwarmScene scene =
+      synthetic::crossing_pairs(synthetic::marker_deck_layout(), 4, 0.05, 1.0, 0.5, 1.0, 3.0);
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  expect_targets(figures, true);
+}
+
+TEST(SwarmTracker, TwoIdenticalQuadrotorsExchangePlaces) {
+  test::SwarmRig rig = eight_cameras(2);
+  const SwarmScene scene = synthetic::place_exchange(
+      synthetic::marker_deck_layout(), Eigen::Vector3d(0, 0, 1), 0.8, 0.05, 1.0, 1.5, 3.0);
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  expect_targets(figures, true);
+}
+
+TEST(SwarmTracker, FiftyQuadrotorsTakeOffFromAGrid) {
+  test::SwarmRig rig = eight_cameras(3);
+  const SwarmScene scene =
+      synthetic::takeoff_grid(synthetic::marker_deck_layout(), 5, 10, 0.3, 1.0, 1.0, 3.0);
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  expect_targets(figures, true);
+}
+
+TEST(SwarmTracker, AHundredSingleMarkerRobotsInRandomFlight) {
+  test::SwarmRig rig = eight_cameras(4);
+  const SwarmScene scene =
+      synthetic::random_flight(synthetic::single_marker_layout(), 100, 3.0, 1.0, 0.1, 2.0, 11);
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  expect_targets(figures, false);
+}
+
+TEST(SwarmTracker, AMixedSwarmOfFiftyQuadrotorsAndFiftySingleMarkerRobots) {
+  test::SwarmRig rig = eight_cameras(5);
+  const SwarmScene scene =
+      synthetic::random_flight(synthetic::marker_deck_layout(), 50, 3.0, 1.3, 0.1, 2.0, 12, "cf")
+          .with(synthetic::random_flight(synthetic::single_marker_layout(), 50, 3.0, 0.6, 0.1, 2.0,
+                                         13, "rover"));
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  expect_targets(figures, false);
+  EXPECT_LE(test::SwarmFigures::median(figures.orientation_errors_deg), 0.2);
+}
+
+// Two identical robots side by side; one vanishes (carried under a cloth) for 0.3 s while the
+// other flies past where it was.
+TEST(SwarmTracker, ALostRobotIsFoundAgainWithoutTakingAnothersMarkers) {
+  SwarmScene scene = synthetic::place_exchange(synthetic::marker_deck_layout(),
+                                               Eigen::Vector3d(0, 0, 1), 0.4, 0.05, 0.5, 2.0, 2.0);
+  test::SwarmRig rig = eight_cameras(6);
+  MarkerCloudTracker cloud;
+  SwarmTracker swarm(test::swarm_database_of(scene));
+  int lost_frames = 0, posed_after = 0;
+  for (int f = 0; f < 480; ++f) {
+    const double time_s = f / kRate_hz;
+    std::vector<Eigen::Vector3d> markers = scene.markers(time_s);
+    const bool hidden = time_s >= 0.5 && time_s < 0.8;
+    if (hidden) markers.erase(markers.begin(), markers.begin() + 4);  // robot 0's
+    const auto stamp_ns = static_cast<int64_t>(time_s * 1e9);
+    for (const SwarmRobotPose& pose :
+         swarm.track(stamp_ns, cloud.track(stamp_ns, rig.frame(markers)))) {
+      const Eigen::Vector3d own = scene.pose(pose.robot, time_s).translation();
+      const Eigen::Vector3d other = scene.pose(1 - pose.robot, time_s).translation();
+      EXPECT_LT((pose.world_from_body.translation() - own).norm(), 1e-3)
+          << swarm.swarm().robots[pose.robot].name << " at " << time_s << " s";
+      EXPECT_GT((pose.world_from_body.translation() - other).norm(), 0.01);
+      if (pose.robot == 0 && hidden) ADD_FAILURE() << "robot 0 posed while hidden";
+      if (pose.robot == 0 && time_s >= 0.8) ++posed_after;
+    }
+    if (hidden) lost_frames += swarm.counts().searching;
+  }
+  EXPECT_GT(lost_frames, 0);
+  // Found again in its first frame back.
+  EXPECT_EQ(posed_after, 480 - static_cast<int>(0.8 * kRate_hz));
+}
+
+TEST(SwarmTracker, ARobotCarriedAwayIsFoundWhereItIsReseeded) {
+  SwarmScene scene =
+      synthetic::random_flight(synthetic::marker_deck_layout(), 4, 2.0, 1.0, 0.1, 2.0, 21);
+  test::SwarmRig rig = eight_cameras(7);
+  MarkerCloudTracker cloud;
+  SwarmTracker swarm(test::swarm_database_of(scene));
+  const Eigen::Vector3d carried(0, 1.5, 0.8);  // beyond the widest search from where it was
+  bool reseeded = false;
+  int posed_carried = 0;
+  for (int f = 0; f < 240; ++f) {
+    const double time_s = f / kRate_hz;
+    std::vector<Eigen::Vector3d> markers = scene.markers(time_s);
+    const bool away = time_s >= 0.25;
+    if (away) {
+      const Eigen::Isometry3d at = scene.pose(0, time_s);
+      for (int m = 0; m < 4; ++m) markers[m] = carried + at.linear() * scene.robots[0].markers[m];
+    }
+    if (time_s >= 0.6 && !reseeded) reseeded = swarm.reseed(scene.robots[0].name, carried);
+    const auto stamp_ns = static_cast<int64_t>(time_s * 1e9);
+    for (const SwarmRobotPose& pose :
+         swarm.track(stamp_ns, cloud.track(stamp_ns, rig.frame(markers)))) {
+      if (pose.robot != 0 || !away) continue;
+      EXPECT_GE(time_s, 0.6) << "found 1.5 m away before it was re-seeded there";
+      EXPECT_LT((pose.world_from_body.translation() - carried).norm(), 1e-3);
+      ++posed_carried;
+    }
+  }
+  EXPECT_TRUE(reseeded);
+  EXPECT_EQ(posed_carried, 240 - static_cast<int>(0.6 * kRate_hz));
+  EXPECT_FALSE(swarm.reseed("nobody", carried));
+}
+
+TEST(SwarmTracker, BadOptionsAreRefusedNamingTheField) {
+  SwarmTrackerOptions options;
+  options.max_search_radius_m = 0.05;
+  try {
+    SwarmTracker swarm(SwarmDatabase{}, options);
+    FAIL() << "a search radius below the start radius accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "SwarmTrackerOptions::max_search_radius_m: 0.05 is below start_radius_m (0.1)");
+  }
+}
+
+}  // namespace
+}  // namespace mocap::volume
