@@ -4,7 +4,9 @@
 #
 #   sudo scripts/docker_test.sh [IMAGE]
 #
-# IMAGE: test that image instead of building one (kept at the end).
+# IMAGE: test that image instead of building one (kept at the end). MOCAP_PACKAGE_BUILD: make the
+# image's package with cpack in that build tree, already built (CI passes its plain tree),
+# instead of a build of its own.
 # Starts a Docker engine if none answers (and stops only that one at the end), makes the
 # debian:bookworm and debian:bookworm-slim base images with debootstrap if they are missing (no
 # registry is needed), builds the image (docker/Dockerfile, from the package its build stage
@@ -88,16 +90,32 @@ done
 if [ $# -eq 0 ]; then
   build_start=$SECONDS
   built_image=$image
-  # The image's package is made as the Dockerfile's build stage makes it (scripts/package.sh
-  # --runtime-only, warnings as errors), in a build folder of its own made afresh, so that what
-  # that path builds is checked here; on this machine rather than in the container, so that
-  # the compiler cache serves it. The Dockerfile takes it as MOCAP_DEB.
   rm -rf build-image
-  MOCAP_PACKAGE_DIR=build-image scripts/package.sh --runtime-only -DMOCAP_WERROR=ON \
-    > "$work/package.log" 2>&1 || { tail -40 "$work/package.log"; fail "scripts/package.sh --runtime-only"; }
+  if [ -n "${MOCAP_PACKAGE_BUILD:-}" ]; then
+    # CI: the package of the tree its tests just built (the same sources and warnings; cpack
+    # strips the debug information either way), rather than a fourth build of the product.
+    # The Dockerfile's own path (a tree without tests) is configured, which is where it could
+    # differ.
+    cmake -S . -B "$work/package-configure" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DMOCAP_BUILD_TESTS=OFF -DMOCAP_BUILD_BENCHMARKS=OFF -DMOCAP_WERROR=ON \
+      > "$work/package.log" 2>&1 || { tail -40 "$work/package.log"; fail "configure without tests"; }
+    { cmake --build "$MOCAP_PACKAGE_BUILD" --target mocap_runtime_package &&
+      (cd "$MOCAP_PACKAGE_BUILD" && cpack -G DEB -D CPACK_COMPONENTS_ALL=runtime -B "$root/build-image"); } \
+      >> "$work/package.log" 2>&1 || { tail -40 "$work/package.log"; fail "the package of $MOCAP_PACKAGE_BUILD"; }
+    made="the package of $MOCAP_PACKAGE_BUILD/"
+  else
+    # The image's package is made as the Dockerfile's build stage makes it (scripts/package.sh
+    # --runtime-only, warnings as errors), in a build folder of its own made afresh, so that what
+    # that path builds is checked here; on this machine rather than in the container, so that
+    # the compiler cache serves it.
+    MOCAP_PACKAGE_DIR=build-image scripts/package.sh --runtime-only -DMOCAP_WERROR=ON \
+      > "$work/package.log" 2>&1 || { tail -40 "$work/package.log"; fail "scripts/package.sh --runtime-only"; }
+    made="scripts/package.sh --runtime-only"
+  fi
+  # The Dockerfile takes it as MOCAP_DEB.
   deb=$(ls build-image/mocap-graph_*_amd64.deb)
   build_args=(--build-arg "MOCAP_DEB=$deb")
-  how="from $deb (scripts/package.sh --runtime-only, $((SECONDS - build_start)) s)"
+  how="from $deb ($made, $((SECONDS - build_start)) s)"
   docker build -f docker/Dockerfile "${build_args[@]}" -t "$image" . > "$work/build.log" 2>&1 ||
     { tail -40 "$work/build.log"; fail "docker build"; }
   echo "image: $image built $how in $((SECONDS - build_start)) s"

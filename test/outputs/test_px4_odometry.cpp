@@ -71,6 +71,24 @@ TEST(Px4Frames, AKnownTableOfPosesInNed) {
   expect_q(to_px4(at({0, 0, 0}, {0, -M_PI / 2, M_PI / 2}), Px4Frame::Ned), {kHalf, 0, kHalf, 0});
 }
 
+// A robot of one marker: a position and its velocity, and NaN (PX4's "not measured") for the
+// attitude, the angular velocity and their variances.
+TEST(Px4Frames, ARobotOfOneMarkerHasNoAttitude) {
+  BodyState robot = at({1, 2, 3}, {0, 0, 0});
+  robot.pose_covariance.diagonal() << 1e-8, 1e-8, 1e-8, 1e9, 1e9, 1e9;
+  robot.linear_velocity = Vector3d(0.5, 0, 0);
+  const Px4Odometry o = to_px4(robot, Px4Frame::Ned);
+  EXPECT_TRUE(o.position.isApprox(Vector3d(2, 1, -3), kExact));
+  EXPECT_TRUE(o.velocity.isApprox(Vector3d(0, 0.5, 0), kExact));
+  EXPECT_NEAR(o.position_variance.x(), 1e-8, 1e-20);
+  for (double value : o.q) EXPECT_TRUE(std::isnan(value));
+  EXPECT_TRUE(o.angular_velocity.array().isNaN().all());
+  EXPECT_TRUE(o.orientation_variance.array().isNaN().all());
+  // A measured attitude, however poor, stays.
+  robot.pose_covariance.diagonal() << 1e-8, 1e-8, 1e-8, 1e9, 1e9, 1;
+  EXPECT_FALSE(std::isnan(to_px4(robot, Px4Frame::Ned).q[0]));
+}
+
 // q as PX4 reads it, written out: v' = q v q*, (w, x, y, z).
 Vector3d rotate(const std::array<double, 4>& q, const Vector3d& v) {
   const double w = q[0];

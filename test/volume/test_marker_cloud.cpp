@@ -4,11 +4,13 @@
 // never triangulated.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
 #include <set>
 #include <stdexcept>
 #include <vector>
 
+#include "common/marker_cloud_message/marker_cloud_message.hpp"
 #include "test/test_support.hpp"
 #include "test/volume/swarm_rig.hpp"
 #include "volume/marker_cloud/marker_cloud.hpp"
@@ -147,6 +149,51 @@ TEST(MarkerCloud, BadOptionsAreRefusedNamingTheField) {
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "MarkerCloudOptions::min_cameras_to_start: 1 is below 2");
   }
+}
+
+TEST(MarkerCloudMessage, ThePointCloudCarriesEveryFieldAndIsReadBack) {
+  std_msgs::msg::Header header;
+  header.frame_id("world");
+  header.stamp().sec(12);
+  const std::vector<LabeledMarker> markers = {
+      {Eigen::Vector3f(0.5f, -1.25f, 1.75f), 3, 2, 41, 0.04f, 0b10110101},
+      {Eigen::Vector3f(-2, 0, 0.25f), -1, 0, 7, 0.125f, 0x80000001u}};
+  const sensor_msgs::msg::PointCloud2 cloud = to_point_cloud(header, markers);
+  EXPECT_EQ(cloud.header().frame_id(), "world");
+  EXPECT_EQ(cloud.height(), 1u);
+  EXPECT_EQ(cloud.width(), 2u);
+  EXPECT_EQ(cloud.point_step(), 32u);
+  EXPECT_EQ(cloud.row_step(), 64u);
+  EXPECT_EQ(cloud.data().size(), 64u);
+  ASSERT_EQ(cloud.fields().size(), 8u);
+  EXPECT_EQ(cloud.fields()[3].name(), "body");
+  EXPECT_EQ(cloud.fields()[3].datatype(), 5);  // INT32
+  EXPECT_EQ(cloud.fields()[4].datatype(), 4);  // UINT16
+  // x of the second point, little-endian float32 at byte 32.
+  float x = 0;
+  std::memcpy(&x, cloud.data().data() + 32, 4);
+  EXPECT_EQ(x, -2.0f);
+  const auto back = markers_from_point_cloud(cloud);
+  ASSERT_TRUE(back);
+  ASSERT_EQ(back->size(), 2u);
+  for (size_t i = 0; i < markers.size(); ++i) {
+    EXPECT_EQ((*back)[i].position, markers[i].position);
+    EXPECT_EQ((*back)[i].body, markers[i].body);
+    EXPECT_EQ((*back)[i].marker, markers[i].marker);
+    EXPECT_EQ((*back)[i].id, markers[i].id);
+    EXPECT_EQ((*back)[i].residual_px, markers[i].residual_px);
+    EXPECT_EQ((*back)[i].cameras, markers[i].cameras);
+  }
+
+  sensor_msgs::msg::PointCloud2 no_id = cloud;
+  no_id.fields().erase(no_id.fields().begin() + 5);
+  std::string problem;
+  EXPECT_FALSE(markers_from_point_cloud(no_id, &problem));
+  EXPECT_EQ(problem, "fields: no 'id'");
+  sensor_msgs::msg::PointCloud2 short_data = cloud;
+  short_data.data().resize(60);
+  EXPECT_FALSE(markers_from_point_cloud(short_data, &problem));
+  EXPECT_EQ(problem, "data: 60 bytes, not 2 points of 32 bytes");
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/swarm_scene/swarm_scene_file.hpp"
 #include "test/test_support.hpp"
 #include "test/volume/swarm_rig.hpp"
 #include "volume/swarm/swarm_database.hpp"
@@ -93,6 +94,52 @@ TEST(SwarmDatabase, RefusesWhatCannotBeToldApartWithOneLineNamingIt) {
       parse_swarm(text, "robots.yaml", 0.002);
       ADD_FAILURE() << "accepted:\n" << text;
     } catch (const RigidBodyError& e) {
+      EXPECT_EQ(std::string(e.what()).substr(0, expected.size()), expected) << e.what();
+    }
+  }
+}
+
+// The demo's robots file is the one its scene makes: the names and the starts cannot drift apart.
+TEST(SwarmScene, TheDemosRobotsFileIsTheOneItsSceneMakes) {
+  const std::string config = (mocap::test::source_dir() / "config" / "swarm").string();
+  const synthetic::SwarmScene scene = synthetic::load_swarm_scene(config + "/scene.yaml");
+  ASSERT_EQ(scene.robots.size(), 100u);
+  const SwarmDatabase made = parse_swarm(synthetic::robots_file_of(scene), "made",
+                                         SwarmTrackerOptions{}.layout_tolerance_m);
+  const SwarmDatabase shipped =
+      load_swarm(config + "/robots.yaml", SwarmTrackerOptions{}.layout_tolerance_m);
+  ASSERT_EQ(shipped.robots.size(), made.robots.size());
+  for (size_t r = 0; r < made.robots.size(); ++r) {
+    EXPECT_EQ(shipped.robots[r].name, made.robots[r].name);
+    EXPECT_EQ(shipped.layouts[shipped.robots[r].layout].markers,
+              made.layouts[made.robots[r].layout].markers);
+    EXPECT_LT((shipped.robots[r].initial_position - scene.pose(r, 0).translation()).norm(), 1e-6);
+  }
+}
+
+TEST(SwarmScene, AFileThatCannotBeFlownIsRefusedWithOneLineNamingIt) {
+  const std::string layouts = "layouts:\n  - {name: single, markers: [[0, 0, 0]]}\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {layouts + "groups:\n  - {flight: loop, layout: single, count: 3}\n",
+       "scene.yaml:4: unknown flight 'loop'"},
+      {layouts + "groups:\n  - {flight: random_flight, layout: dot, count: 3}\n",
+       "scene.yaml:4: no layout 'dot' in the file"},
+      {layouts + "groups:\n  - {flight: random_flight, layout: single, count: 100, extent_m: 1,"
+                 " height_m: 1, min_separation_m: 0.2}\n",
+       "scene.yaml:4: random_flight: 100 robots in 1 m leave no room to move 0.2 m apart"},
+      {layouts + "groups:\n  - {flight: formation_circle, layout: single, count: 3, radius_m: 1,"
+                 " height_m: 1, rate_rad_s: 0.5, speed: 3}\n",
+       "scene.yaml:4:"},
+      {layouts + "groups:\n  - {flight: formation_circle, layout: single, count: 3, radius_m: 1,"
+                 " height_m: 1, rate_rad_s: 0.5}\n  - {flight: formation_circle, layout: single,"
+                 " count: 3, radius_m: 2, height_m: 1, rate_rad_s: 0.5}\n",
+       "scene.yaml:5: robot 'robot_01' is named twice: give the group its own prefix"},
+  };
+  for (const auto& [text, expected] : cases) {
+    try {
+      synthetic::parse_swarm_scene(text, "scene.yaml");
+      ADD_FAILURE() << "accepted:\n" << text;
+    } catch (const synthetic::SwarmSceneError& e) {
       EXPECT_EQ(std::string(e.what()).substr(0, expected.size()), expected) << e.what();
     }
   }

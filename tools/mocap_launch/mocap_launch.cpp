@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include <mocap/component_host.hpp>
+#include <mocap/launch_start.hpp>
 
 #include "host/plugin_loader.hpp"
 #include "launch/group_supervisor.hpp"
@@ -259,6 +260,15 @@ int main(int argc, char** argv) {
                launch.component_count());
     return 0;
   }
+  // One instant every process of this launch shares, its groups restarted ones too (they
+  // inherit it): simulated cameras in different processes count scene time from it. A
+  // launcher started with it set (one per host) keeps the value given.
+  setenv(mocap::kLaunchStartVariable,
+         std::to_string(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count())
+             .c_str(),
+         0);
   if (!group && launch.groups.size() == 1) group = &launch.groups.front();
   if (group) return run_group(launch, *group, options.duration, options.health_file, ready);
   return run_groups(launch, options);

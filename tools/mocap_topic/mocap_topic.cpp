@@ -1,4 +1,5 @@
 // mocap_topic: what is on the DDS domain, and what goes over it.
+#include <array>
 #include <charconv>
 #include <condition_variable>
 #include <cstdlib>
@@ -12,6 +13,8 @@
 #include <fmt/format.h>
 
 #include <mocap/generated_message_types.hpp>
+#include <mocap/message_time.hpp>
+#include <motion_capture_tracking_interfaces/msg/named_pose_array.hpp>
 
 #include <mocap/raw_message_type.hpp>
 #include "core/rate_estimator.hpp"
@@ -28,6 +31,7 @@ constexpr const char* kUsage = R"(usage:
   mocap_topic list [--wait SECONDS]
   mocap_topic echo TOPIC [--count N] [--full] [--idl FILE]...
   mocap_topic hz TOPIC [--window N] [--count N]
+  mocap_topic reseed ROBOT X Y Z [--topic TOPIC] [--wait SECONDS]
 options for all: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
 
   list   topics seen on the domain, with their types and endpoint counts, and each
@@ -36,6 +40,9 @@ options for all: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
          --idl adds definitions for types this build does not know
   hz     publication rate from the publisher's timestamps, every second; --window sets the
          samples averaged (default 10000), --count stops after N reports
+  reseed tell the volume a swarm robot was carried to (X, Y, Z) (world frame, metres): it is
+         looked for there; published on /mocap/reseed (--topic) once the fusion listens,
+         waiting up to --wait seconds (default 5)
 )";
 
 [[noreturn]] void usage_error(std::string_view message) {
@@ -227,6 +234,54 @@ int hz(mocap::DdsTransport& transport, const std::string& topic, size_t window, 
   });
 }
 
+double parse_coordinate(const std::string& text) {
+  double value = 0;
+  auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size()) {
+    usage_error(fmt::format("{}: expected a number of metres", text));
+  }
+  return value;
+}
+
+// One re-seed for the fusion, published once a subscriber listens: the fusion takes robots'
+// new positions on a reliable topic.
+int reseed(mocap::DdsTransport& transport, const std::string& topic, const std::string& robot,
+           const std::array<double, 3>& position, double wait_seconds) {
+  using motion_capture_tracking_interfaces::msg::NamedPoseArray;
+  const mocap::Endpoint endpoint{topic, &mocap::message_type<NamedPoseArray>(),
+                                 mocap::Qos::reliable(), "mocap_topic"};
+  auto publisher = transport.advertise(endpoint);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_seconds);
+  while (publisher->matched_subscribers() == 0 && std::chrono::steady_clock::now() < deadline &&
+         !mocap::ShutdownSignal::received()) {
+    sleep_unless_stopped(std::chrono::milliseconds(50));
+  }
+  if (publisher->matched_subscribers() == 0) {
+    fmt::print(stderr,
+               "mocap_topic: nothing subscribes to {} within {} s: is volume_fusion running with "
+               "a robots file, on this domain?\n",
+               topic, wait_seconds);
+    return 1;
+  }
+  auto message = std::make_shared<NamedPoseArray>();
+  message->header().stamp(mocap::to_time_msg(mocap::Clock::now()));
+  message->header().frame_id("world");
+  motion_capture_tracking_interfaces::msg::NamedPose named;
+  named.name(robot);
+  named.pose().position().x(position[0]);
+  named.pose().position().y(position[1]);
+  named.pose().position().z(position[2]);
+  named.pose().orientation().w(1);
+  message->poses().push_back(named);
+  publisher->publish(message, mocap::Clock::now());
+  // Reliable delivery takes a moment after the call; the process must not leave before.
+  sleep_unless_stopped(std::chrono::milliseconds(500));
+  fmt::print("{}: looked for at ({}, {}, {}) (on {})\n", robot, position[0], position[1],
+             position[2], topic);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -238,9 +293,10 @@ int main(int argc, char** argv) {
   }
   std::string command = args[0];
   std::optional<std::string> topic;
+  std::vector<std::string> positional;
   std::optional<int> domain;
   size_t count = SIZE_MAX, window = 10000;
-  double wait_seconds = 1.5;
+  std::optional<double> wait_seconds;  // list: 1.5, reseed: 5
   bool full = false;
   std::vector<std::string> idl_files;
   for (size_t i = 1; i < args.size(); ++i) {
@@ -257,17 +313,27 @@ int main(int argc, char** argv) {
       window = parse_number(arg, value(), 2, 10000000);
     } else if (arg == "--wait") {
       wait_seconds = std::atof(value().c_str());
+    } else if (arg == "--topic" && command == "reseed") {
+      topic = value();
     } else if (arg == "--full") {
       full = true;
     } else if (arg == "--idl") {
       idl_files.push_back(value());
-    } else if (arg.starts_with("-")) {
+    } else if (arg.starts_with("-") && !(command == "reseed" && positional.size() >= 1)) {
       usage_error(fmt::format("unknown option {}", arg));
+    } else if (command == "reseed") {
+      positional.push_back(arg);
     } else if (!topic) {
       topic = arg;
     } else {
       usage_error(fmt::format("unexpected argument {}", arg));
     }
+  }
+  std::array<double, 3> position{};
+  if (command == "reseed") {
+    if (positional.size() != 4) usage_error("reseed needs ROBOT X Y Z");
+    for (int i = 0; i < 3; ++i) position[i] = parse_coordinate(positional[i + 1]);
+    if (!topic) topic = "/mocap/reseed";
   }
   if (command != "list" && !topic) usage_error(fmt::format("{} needs a TOPIC", command));
   if (domain) setenv("MOCAP_DOMAIN_ID", std::to_string(*domain).c_str(), 1);
@@ -280,9 +346,12 @@ int main(int argc, char** argv) {
   try {
     auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_topic");
     mocap::DdsTransport& transport = *dds;
-    if (command == "list") return list(transport, wait_seconds);
+    if (command == "list") return list(transport, wait_seconds.value_or(1.5));
     if (command == "echo") return echo(transport, *topic, count, full, idl_files);
     if (command == "hz") return hz(transport, *topic, window, count);
+    if (command == "reseed") {
+      return reseed(transport, *topic, positional[0], position, wait_seconds.value_or(5));
+    }
   } catch (const std::exception& e) {
     fmt::print(stderr, "mocap_topic: {}\n", e.what());
     return 1;

@@ -23,12 +23,19 @@ inline constexpr const char* kDemoFiducials = "/demo/fiducials";  // FiducialArr
 
 // A volume of fixed cameras.
 inline constexpr const char* kVolumeFiducials = "/volume/{camera}/fiducials";  // FiducialArray
+inline constexpr const char* kMarkers = "/mocap/markers";  // sensor_msgs/PointCloud2, world
+// A robot carried away by hand, to be looked for where it now is: each name at its position.
+inline constexpr const char* kReseed =
+    "/mocap/reseed";  // motion_capture_tracking_interfaces/NamedPoseArray
 
 // The poses as other tools read them.
 inline constexpr const char* kBoardPose = "/mocap/{board}/pose";      // PoseStamped
 inline constexpr const char* kBoardOdometry = "/mocap/{board}/odom";  // nav_msgs/Odometry
 inline constexpr const char* kTf = "/tf";                             // tf2_msgs/TFMessage
 inline constexpr const char* kTfStatic = "/tf_static";                // tf2_msgs/TFMessage
+// Every body of a frame by name, as crazyswarm2 reads a swarm's poses.
+inline constexpr const char* kNamedPoses =
+    "/poses";  // motion_capture_tracking_interfaces/NamedPoseArray
 inline constexpr const char* kPx4VisualOdometry =
     "/fmu/in/vehicle_visual_odometry";  // px4_msgs/VehicleOdometry
 

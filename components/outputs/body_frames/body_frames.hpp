@@ -34,6 +34,14 @@ struct BodyState {
   Matrix6d velocity_covariance = Matrix6d::Zero();
 };
 
+// A pose whose orientation variances (rad², each axis) are all this large or more has no
+// orientation: a robot of one marker, whose pose carries 1e9 there as ROS's Odometry readers
+// expect.
+inline constexpr double kUnknownOrientationVariance = 1e6;
+inline bool orientation_unknown(const Matrix6d& pose_covariance) {
+  return (pose_covariance.diagonal().tail<3>().array() >= kUnknownOrientationVariance).all();
+}
+
 // `body` seen from another frame, fixed to its parent: `new_from_parent` the parent in the new
 // frame. Pose composed; velocities and both covariances rotated.
 BodyState seen_from(const Eigen::Isometry3d& new_from_parent, const BodyState& body);

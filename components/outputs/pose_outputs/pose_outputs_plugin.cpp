@@ -1,8 +1,9 @@
 // pose_outputs: the tracked boards as ROS 2 tools read them. Per board a
 // geometry_msgs/PoseStamped on /mocap/<board>/pose and a nav_msgs/Odometry on
-// /mocap/<board>/odom; every board on /tf, and the camera's mounting on /tf_static. Stamps are
-// the poses' own, the capture time of their image; rates are kept by those stamps, so a
-// replayed bag gives the live run's messages.
+// /mocap/<board>/odom; every board on /tf, and the camera's mounting on /tf_static; every board
+// of a frame in one motion_capture_tracking_interfaces/NamedPoseArray on /poses, as crazyswarm2's
+// crazyflie_server reads a swarm's poses. Stamps are the poses' own, the capture time of their
+// image; rates are kept by those stamps, so a replayed bag gives the live run's messages.
 #include <cmath>
 #include <map>
 #include <set>
@@ -15,6 +16,7 @@
 #include <mocap/component_spec.hpp>
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
+#include <motion_capture_tracking_interfaces/msg/named_pose_array.hpp>
 #include <nav_msgs/msg/odometry.hpp>
 #include <tf2_msgs/msg/tf_message.hpp>
 
@@ -29,6 +31,7 @@ namespace {
 using geometry_msgs::msg::PoseStamped;
 using mocap_msgs::msg::ConstellationPose;
 using mocap_msgs::msg::ConstellationPoseArray;
+using motion_capture_tracking_interfaces::msg::NamedPoseArray;
 using nav_msgs::msg::Odometry;
 using tf2_msgs::msg::TFMessage;
 
@@ -117,6 +120,9 @@ class PoseOutputs final : public Component {
     spec.publishes<TFMessage>(topics::kTf, tf_qos(), "the boards in the parent frame");
     spec.publishes<TFMessage>(topics::kTfStatic, Qos::latched(),
                               "world -> camera_frame -> optical_frame, once");
+    spec.publishes<NamedPoseArray>(topics::kNamedPoses, Qos::sensor_data(),
+                                   "every board of a frame by name, in the parent frame (a "
+                                   "swarm's poses as crazyswarm2's crazyflie_server reads them)");
   }
 
   explicit PoseOutputs(Context& context)
@@ -145,6 +151,7 @@ class PoseOutputs final : public Component {
     world_from_optical_ = world_from_camera * camera_from_optical;
 
     tf_ = create_publisher<TFMessage>(topics::kTf);
+    named_ = create_publisher<NamedPoseArray>(topics::kNamedPoses);
     create_subscription<ConstellationPoseArray>(
         topics::kPoses, [this](const ConstellationPoseArray& poses) { on_poses(poses); });
 
@@ -188,6 +195,7 @@ class PoseOutputs final : public Component {
   void on_poses(const ConstellationPoseArray& poses) {
     ++arrays_;
     TFMessage transforms;
+    NamedPoseArray named;
     for (const ConstellationPose& pose : poses.poses()) {
       std_msgs::msg::Header header = pose.pose().header();
       if (header.frame_id().empty()) header.frame_id(poses.header().frame_id());
@@ -214,6 +222,11 @@ class PoseOutputs final : public Component {
       const int64_t stamp_ns = to_nanoseconds(header.stamp());
       const std::string child = settings_.child_frame_prefix + pose.name();
       ++boards_published_;
+      if (named.poses().empty()) named.header(header);
+      motion_capture_tracking_interfaces::msg::NamedPose by_name;
+      by_name.name(pose.name());
+      by_name.pose(to_pose_message(board.parent_from_body));
+      named.poses().push_back(std::move(by_name));
       if (tf_rate_.due(pose.name(), stamp_ns)) {
         transforms.transforms().push_back(to_transform(header, child, board.parent_from_body));
       }
@@ -239,6 +252,7 @@ class PoseOutputs final : public Component {
       }
     }
     if (!transforms.transforms().empty()) tf_.publish(transforms);
+    if (!named.poses().empty()) named_.publish(named);
   }
 
   // The board's publishers, made when it is first seen; null when its name makes no topic
@@ -265,6 +279,7 @@ class PoseOutputs final : public Component {
   Publisher<TFMessage> tf_;
   std::map<std::string, BoardOutputs> outputs_;
   std::set<std::string> unpublishable_;
+  Publisher<NamedPoseArray> named_;
   uint64_t arrays_ = 0, boards_published_ = 0, wrong_frame_ = 0, invalid_ = 0;
 };
 

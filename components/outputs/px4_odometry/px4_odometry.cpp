@@ -1,5 +1,7 @@
 #include "outputs/px4_odometry/px4_odometry.hpp"
 
+#include <limits>
+
 namespace mocap::outputs {
 namespace {
 
@@ -46,6 +48,12 @@ Px4Odometry to_px4(const BodyState& vehicle, Px4Frame frame) {
   odometry.orientation_variance =
       diagonal(body_from_world, vehicle.pose_covariance.bottomRightCorner<3, 3>());
   odometry.velocity_variance = diagonal(world, vehicle.velocity_covariance.topLeftCorner<3, 3>());
+  if (orientation_unknown(vehicle.pose_covariance)) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    odometry.q = {nan, nan, nan, nan};
+    odometry.angular_velocity.setConstant(nan);
+    odometry.orientation_variance.setConstant(nan);
+  }
   return odometry;
 }
 

@@ -28,6 +28,8 @@ struct Px4Odometry {
 };
 
 // `vehicle`: its FLU body in our world (ENU for Ned, any heading for Frd), as BodyState holds it.
+// A vehicle whose orientation is unknown (a robot of one marker: orientation_unknown()) gets
+// NaN in q, the angular velocity and their variances: PX4's mark of a field not measured.
 Px4Odometry to_px4(const BodyState& vehicle, Px4Frame frame);
 
 }  // namespace mocap::outputs

@@ -42,6 +42,7 @@ struct SwarmLeg {
 struct SwarmSceneRobot {
   std::string name;
   std::vector<Eigen::Vector3d> markers;  // in the robot's frame, metres
+  std::string layout;                    // the markers' name, where a file gave one
   std::vector<SwarmLeg> legs;            // in time order; before the first, at its start
   double yaw_rad = 0;                    // heading at time 0
   double yaw_rate_rad_s = 0;

@@ -26,7 +26,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include <geometry_msgs/msg/pose_stamped.hpp>
 #include <mocap/calibration/camera_file.hpp>
@@ -37,6 +36,7 @@
 #include <sensor_msgs/msg/camera_info.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
+#include "common/capture_clock/capture_clock.hpp"
 #include "common/image_message/camera_info_message.hpp"
 #include "common/image_message/image_message.hpp"
 #include "common/pose_message/pose_message.hpp"
@@ -178,8 +178,10 @@ class SyntheticIrCamera final : public Component {
                                                 std::chrono::duration<double>(1 / rate_hz))
                                           : std::chrono::nanoseconds(kBackToBackPeriod);
     if (settings_.synchronized) {
-      create_worker("capture",
-                    [this, period](std::stop_token stop) { capture_on_the_clock(period, stop); });
+      // The only caller of tick() then (no timer, no pose subscription): it needs no lock.
+      create_worker("capture", [this, period](std::stop_token stop) {
+        capture_on_the_clock(period, stop, [this](Clock::time_point capture) { tick(capture); });
+      });
     } else {
       create_timer(period, [this] { tick(); });
     }
@@ -190,22 +192,6 @@ class SyntheticIrCamera final : public Component {
   }
 
  private:
-  // Synchronized: a frame at every multiple of `period` on the system clock, stamped with it.
-  // The only caller of tick() then (no timer, no pose subscription), so it needs no lock.
-  void capture_on_the_clock(std::chrono::nanoseconds period, const std::stop_token& stop) {
-    constexpr auto kStopCheck = std::chrono::milliseconds(100);
-    while (!stop.stop_requested()) {
-      const auto since_epoch = std::chrono::system_clock::now().time_since_epoch();
-      const Clock::time_point next(since_epoch / period * period + period);
-      if (next - std::chrono::system_clock::now() > kStopCheck) {
-        std::this_thread::sleep_for(kStopCheck);
-        continue;
-      }
-      std::this_thread::sleep_until(next);
-      tick(next);
-    }
-  }
-
   // `capture`: the synchronized capture time; none: now, and scene time by the frame count.
   void tick(std::optional<Clock::time_point> capture = std::nullopt) {
     if (wait_for_subscriber_) {

@@ -22,6 +22,8 @@ void merge(EvaluationSummary& into, const EvaluationSummary& from) {
   into.expected += from.expected;
   into.tracked += from.tracked;
   into.false_identifications += from.false_identifications;
+  into.identity_swaps += from.identity_swaps;
+  into.objects = std::max(into.objects, from.objects);
   into.false_identification_details.insert(into.false_identification_details.end(),
                                            from.false_identification_details.begin(),
                                            from.false_identification_details.end());
@@ -102,6 +104,7 @@ void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& tr
     frame.false_identification_details.push_back({stamp_ns, name, position, orientation});
   };
   frame.frames = 1;
+  frame.objects = truth.size();
   for (const ObjectPose& t : truth) {
     if (t.visible_markers >= options_.min_visible_markers) ++frame.expected;
   }
@@ -114,7 +117,13 @@ void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& tr
       continue;
     }
     double position = (e.pose.translation() - t->pose.translation()).norm();
-    double orientation = angle_deg(e.pose, t->pose);
+    double orientation = e.orientation_known ? angle_deg(e.pose, t->pose) : 0;
+    if (std::any_of(truth.begin(), truth.end(), [&](const ObjectPose& other) {
+          return &other != &*t &&
+                 (e.pose.translation() - other.pose.translation()).norm() < position;
+        })) {
+      ++frame.identity_swaps;
+    }
     if (position > options_.false_position_error_m ||
         orientation > options_.false_orientation_error_deg) {
       count_false(e.name, position, orientation);
@@ -123,7 +132,7 @@ void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& tr
     // Found with fewer visible markers than expected is a bonus, not a trackable object.
     if (t->visible_markers >= options_.min_visible_markers) ++frame.tracked;
     frame.position_errors_m.push_back(position);
-    frame.orientation_errors_deg.push_back(orientation);
+    if (e.orientation_known) frame.orientation_errors_deg.push_back(orientation);
     if (e.linear_velocity && t->linear_velocity) {
       frame.velocity_errors_mps.push_back((*e.linear_velocity - *t->linear_velocity).norm());
     }

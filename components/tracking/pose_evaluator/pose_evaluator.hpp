@@ -32,6 +32,9 @@ struct ObjectPose {
   std::string name;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   int visible_markers = 0;  // truth only
+  // False for an estimate whose orientation is unknown (a robot of one marker): its position
+  // alone is judged.
+  bool orientation_known = true;
   // Linear (m/s) and angular (rad/s) velocity in the camera frame, when known: always for the
   // truth, for an estimate once its track has measured them.
   std::optional<Eigen::Vector3d> linear_velocity, angular_velocity;
@@ -54,8 +57,12 @@ struct EvaluationSummary {
   uint64_t tracked = 0;      // of them, estimated within the false-identification bounds
   uint64_t false_identifications = 0;
   std::vector<FalseIdentification> false_identification_details;  // one per count above
-  std::vector<double> position_errors_m;                          // one per tracked object
-  std::vector<double> orientation_errors_deg;                     // one per tracked object
+  // Estimates nearer another object's true position than their own: one object reported as
+  // another (identical robots of a swarm swapped).
+  uint64_t identity_swaps = 0;
+  uint64_t objects = 0;                   // the most objects in one truth frame (a swarm's robots)
+  std::vector<double> position_errors_m;  // one per tracked object
+  std::vector<double> orientation_errors_deg;  // one per tracked object
   // Per tracked object with a measured velocity: |v - v_true| m/s, |w - w_true| deg/s.
   std::vector<double> velocity_errors_mps, angular_velocity_errors_dps;
 

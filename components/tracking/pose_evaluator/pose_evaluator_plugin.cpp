@@ -16,6 +16,10 @@
 namespace mocap::evaluation {
 namespace {
 
+// An orientation variance this large (rad², on each axis) says the orientation is unknown: a
+// robot of one marker has 1e9 there, as ROS's Odometry readers expect.
+constexpr double kUnknownOrientationVariance = 1e6;
+
 // `truth`: the synthetic camera's, whose velocities are exact (and have no covariance).
 std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& array, bool truth) {
   std::vector<ObjectPose> out;
@@ -26,6 +30,10 @@ std::vector<ObjectPose> objects(const mocap_msgs::msg::ConstellationPoseArray& a
     object.name = pose.name();
     object.pose = *isometry;
     object.visible_markers = static_cast<int>(pose.points_used());
+    const auto& covariance = pose.covariance();
+    object.orientation_known = truth || !(covariance[21] >= kUnknownOrientationVariance &&
+                                          covariance[28] >= kUnknownOrientationVariance &&
+                                          covariance[35] >= kUnknownOrientationVariance);
     // An estimate's velocity counts once measured: its covariance not all zeros ("unknown",
     // as the per-frame pose estimator leaves it) and its standard deviation below 0.5 m/s (a
     // track just started has the tracker's initial 2 m/s).
@@ -151,13 +159,14 @@ class PoseEvaluatorComponent final : public Component {
     }
     log().info(
         "{:.1f} frames/s, latency {:.2f} ms (p99 {:.2f} ms), {} frame(s) lost, tracked {:.1f} %, "
-        "position error {:.2f} mm, orientation error {:.3f} deg, false identifications {}",
+        "position error {:.2f} mm, orientation error {:.3f} deg, false identifications {}, "
+        "identity swaps {}",
         window.frames / settings_.report_period_s,
         EvaluationSummary::quantile(window_latencies_s_, 0.5) * 1e3,
         EvaluationSummary::quantile(window_latencies_s_, 0.99) * 1e3, window.frames_lost,
         window.tracked_percent(), EvaluationSummary::quantile(window.position_errors_m, 0.5) * 1e3,
         EvaluationSummary::quantile(window.orientation_errors_deg, 0.5),
-        window.false_identifications);
+        window.false_identifications, window.identity_swaps);
   }
 
   void check_done() {
@@ -178,21 +187,23 @@ class PoseEvaluatorComponent final : public Component {
     log().info(
         "| frames | lost | tracked | position mm (median, p95) | orientation deg "
         "(median, p95) | velocity error cm/s, deg/s (median) | false ids | latency ms (median, "
-        "p99) |");
+        "p99) | robots | identity swaps |");
     log().info(
-        "| {} | {} | {:.2f} % | {:.2f}, {:.2f} | {:.3f}, {:.3f} | {:.2f}, {:.2f} | {} | {:.2f}, "
-        "{:.2f} |",
+        "| {} | {} | {:.2f} % | {:.3f}, {:.3f} | {:.3f}, {:.3f} | {:.2f}, {:.2f} | {} | {:.2f}, "
+        "{:.2f} | {} | {} |",
         total.frames, total.frames_lost, total.tracked_percent(),
         q(total.position_errors_m, 0.5) * 1e3, q(total.position_errors_m, 0.95) * 1e3,
         q(total.orientation_errors_deg, 0.5), q(total.orientation_errors_deg, 0.95),
         q(total.velocity_errors_mps, 0.5) * 100, q(total.angular_velocity_errors_dps, 0.5),
         total.false_identifications, q(all_latencies_s_, 0.5) * 1e3,
-        q(all_latencies_s_, 0.99) * 1e3);
+        q(all_latencies_s_, 0.99) * 1e3, total.objects, total.identity_swaps);
     if (settings_.summary_file.empty()) return;
     std::ofstream out(settings_.summary_file);
     out << "frames: " << total.frames << "\nframes_lost: " << total.frames_lost
-        << "\nexpected: " << total.expected << "\ntracked: " << total.tracked
+        << "\nrobots: " << total.objects << "\nexpected: " << total.expected
+        << "\ntracked: " << total.tracked
         << "\nfalse_identifications: " << total.false_identifications
+        << "\nidentity_swaps: " << total.identity_swaps
         << "\nposition_error_median_m: " << q(total.position_errors_m, 0.5)
         << "\nposition_error_p95_m: " << q(total.position_errors_m, 0.95)
         << "\norientation_error_median_deg: " << q(total.orientation_errors_deg, 0.5)
@@ -200,7 +211,8 @@ class PoseEvaluatorComponent final : public Component {
         << "\nvelocity_errors: " << total.velocity_errors_mps.size()
         << "\nvelocity_error_median_mps: " << q(total.velocity_errors_mps, 0.5)
         << "\nangular_velocity_error_median_dps: " << q(total.angular_velocity_errors_dps, 0.5)
-        << "\nlatency_median_s: " << q(all_latencies_s_, 0.5) << "\n";
+        << "\nlatency_median_s: " << q(all_latencies_s_, 0.5)
+        << "\nlatency_p99_s: " << q(all_latencies_s_, 0.99) << "\n";
     if (!out) log().error("cannot write {}", settings_.summary_file);
   }
 

@@ -603,4 +603,25 @@ TrackedBodyPose VolumeTracker::update_track(size_t body, int64_t stamp_ns,
   return pose;
 }
 
+std::vector<MarkerOwner> owners_of(const std::vector<CloudMarker>& cloud,
+                                   const std::vector<PlacedBody>& bodies, double radius_m) {
+  std::vector<MarkerOwner> owners(cloud.size());
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    for (size_t k = 0; k < bodies[b].markers->size(); ++k) {
+      const Eigen::Vector3d at = bodies[b].world_from_body * (*bodies[b].markers)[k];
+      size_t nearest = cloud.size();
+      double nearest_m = radius_m;
+      for (size_t m = 0; m < cloud.size(); ++m) {
+        const double off = (cloud[m].position - at).norm();
+        if (owners[m].body < 0 && off <= nearest_m) {
+          nearest = m;
+          nearest_m = off;
+        }
+      }
+      if (nearest < cloud.size()) owners[nearest] = {static_cast<int>(b), static_cast<int>(k)};
+    }
+  }
+  return owners;
+}
+
 }  // namespace mocap::volume

@@ -28,6 +28,7 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
+#include "volume/marker_cloud/marker_cloud.hpp"
 #include "volume/pose_fusion/pose_fusion.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
 #include "volume/rigid_bodies/rigid_body_identification.hpp"
@@ -176,5 +177,22 @@ class VolumeTracker {
   int64_t unusual_fits_ = 0;
   double usual_normalized_rms_ = 0;  // of every body's fits, a running average
 };
+
+// A cloud marker's body: the index of a posed body in the list given, and which of its markers.
+struct MarkerOwner {
+  int body = -1;  // -1: unlabeled
+  int marker = 0;
+};
+
+// A body's markers where its pose puts them (world frame).
+struct PlacedBody {
+  Eigen::Isometry3d world_from_body = Eigen::Isometry3d::Identity();
+  const std::vector<Eigen::Vector3d>* markers = nullptr;  // in the body's frame
+};
+
+// Each cloud marker's owner: every placed marker claims the nearest cloud marker within
+// `radius_m` that no one claimed first (bodies in the order given); unlabeled otherwise.
+std::vector<MarkerOwner> owners_of(const std::vector<CloudMarker>& cloud,
+                                   const std::vector<PlacedBody>& bodies, double radius_m);
 
 }  // namespace mocap::volume

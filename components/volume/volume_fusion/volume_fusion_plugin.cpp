@@ -8,7 +8,15 @@
 // on /alerts, and taken back, also reported, at its next message; so is a camera found drifted
 // (its extrinsics moved: its residuals against the others' poses), and a body seen by one
 // camera only (its pose then rests on that camera alone).
+//
+// Every fused frame's markers in 3D (the marker cloud: marker_cloud.hpp) go out on
+// /mocap/markers as a PointCloud2 (marker_cloud_message.hpp), each labeled with the body or
+// robot it belongs to. With a `robots` file, the swarm's robots (identical layouts told apart
+// by their tracks, and robots of one marker: swarm_tracker.hpp) are tracked in the cloud's
+// markers no body took, and posed on /mocap/poses after the bodies; /mocap/reseed tells where a
+// robot carried away by hand now is.
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -23,12 +31,18 @@
 #include <mocap_msgs/msg/alert.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
+#include <motion_capture_tracking_interfaces/msg/named_pose_array.hpp>
+#include <sensor_msgs/msg/point_cloud2.hpp>
 #include <tf2_msgs/msg/tf_message.hpp>
 
+#include "common/marker_cloud_message/marker_cloud_message.hpp"
 #include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
 #include "volume/frame_assembly/frame_assembler.hpp"
+#include "volume/marker_cloud/marker_cloud.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
+#include "volume/swarm/swarm_database.hpp"
+#include "volume/swarm/swarm_tracker.hpp"
 #include "volume/volume_fusion/volume_fusion.hpp"
 
 namespace mocap::volume {
@@ -37,6 +51,8 @@ namespace {
 using mocap_msgs::msg::Alert;
 using mocap_msgs::msg::ConstellationPoseArray;
 using mocap_msgs::msg::FiducialArray;
+using motion_capture_tracking_interfaces::msg::NamedPoseArray;
+using sensor_msgs::msg::PointCloud2;
 using tf2_msgs::msg::TFMessage;
 
 constexpr std::chrono::milliseconds kSingleCameraAlert{500};
@@ -44,6 +60,8 @@ constexpr std::chrono::milliseconds kUnposedAlert{500};
 constexpr size_t kMaxBacklog = 2;  // frames fused at once; older ready ones are skipped
 // A camera that misses this many frames in a row is said to be back when it returns.
 constexpr int kGapFramesLogged = 3;
+// A cloud marker this close to where a posed body puts one of its markers is that marker.
+constexpr double kOwnMarkerRadius_m = 0.005;
 
 std::chrono::nanoseconds seconds(double s) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
@@ -56,6 +74,9 @@ struct Settings : VolumeTrackerOptions {
                                       mocap::config_file("volume/cameras/cam_2.yaml"),
                                       mocap::config_file("volume/cameras/cam_3.yaml")};
   std::string bodies = mocap::config_file("volume/bodies.yaml");
+  std::string robots;  // none
+  MarkerCloudOptions cloud;
+  SwarmTrackerOptions swarm;
   double same_capture_s = 0.002;
   double wait_s = 0.005;
   double silent_after_s = 0.5;
@@ -71,9 +92,38 @@ const ParameterList<Settings> kParameters =
              "camera_name names the camera's topic",
              &Settings::cameras)
         .path()
-        .add("bodies", "the rigid bodies: markers in 3D (rigid_body_database.hpp)",
+        .add("bodies",
+             "the rigid bodies, each of its own marker layout (rigid_body_database.hpp); empty: "
+             "none",
              &Settings::bodies)
         .path()
+        .add("robots",
+             "the swarm: robots of shared marker layouts or of one marker, and where each "
+             "starts (swarm_database.hpp); empty: none",
+             &Settings::robots)
+        .path()
+        .add("marker_gate_px",
+             "how far a detection may be from where a cloud marker's track predicts it",
+             &Settings::cloud, &MarkerCloudOptions::gate_px)
+        .range(0.1, 100)
+        .add("marker_tolerance_px",
+             "how far a cloud marker may reproject from a detection it explains", &Settings::cloud,
+             &MarkerCloudOptions::tolerance_px)
+        .range(0.01, 100)
+        .add("marker_min_cameras", "fewest cameras that start a cloud marker", &Settings::cloud,
+             &MarkerCloudOptions::min_cameras_to_start)
+        .range(2, kMaxCloudCameras)
+        .add("robot_gate_m",
+             "how far a marker may be from where a tracked robot's motion puts one of its markers",
+             &Settings::swarm, &SwarmTrackerOptions::gate_m)
+        .range(1e-4, 1)
+        .add("robot_start_radius_m",
+             "how far from its initial (or re-seeded) position a robot is looked for",
+             &Settings::swarm, &SwarmTrackerOptions::start_radius_m)
+        .range(1e-3, 100)
+        .add("robot_lost_after_s", "a robot not posed this long is lost: looked for afresh",
+             &Settings::swarm, &SwarmTrackerOptions::lost_after_s)
+        .range(0, 3600)
         .add("body_tolerance_m",
              "how far a triangulated inter-marker distance may be from the body's",
              &Settings::identification, &RigidBodyIdentificationOptions::tolerance)
@@ -129,6 +179,48 @@ std::vector<VolumeCamera> load_cameras(const std::vector<std::string>& files) {
   return cameras;
 }
 
+// The swarm of the `robots` file, or none; a robot named as a body is refused.
+std::optional<SwarmTracker> load_robots(const Settings& settings, const RigidBodyDatabase& bodies) {
+  if (settings.robots.empty()) return std::nullopt;
+  SwarmDatabase swarm = load_swarm(settings.robots, settings.swarm.layout_tolerance_m);
+  for (const SwarmRobot& robot : swarm.robots) {
+    for (const RigidBody& body : bodies.bodies) {
+      if (body.name == robot.name) {
+        throw std::invalid_argument(
+            fmt::format("{}: robot '{}' has the name of a body of {}: poses are told apart by name",
+                        settings.robots, robot.name, settings.bodies));
+      }
+    }
+  }
+  return SwarmTracker(std::move(swarm), settings.swarm);
+}
+
+// A pose message of the array's header.
+mocap_msgs::msg::ConstellationPose pose_message(const std_msgs::msg::Header& header,
+                                                const std::string& name,
+                                                const Eigen::Isometry3d& world_from_body,
+                                                const Eigen::Matrix<double, 6, 6>& covariance) {
+  mocap_msgs::msg::ConstellationPose pose;
+  pose.name(name);
+  pose.pose().header(header);
+  pose.pose().pose(to_pose_message(world_from_body));
+  for (int i = 0; i < 36; ++i) pose.covariance()[static_cast<size_t>(i)] = covariance(i / 6, i % 6);
+  return pose;
+}
+
+void set_velocity(mocap_msgs::msg::ConstellationPose& pose, const Eigen::Vector3d& linear,
+                  const Eigen::Vector3d& angular, const Eigen::Matrix<double, 6, 6>& covariance) {
+  for (int i = 0; i < 36; ++i) {
+    pose.velocity_covariance()[static_cast<size_t>(i)] = covariance(i / 6, i % 6);
+  }
+  pose.velocity().linear().x(linear.x());
+  pose.velocity().linear().y(linear.y());
+  pose.velocity().linear().z(linear.z());
+  pose.velocity().angular().x(angular.x());
+  pose.velocity().angular().y(angular.y());
+  pose.velocity().angular().z(angular.z());
+}
+
 class VolumeFusion final : public Component {
   // Before the other members, which may start from it.
   const Settings settings_ = read_settings(kParameters);
@@ -150,6 +242,13 @@ class VolumeFusion final : public Component {
         "each body posed in a frame: frame 'world', stamped with the capture time; "
         "points_used counts pixels over every camera, cameras_used the cameras (1: a "
         "single camera's pose)");
+    spec.publishes<PointCloud2>(
+        topics::kMarkers, Qos::sensor_data(),
+        "every fused frame's markers in 3D: frame 'world', stamped with the capture time; fields "
+        "x y z, body (the index of its pose's name among the bodies then the robots; -1 "
+        "unlabeled), marker, id (its track's), residual (px), cameras (a bit per camera)");
+    spec.subscribes<NamedPoseArray>(topics::kReseed, Qos::reliable(),
+                                    "robots carried away by hand: each looked for at its position");
     spec.publishes<Alert>(topics::kAlerts, Qos::reliable(),
                           "cameras silent, back or drifted; bodies seen by one camera only");
     spec.publishes<TFMessage>(
@@ -160,9 +259,13 @@ class VolumeFusion final : public Component {
   explicit VolumeFusion(Context& context)
       : Component(context),
         tracker_(load_cameras(settings_.cameras),
-                 load_rigid_bodies(settings_.bodies, settings_.identification.tolerance,
-                                   settings_.identification.min_markers),
+                 settings_.bodies.empty()
+                     ? RigidBodyDatabase{}
+                     : load_rigid_bodies(settings_.bodies, settings_.identification.tolerance,
+                                         settings_.identification.min_markers),
                  settings_),
+        cloud_(settings_.cloud),
+        swarm_(load_robots(settings_, tracker_.bodies())),
         frames_(static_cast<int>(tracker_.cameras().size()),
                 {seconds(settings_.same_capture_s), seconds(settings_.wait_s),
                  seconds(settings_.silent_after_s)}),
@@ -171,7 +274,10 @@ class VolumeFusion final : public Component {
         gaps_(tracker_.cameras().size()),
         drifted_(tracker_.cameras().size(), false) {
     poses_ = create_publisher<ConstellationPoseArray>(topics::kPoses);
+    markers_ = create_publisher<PointCloud2>(topics::kMarkers);
     alerts_ = create_publisher<Alert>(topics::kAlerts);
+    create_subscription<NamedPoseArray>(topics::kReseed,
+                                        [this](const NamedPoseArray& array) { reseed(array); });
     publish_camera_frames();
     for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
       create_subscription<FiducialArray>(
@@ -186,8 +292,11 @@ class VolumeFusion final : public Component {
     create_timer(std::chrono::milliseconds(1), [this] { fuse_ready(); });
     std::string names;
     for (const VolumeCamera& camera : tracker_.cameras()) names += " " + camera.name;
-    log().info("{} bodies ({}), {} cameras:{}", tracker_.bodies().bodies.size(), settings_.bodies,
-               tracker_.cameras().size(), names);
+    log().info("{} bodies ({}), {} robots ({}), {} cameras:{}", tracker_.bodies().bodies.size(),
+               settings_.bodies.empty() ? "none" : settings_.bodies,
+               swarm_ ? swarm_->swarm().robots.size() : 0,
+               settings_.robots.empty() ? "none" : settings_.robots, tracker_.cameras().size(),
+               names);
   }
 
   ~VolumeFusion() override {
@@ -200,10 +309,12 @@ class VolumeFusion final : public Component {
     }
     log().info(
         "{} frames fused ({} incomplete, {} skipped while behind), {} body poses ({} from one "
-        "camera), {} identifications, {} fits set aside as unusually poor, {} late messages "
-        "dropped{}",
+        "camera), {} robot poses, {} identifications, {} fits set aside as unusually poor, {} "
+        "late messages dropped; marker cloud: {} tracks started, {} detections left out as "
+        "merged, {} no marker explains{}",
         fused_frames_, incomplete_frames_, skipped_frames_, body_poses_, single_camera_poses_,
-        tracker_.identifications(), tracker_.unusual_fits(), frames_.late_drops(), health);
+        robot_poses_, tracker_.identifications(), tracker_.unusual_fits(), frames_.late_drops(),
+        cloud_.totals().started, cloud_.totals().merged, cloud_.totals().unexplained, health);
   }
 
  private:
@@ -253,34 +364,102 @@ class VolumeFusion final : public Component {
         to_time_msg(Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns))));
     message->header().frame_id("world");
     for (const TrackedBodyPose& body : poses) {
-      mocap_msgs::msg::ConstellationPose pose;
-      pose.name(body.name);
-      pose.pose().header(message->header());
-      pose.pose().pose(to_pose_message(body.world_from_body));
-      for (int i = 0; i < 36; ++i)
-        pose.covariance()[static_cast<size_t>(i)] = body.covariance(i / 6, i % 6);
+      mocap_msgs::msg::ConstellationPose pose =
+          pose_message(message->header(), body.name, body.world_from_body, body.covariance);
       pose.reprojection_rms_px(static_cast<float>(body.reprojection_rms_px));
       pose.points_used(static_cast<uint32_t>(body.points_used));
       pose.cameras_used(static_cast<uint32_t>(body.cameras_used));
       if (body.velocity_known) {
-        for (int i = 0; i < 36; ++i) {
-          pose.velocity_covariance()[static_cast<size_t>(i)] =
-              body.velocity_covariance(i / 6, i % 6);
-        }
-        pose.velocity().linear().x(body.linear_velocity.x());
-        pose.velocity().linear().y(body.linear_velocity.y());
-        pose.velocity().linear().z(body.linear_velocity.z());
-        pose.velocity().angular().x(body.angular_velocity.x());
-        pose.velocity().angular().y(body.angular_velocity.y());
-        pose.velocity().angular().z(body.angular_velocity.z());
+        set_velocity(pose, body.linear_velocity, body.angular_velocity, body.velocity_covariance);
       }
       message->poses().push_back(std::move(pose));
       report_single_camera(body, assembled.stamp_ns);
     }
+    track_markers(assembled.stamp_ns, frame, poses, *message);
     body_poses_ += poses.size();
     poses_.publish(std::move(message));
     report_unposed(poses, assembled.stamp_ns);
     report_drift();
+  }
+
+  // The marker cloud of every camera's detections; the bodies' markers in it labeled, the
+  // robots tracked in the rest and added to `message`; the cloud published.
+  void track_markers(int64_t stamp_ns, const std::vector<CameraFrame>& frame,
+                     const std::vector<TrackedBodyPose>& poses, ConstellationPoseArray& message) {
+    std::vector<CameraDetections> detections;
+    for (size_t c = 0; c < frame.size(); ++c) {
+      const VolumeCamera& camera = tracker_.cameras()[c];
+      CameraDetections seen{camera.model.get(), camera.camera_from_world, {}, {}};
+      if (frame[c].received && !tracker_.camera_health()[c].drifted) {
+        seen.pixels = frame[c].pixels;
+        seen.pixel_sigma_px = frame[c].pixel_sigma_px;
+      }
+      detections.push_back(std::move(seen));
+    }
+    const std::vector<CloudMarker> cloud = cloud_.track(stamp_ns, detections);
+    const std::vector<RigidBody>& bodies = tracker_.bodies().bodies;
+    std::vector<PlacedBody> placed;
+    std::vector<int> body_index;  // of each placed body in the database
+    for (const TrackedBodyPose& pose : poses) {
+      const auto body = std::find_if(bodies.begin(), bodies.end(),
+                                     [&](const RigidBody& b) { return b.name == pose.name; });
+      placed.push_back({pose.world_from_body, &body->markers});
+      body_index.push_back(static_cast<int>(body - bodies.begin()));
+    }
+    std::vector<MarkerOwner> owners = owners_of(cloud, placed, kOwnMarkerRadius_m);
+    for (MarkerOwner& owner : owners) {
+      if (owner.body >= 0) owner.body = body_index[static_cast<size_t>(owner.body)];
+    }
+    if (swarm_) {
+      std::vector<char> claimed(cloud.size());
+      for (size_t m = 0; m < cloud.size(); ++m) claimed[m] = owners[m].body >= 0;
+      for (const SwarmRobotPose& robot : swarm_->track(stamp_ns, cloud, claimed)) {
+        uint32_t cameras = 0;
+        double rms_px = 0;
+        uint32_t points = 0;
+        for (size_t k = 0; k < robot.markers.size(); ++k) {
+          const int m = robot.markers[k];
+          if (m < 0) continue;
+          owners[static_cast<size_t>(m)] = {static_cast<int>(bodies.size() + robot.robot),
+                                            static_cast<int>(k)};
+          cameras |= cloud[static_cast<size_t>(m)].cameras;
+          rms_px += cloud[static_cast<size_t>(m)].rms_px;
+          points += static_cast<uint32_t>(cloud[static_cast<size_t>(m)].observations.size());
+        }
+        mocap_msgs::msg::ConstellationPose pose =
+            pose_message(message.header(), swarm_->swarm().robots[robot.robot].name,
+                         robot.world_from_body, robot.covariance);
+        pose.reprojection_rms_px(static_cast<float>(rms_px / robot.markers_used));
+        pose.points_used(points);
+        pose.cameras_used(static_cast<uint32_t>(std::popcount(cameras)));
+        if (robot.velocity_known) {
+          set_velocity(pose, robot.linear_velocity, robot.angular_velocity,
+                       robot.velocity_covariance);
+        }
+        message.poses().push_back(std::move(pose));
+        ++robot_poses_;
+      }
+    }
+    std::vector<LabeledMarker> labeled;
+    for (size_t m = 0; m < cloud.size(); ++m) {
+      labeled.push_back({cloud[m].position.cast<float>(), owners[m].body,
+                         static_cast<uint16_t>(owners[m].marker), cloud[m].id,
+                         static_cast<float>(cloud[m].rms_px), cloud[m].cameras});
+    }
+    markers_.publish(std::make_shared<PointCloud2>(to_point_cloud(message.header(), labeled)));
+  }
+
+  void reseed(const NamedPoseArray& array) {
+    for (const auto& named : array.poses()) {
+      const auto& p = named.pose().position();
+      const Eigen::Vector3d position(p.x(), p.y(), p.z());
+      if (swarm_ && swarm_->reseed(named.name(), position)) {
+        log().info("{}: looked for at ({:.3f}, {:.3f}, {:.3f})", named.name(), p.x(), p.y(), p.z());
+      } else {
+        log().warn("re-seed: no robot '{}' in the swarm{}", named.name(),
+                   swarm_ ? "" : " (no robots file)");
+      }
+    }
   }
 
   // A body posed before and not for kUnposedAlert is said to be seen too poorly to pose: too
@@ -382,6 +561,8 @@ class VolumeFusion final : public Component {
   }
 
   VolumeTracker tracker_;
+  MarkerCloudTracker cloud_;
+  std::optional<SwarmTracker> swarm_;
   FrameAssembler<FiducialArray> frames_;
   std::vector<bool> heard_;   // per camera
   std::vector<bool> silent_;  // per camera, as last reported
@@ -403,12 +584,14 @@ class VolumeFusion final : public Component {
   std::map<std::string, Unposed> unposed_;  // by body
   uint64_t single_camera_poses_ = 0;
   Publisher<ConstellationPoseArray> poses_;
+  Publisher<PointCloud2> markers_;
   Publisher<Alert> alerts_;
   Publisher<TFMessage> camera_frames_;
   uint64_t fused_frames_ = 0;
   uint64_t incomplete_frames_ = 0;
   uint64_t skipped_frames_ = 0;  // behind: older than the newest kMaxBacklog ready
   uint64_t body_poses_ = 0;
+  uint64_t robot_poses_ = 0;
 };
 
 }  // namespace

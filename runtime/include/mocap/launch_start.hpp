@@ -1,0 +1,32 @@
+// The instant a launch started, shared by every process mocap_launch starts for it (and by
+// their restarts, which inherit it): simulated sensors in different processes count their
+// scene's time from it, so that they show the same instant in frames of the same stamp.
+// mocap_launch sets it unless it is set already (launchers on several hosts given one value).
+#pragma once
+
+#include <charconv>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <optional>
+#include <string_view>
+
+namespace mocap {
+
+inline constexpr const char* kLaunchStartVariable = "MOCAP_LAUNCH_START_NS";
+
+// nullopt when this process was not started by mocap_launch (or the variable is not a count
+// of nanoseconds since the epoch).
+inline std::optional<std::chrono::system_clock::time_point> launch_start() {
+  const char* text = std::getenv(kLaunchStartVariable);
+  if (text == nullptr) return std::nullopt;
+  const std::string_view view(text);
+  int64_t ns = 0;
+  auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), ns);
+  if (error != std::errc() || end != view.data() + view.size() || ns <= 0) return std::nullopt;
+  return std::chrono::system_clock::time_point(
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(
+          std::chrono::nanoseconds(ns)));
+}
+
+}  // namespace mocap
