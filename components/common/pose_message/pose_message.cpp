@@ -18,6 +18,18 @@ geometry_msgs::msg::Pose to_pose_message(const Eigen::Isometry3d& pose) {
   return message;
 }
 
+geometry_msgs::msg::Twist to_twist_message(const Eigen::Vector3d& linear,
+                                           const Eigen::Vector3d& angular) {
+  geometry_msgs::msg::Twist message;
+  message.linear().x(linear.x());
+  message.linear().y(linear.y());
+  message.linear().z(linear.z());
+  message.angular().x(angular.x());
+  message.angular().y(angular.y());
+  message.angular().z(angular.z());
+  return message;
+}
+
 std::optional<Eigen::Isometry3d> to_isometry(const geometry_msgs::msg::Pose& pose) {
   const auto& p = pose.position();
   const auto& q = pose.orientation();

@@ -8,11 +8,16 @@
 #include <Eigen/Geometry>
 #include <geometry_msgs/msg/pose.hpp>
 #include <geometry_msgs/msg/transform_stamped.hpp>
+#include <geometry_msgs/msg/twist.hpp>
 #include <std_msgs/msg/header.hpp>
 
 namespace mocap {
 
 geometry_msgs::msg::Pose to_pose_message(const Eigen::Isometry3d& pose);
+
+// A body's linear (m/s) and angular (rad/s) velocity as a Twist.
+geometry_msgs::msg::Twist to_twist_message(const Eigen::Vector3d& linear,
+                                           const Eigen::Vector3d& angular);
 
 // The pose a message describes, its quaternion normalised; nothing when the position is not
 // finite or the quaternion is not finite or (nearly) zero, since no rotation fits it.

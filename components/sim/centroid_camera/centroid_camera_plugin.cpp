@@ -141,9 +141,7 @@ class CentroidCameraComponent final : public Component {
       robot.name(scene_.robots[r].name);
       robot.pose().header(header);
       robot.pose().pose(to_pose_message(pose));
-      robot.velocity().linear().x(velocity.x());
-      robot.velocity().linear().y(velocity.y());
-      robot.velocity().linear().z(velocity.z());
+      robot.velocity(to_twist_message(velocity, Eigen::Vector3d::Zero()));
       robot.points_used(static_cast<uint32_t>(scene_.robots[r].markers.size()));
       truth->poses().push_back(std::move(robot));
     }

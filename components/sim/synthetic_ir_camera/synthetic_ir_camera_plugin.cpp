@@ -249,12 +249,7 @@ class SyntheticIrCamera final : public Component {
       pose.pose().pose(to_pose_message(to_truth_frame * object.pose));
       pose.reprojection_rms_px(0);
       pose.points_used(static_cast<uint32_t>(object.visible_markers()));
-      pose.velocity().linear().x(linear.x());
-      pose.velocity().linear().y(linear.y());
-      pose.velocity().linear().z(linear.z());
-      pose.velocity().angular().x(angular.x());
-      pose.velocity().angular().y(angular.y());
-      pose.velocity().angular().z(angular.z());
+      pose.velocity(to_twist_message(linear, angular));
       truth->poses().push_back(std::move(pose));
     }
     images_.publish(std::move(image));

@@ -164,14 +164,7 @@ class ConstellationTrackerComponent final : public Component {
     out.reprojection_rms_px(static_cast<float>(board.pose.reprojection_rms_px));
     out.points_used(static_cast<uint32_t>(board.pose.points_used));
     out.cameras_used(1);
-    const Eigen::Vector3d& v = board.motion.linear_velocity;
-    const Eigen::Vector3d& w = board.motion.angular_velocity;
-    out.velocity().linear().x(v.x());
-    out.velocity().linear().y(v.y());
-    out.velocity().linear().z(v.z());
-    out.velocity().angular().x(w.x());
-    out.velocity().angular().y(w.y());
-    out.velocity().angular().z(w.z());
+    out.velocity(to_twist_message(board.motion.linear_velocity, board.motion.angular_velocity));
     return out;
   }
 

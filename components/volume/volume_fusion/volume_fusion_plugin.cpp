@@ -213,12 +213,7 @@ void set_velocity(mocap_msgs::msg::ConstellationPose& pose, const Eigen::Vector3
   for (int i = 0; i < 36; ++i) {
     pose.velocity_covariance()[static_cast<size_t>(i)] = covariance(i / 6, i % 6);
   }
-  pose.velocity().linear().x(linear.x());
-  pose.velocity().linear().y(linear.y());
-  pose.velocity().linear().z(linear.z());
-  pose.velocity().angular().x(angular.x());
-  pose.velocity().angular().y(angular.y());
-  pose.velocity().angular().z(angular.z());
+  pose.velocity(to_twist_message(linear, angular));
 }
 
 class VolumeFusion final : public Component {
