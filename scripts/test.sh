@@ -16,23 +16,6 @@ cd "$(dirname "$0")/.."
 parts=("$@")
 [ ${#parts[@]} -gt 0 ] || parts=(plain address)
 scripts/install_deps.sh all
-# Pauses (STOP) or resumes (CONT) what MOCAP_BACKGROUND_PGID names, if anything: that process
-# group and every process below it (the compilers ninja starts have process groups of their
-# own). On resuming, says how much processor time it took while paused.
-paused_at_cpu=""
-background() {
-  [ -n "${MOCAP_BACKGROUND_PGID:-}" ] || return 0
-  if [ "$1" = STOP ]; then
-    scripts/process_tree.sh STOP "$MOCAP_BACKGROUND_PGID"
-    paused_at_cpu=$(scripts/process_tree.sh cpu "$MOCAP_BACKGROUND_PGID")
-  else
-    [ -z "$paused_at_cpu" ] ||
-      echo "test.sh: the background took $(awk -v a="$paused_at_cpu" -v b="$(scripts/process_tree.sh cpu "$MOCAP_BACKGROUND_PGID")" 'BEGIN { printf "%.1f", b - a }') s of processor time while paused"
-    paused_at_cpu=""
-    scripts/process_tree.sh CONT "$MOCAP_BACKGROUND_PGID"
-  fi
-}
-trap 'background CONT' EXIT
 for part in "${parts[@]}"; do
   case "$part" in
     plain)
@@ -43,10 +26,8 @@ for part in "${parts[@]}"; do
       cmake -DBUILD=build -P scripts/check_test_parts.cmake
       # The tests' independent clients and readers (pinned in test/package-lock.json).
       npm ci --prefix test --no-audit --no-fund --loglevel=error
-      # Nothing beside them: what CI runs in the background (.ci/run) is paused meanwhile.
-      background STOP
+      # One at a time; what CI compiles beside them runs in the idle class (.ci/run).
       MOCAP_TEST_PARALLEL=1 scripts/run_tests.sh build "plain, real time" -L '^realtime$'
-      background CONT
       # Side by side: the slow-subscriber loads are paced by their subscribers and the package
       # tests wait on dpkg and a compiler; then the loads that keep every core busy.
       MOCAP_TEST_PARALLEL=4 scripts/run_tests.sh build plain -L '^plain$'
