@@ -9,8 +9,10 @@
 #include <cstring>
 #include <mutex>
 #include <random>
+#include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <mocap/component_host.hpp>
 #include <mocap/message_time.hpp>
 #include <mocap/message_type.hpp>
@@ -285,6 +287,78 @@ TEST(Px4Odometry, ThePluginSendsTheVehiclesStateInNedAtItsRate) {
   EXPECT_NEAR(first.velocity()[0], 0, 1e-6);  // moving east: NED (0, 1, 0)
   EXPECT_NEAR(first.velocity()[1], 1, 1e-6);
   EXPECT_NEAR(first.velocity()[2], 0, 1e-6);
+}
+
+// A swarm: one px4_odometry per vehicle, each remapped into its vehicle's namespace as PX4's
+// multi-vehicle uXRCE-DDS clients have them (/px4_1/fmu/in/..., /px4_2/fmu/in/...), each
+// sending its own robot of the volume's poses (frame world, ENU): a quadrotor with its
+// attitude, a robot of one marker with NaN there (PX4's mark of an invalid field).
+TEST(Px4Odometry, OnePerVehicleEachInItsVehiclesNamespace) {
+  PluginLoader loader;
+  ComponentHost host({.name = "test", .threads = 2, .dds = {.enabled = false}});
+  const std::vector<std::string> robots = {"cf01", "rover01"};
+  std::vector<Collector*> collectors;
+  for (size_t v = 0; v < robots.size(); ++v) {
+    const std::string topic = fmt::format("/px4_{}/fmu/in/vehicle_visual_odometry", v + 1);
+    collectors.push_back(&static_cast<Collector&>(
+        host.add(make_component_factory<Collector>("collector"),
+                 {.name = "collector_" + robots[v],
+                  .remaps = {{"/fmu/in/vehicle_visual_odometry", topic}}})));
+    host.add(*loader.load("px4_odometry").factory,
+             {.name = "px4_" + robots[v],
+              .parameters = {{"board", robots[v]},
+                             {"pose_frame", std::string("ned")},
+                             {"optical_frame", std::string("world")},
+                             {"camera_in_world", std::vector<double>{}},
+                             {"rate_hz", 0.0}},
+              .remaps = {{"/fmu/in/vehicle_visual_odometry", topic}}});
+  }
+  auto& feeder =
+      static_cast<Feeder&>(host.add(make_component_factory<Feeder>("feeder"), {.name = "feeder"}));
+  host.start();
+
+  Isometry3d world_from_quadrotor = Isometry3d::Identity();
+  world_from_quadrotor.translation() = Vector3d(1, 2, 1.5);
+  Isometry3d world_from_rover = Isometry3d::Identity();
+  world_from_rover.translation() = Vector3d(-1, 0.5, 0);
+  for (int k = 0; k < 3; ++k) {
+    ConstellationPoseArray array;
+    array.header().stamp(to_time_msg(std::chrono::system_clock::time_point(
+        std::chrono::nanoseconds(1'700'000'000'000'000'000 + k * 4'166'667))));
+    array.header().frame_id("world");
+    auto add = [&](const std::string& name, const Isometry3d& pose, double orientation_variance) {
+      mocap_msgs::msg::ConstellationPose robot;
+      robot.name(name);
+      robot.pose().header(array.header());
+      robot.pose().pose(to_pose_message(pose));
+      for (size_t i = 0; i < 6; ++i)
+        robot.covariance()[7 * i] = i < 3 ? 1e-8 : orientation_variance;
+      array.poses().push_back(robot);
+    };
+    add("cf01", world_from_quadrotor, 1e-4);
+    add("rover01", world_from_rover, 1e9);
+    feeder.publisher.publish(array);
+  }
+  for (Collector* collector : collectors) {
+    std::unique_lock lock(collector->mutex);
+    ASSERT_TRUE(collector->arrived.wait_for(lock, std::chrono::seconds(10),
+                                            [&] { return collector->received.size() >= 3; }));
+  }
+  host.stop();
+  ASSERT_EQ(collectors[0]->received.size(), 3u);
+  ASSERT_EQ(collectors[1]->received.size(), 3u);
+  // ENU (1, 2, 1.5) is NED (2, 1, -1.5); level and facing east (x east in ENU): yaw 90° in NED.
+  const VehicleOdometry& quadrotor = collectors[0]->received[0];
+  EXPECT_NEAR(quadrotor.position()[0], 2, 1e-6);
+  EXPECT_NEAR(quadrotor.position()[1], 1, 1e-6);
+  EXPECT_NEAR(quadrotor.position()[2], -1.5, 1e-6);
+  EXPECT_NEAR(std::abs(quadrotor.q()[0]), std::sqrt(0.5), 1e-6);
+  EXPECT_NEAR(std::abs(quadrotor.q()[3]), std::sqrt(0.5), 1e-6);
+  const VehicleOdometry& rover = collectors[1]->received[0];
+  EXPECT_NEAR(rover.position()[0], 0.5, 1e-6);
+  EXPECT_NEAR(rover.position()[1], -1, 1e-6);
+  EXPECT_NEAR(rover.position()[2], 0, 1e-6);
+  for (float q : rover.q()) EXPECT_TRUE(std::isnan(q));
 }
 
 }  // namespace

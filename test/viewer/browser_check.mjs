@@ -9,12 +9,14 @@
 // bridge asking for a token the URL lacks) it checks that the page says it is disconnected;
 // with --tf (a bridge offering /tf but not /mocap/poses), that the top view draws the boards;
 // with --volume (a volume of cameras), every camera's image with its fiducials and the volume
-// from above with the cameras, their views and the bodies.
+// from above with the cameras, their views and the bodies; with --swarm COUNT (a volume whose
+// cameras send centroids), the volume from above with its cameras from /tf, COUNT robots and
+// at least as many markers of the cloud, and no camera panel.
 // HTTPS certificates are not checked (the TLS test's is self-signed). One line per check; exit 0
 // when all passed.
 //
 //   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused | --tf |
-//                                          --volume]
+//                                          --volume | --swarm COUNT]
 import { chromium } from "playwright-core";
 import { existsSync } from "node:fs";
 
@@ -66,6 +68,21 @@ try {
     check(await page.isHidden("#camera-section"), "the single camera's panel is hidden");
     await page.waitForTimeout(1000);
     await page.screenshot({ path: screenshot, fullPage: true });
+    check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+    await browser.close();
+    process.exit(failed ? 1 : 0);
+  }
+  if (mode === "--swarm") {
+    const count = Number(flagFile);
+    const seen = await snapshot(page, new Function("s", `return s?.volumeBodiesDrawn >= ${count} && ` +
+      `s.volumeMarkersDrawn >= ${count} && s.volumeCamerasDrawn >= 8;`), 90000);
+    check(true, `from above: ${seen.volumeCamerasDrawn} cameras from /tf, ${seen.volumeBodiesDrawn} robots, ` +
+      `${seen.volumeMarkersDrawn} markers of the cloud`);
+    check(await page.isHidden("#camera-section"), "the single camera's panel is hidden");
+    check(!(await page.isHidden("#volume")), "the volume's panel is shown");
+    await page.waitForTimeout(1000);
+    // The view's first screen: the volume from above and the first robots of the table.
+    await page.screenshot({ path: screenshot });
     check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
     await browser.close();
     process.exit(failed ? 1 : 0);

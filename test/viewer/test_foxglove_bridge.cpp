@@ -594,6 +594,33 @@ TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
       << page;
 }
 
+// The swarm demo as shipped (100 robots, 8 cameras that send centroids at 240 Hz): no camera
+// image, so the page shows the volume from above alone, with the cameras where /tf puts them,
+// every robot and the marker cloud (/mocap/markers) that the bridge relays.
+TEST(FoxgloveBridgeVolume, ThePageDrawsASwarmsRobotsAndMarkerCloudFromAbove) {
+  test::TempDir dir;
+  const int port = free_port();
+  test::ChildProcess graph({(test::bin_dir() / "mocap_launch").string(),
+                            (test::source_dir() / "launch_yaml" / "swarm_demo.yaml").string(),
+                            "--set", fmt::format("viewer.port={}", port)},
+                           {{"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(57))}},
+                           dir / "graph.log");
+  ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
+      << graph.output();
+  std::filesystem::path screenshot = dir / "swarm.png";
+  if (const char* wanted = std::getenv("MOCAP_VIEWER_SCREENSHOT")) {
+    const std::filesystem::path path(wanted);
+    screenshot = path.parent_path() / (path.stem().string() + "_swarm" + path.extension().string());
+  }
+  auto [code, page] = test::run_command(
+      {"node", (viewer_tests() / "browser_check.mjs").string(),
+       fmt::format("http://127.0.0.1:{}/", port), screenshot.string(), "--swarm", "100"},
+      {}, std::chrono::seconds(120));
+  EXPECT_EQ(code, 0) << page << graph.output();
+  EXPECT_NE(page.find("PASS from above: 8 cameras from /tf, 100 robots"), std::string::npos)
+      << page;
+}
+
 // secure_client.mjs's one line: what a client of the `ws` package got.
 json secure_client(std::vector<std::string> arguments,
                    const std::vector<std::string>& prefix = {}) {

@@ -77,6 +77,9 @@ struct SwarmFigures {
   int64_t tracked = 0;
   // Robots reported nearer another robot's true position than their own.
   int64_t identity_swaps = 0;
+  // Poses more than 5 cm or 5 degrees off their own robot's truth: what the pose evaluator
+  // counts as false identifications.
+  int64_t wrong_poses = 0;
   std::vector<double> position_errors_m;
   std::vector<double> orientation_errors_deg;  // robots of several markers
   MarkerCloudCounts cloud;
@@ -123,6 +126,8 @@ inline SwarmFigures track_swarm(const synthetic::SwarmScene& scene, SwarmRig& ri
                                     scene.pose(pose.robot, time_s).linear().transpose());
         figures.orientation_errors_deg.push_back(off.angle() * 180 / 3.14159265358979323846);
       }
+      const bool turned = pose.orientation_known && figures.orientation_errors_deg.back() > 5;
+      if (own > 0.05 || turned) ++figures.wrong_poses;
     }
   }
   figures.cloud = cloud.totals();

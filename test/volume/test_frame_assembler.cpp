@@ -119,6 +119,37 @@ TEST(FrameAssembler, ASilentCameraIsLeftOutUntilItComesBack) {
   EXPECT_EQ(count_messages(back[0]), 2);
 }
 
+// At 240 Hz a frame lasts 4.2 ms: once the capture times show the rate, a frame waits a third of
+// it for a late camera (1.39 ms), not the 5 ms the options allow at most; with the share 0, the
+// whole 5 ms.
+TEST(FrameAssembler, TheWaitIsSizedToTheFrameRate) {
+  constexpr int64_t kFrameNs = 4'166'667;  // 240 Hz
+  for (double share : {1.0 / 3.0, 0.0}) {
+    SCOPED_TRACE(share);
+    Frames frames(2, {.wait_share_of_frame = share});
+    Clock::time_point now{};
+    int64_t stamp = 0;
+    for (int k = 0; k < 20; ++k) {  // both cameras, on time; one frame dropped on the way
+      stamp += (k == 10 ? 2 : 1) * kFrameNs;
+      now += std::chrono::nanoseconds(kFrameNs);
+      frames.add(0, stamp, 0, now);
+      frames.add(1, stamp, 1, now);
+      ASSERT_EQ(frames.take_ready(now).size(), 1u);
+    }
+    EXPECT_EQ(frames.frame_period().count(), kFrameNs);
+    const auto expected_wait = share > 0 ? std::chrono::nanoseconds(kFrameNs / 3) : milliseconds(5);
+    EXPECT_EQ(frames.wait(), expected_wait);
+    // Camera 1 late: the frame goes without it once the wait has run out, not before.
+    stamp += kFrameNs;
+    now += std::chrono::nanoseconds(kFrameNs);
+    frames.add(0, stamp, 0, now);
+    EXPECT_TRUE(frames.take_ready(now + expected_wait - std::chrono::microseconds(10)).empty());
+    const auto ready = frames.take_ready(now + expected_wait);
+    ASSERT_EQ(ready.size(), 1u);
+    EXPECT_FALSE(ready[0].complete);
+  }
+}
+
 // Not above 0, every camera would be silent and every frame complete at once; negative, no two
 // stamps would be one capture time. Refused, naming the field.
 TEST(FrameAssemblerOptions, NameTheFieldThatCannotBeUsed) {
@@ -127,6 +158,8 @@ TEST(FrameAssemblerOptions, NameTheFieldThatCannotBeUsed) {
             "same_capture: -1.5 ms is below 0");
   EXPECT_EQ(FrameAssemblerOptions{.wait = milliseconds(0)}.problem(), std::nullopt);  // no wait
   EXPECT_EQ(FrameAssemblerOptions{.wait = milliseconds(-5)}.problem(), "wait: -5 ms is below 0");
+  EXPECT_EQ(FrameAssemblerOptions{.wait_share_of_frame = 1.5}.problem(),
+            "wait_share_of_frame: 1.5 is not between 0 and 1");
   EXPECT_EQ(FrameAssemblerOptions{.silent_after = milliseconds(0)}.problem(),
             "silent_after: 0 ms is not above 0");
   try {

@@ -30,12 +30,14 @@ test::SwarmRig eight_cameras(uint64_t seed = 1) {
 // The swarm issue's targets.
 void expect_targets(const test::SwarmFigures& figures, bool oriented) {
   fmt::print(
-      "{} robot-frames, {} tracked ({:.3f} %), {} identity swaps, position median {:.4f} mm, "
-      "orientation median {:.4f} deg\n",
+      "{} robot-frames, {} tracked ({:.3f} %), {} identity swaps, {} wrong poses, position median "
+      "{:.4f} mm, orientation median {:.4f} deg\n",
       figures.robot_frames, figures.tracked, 100 * figures.tracked_fraction(),
-      figures.identity_swaps, 1e3 * test::SwarmFigures::median(figures.position_errors_m),
+      figures.identity_swaps, figures.wrong_poses,
+      1e3 * test::SwarmFigures::median(figures.position_errors_m),
       test::SwarmFigures::median(figures.orientation_errors_deg));
   EXPECT_EQ(figures.identity_swaps, 0);
+  EXPECT_EQ(figures.wrong_poses, 0);
   EXPECT_GE(figures.tracked_fraction(), 0.999)
       << figures.tracked << " of " << figures.robot_frames << " robot-frames";
   EXPECT_LE(test::SwarmFigures::median(figures.position_errors_m), 0.1e-3);
@@ -117,6 +119,31 @@ TEST(SwarmScene, TheDemosRobotsFileIsTheOneItsSceneMakes) {
   }
 }
 
+// A swarm waits where it starts while its tracker comes up: with `hold_s`, every robot stays
+// at its pose of time 0 until then, and flies afterwards as the scene without the hold does.
+TEST(SwarmScene, AHoldKeepsEveryRobotWhereItsFlightStarts) {
+  const std::string flights =
+      "layouts:\n  - {name: deck, markers: [[0, 0.02, 0], [0.02, 0, 0], [0, 0, 0.03]]}\n"
+      "groups:\n  - {flight: crossing_pairs, layout: deck, pairs: 1, separation_m: 0.05,"
+      " speed_mps: 1, pair_spacing_m: 0.5, height_m: 1}\n";
+  const SwarmScene held = synthetic::parse_swarm_scene("hold_s: 2\n" + flights, "scene.yaml");
+  const SwarmScene flying = synthetic::parse_swarm_scene(flights, "scene.yaml");
+  ASSERT_EQ(held.robots.size(), 2u);
+  for (size_t r = 0; r < held.robots.size(); ++r) {
+    EXPECT_TRUE(held.pose(r, 1.9).isApprox(flying.pose(r, 0), 1e-12));
+    EXPECT_TRUE(held.pose(r, 3.2).isApprox(flying.pose(r, 1.2), 1e-12));
+  }
+  // Without the hold, 1.2 s in, the first robot has flown more than half way to the other end.
+  EXPECT_GT((flying.pose(0, 1.2).translation() - flying.pose(0, 0).translation()).norm(), 0.6);
+  try {
+    synthetic::parse_swarm_scene("hold_s: -1\n" + flights, "scene.yaml");
+    ADD_FAILURE() << "a negative hold accepted";
+  } catch (const synthetic::SwarmSceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.yaml:1:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("hold_s"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SwarmScene, AFileThatCannotBeFlownIsRefusedWithOneLineNamingIt) {
   const std::string layouts = "layouts:\n  - {name: single, markers: [[0, 0, 0]]}\n";
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -186,6 +213,24 @@ TEST(SwarmTracker, AMixedSwarmOfFiftyQuadrotorsAndFiftySingleMarkerRobots) {
   const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
   expect_targets(figures, false);
   EXPECT_LE(test::SwarmFigures::median(figures.orientation_errors_deg), 0.2);
+}
+
+// Quadrotors on the floor among robots of one marker: from scratch, some are seen by three
+// markers of a nearly isosceles triangle, which a half turn relabels; each is found upright,
+// not turned over (the mixed take-off once put one 3 cm and 180 degrees off for the whole run).
+// Names and poses only: the accuracy targets are the 60 s scenes' (swarm_bench: 0.096 mm for
+// this one), and a quarter of these 2 s is on the floor, where the cameras see the markers low.
+TEST(SwarmTracker, AMixedSwarmTakesOffWithEveryQuadrotorUpright) {
+  test::SwarmRig rig = eight_cameras(8);
+  const SwarmScene scene =
+      synthetic::takeoff_grid(synthetic::marker_deck_layout(), 5, 10, 0.3, 1.0, 0.5, 2.0, "cf")
+          .with(synthetic::takeoff_grid(synthetic::single_marker_layout(), 5, 10, 0.3, 0.6, 0.5,
+                                        2.0, "rover")
+                    .shifted(Eigen::Vector3d(0.15, 0.15, 0)));
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  EXPECT_EQ(figures.wrong_poses, 0);
+  EXPECT_EQ(figures.identity_swaps, 0);
+  EXPECT_GE(figures.tracked_fraction(), 0.999);
 }
 
 // Two identical robots side by side; one vanishes (carried under a cloth) for 0.3 s while the

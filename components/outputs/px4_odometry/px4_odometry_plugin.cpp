@@ -1,8 +1,9 @@
-// px4_odometry: one tracked board, carried by a PX4 vehicle, as px4_msgs/VehicleOdometry on
-// /fmu/in/vehicle_visual_odometry, the topic PX4's uXRCE-DDS agent forwards to the flight
-// controller's external-vision input (remap it to /fmu/in/vehicle_mocap_odometry for PX4's
-// motion-capture input). Frames converted to PX4's (px4_odometry.hpp); rate kept by the poses'
-// capture stamps.
+// px4_odometry: one tracked board (or a volume's robot), carried by a PX4 vehicle, as
+// px4_msgs/VehicleOdometry on /fmu/in/vehicle_visual_odometry, the topic PX4's uXRCE-DDS agent
+// forwards to the flight controller's external-vision input (remap it to
+// /fmu/in/vehicle_mocap_odometry for PX4's motion-capture input; a swarm has one per vehicle,
+// each remapped into its vehicle's namespace). Frames converted to PX4's (px4_odometry.hpp); rate
+// kept by the poses' capture stamps.
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -65,7 +66,7 @@ const ParameterList<Settings> kParameters =
              &Settings::pose_frame)
         .add("camera_in_world",
              "the camera's REP 103 body frame in the world: x, y, z (m), roll, pitch, yaw "
-             "(rad)",
+             "(rad); [] for no camera (a volume's poses, in the world frame already)",
              &Settings::camera_in_world)
         .add("vehicle_in_board",
              "the vehicle's FLU body frame (x forward, y left, z up) in the board's frame: "
@@ -105,8 +106,11 @@ class Px4OdometryComponent final : public Component {
       throw std::invalid_argument("pose_frame: '" + frame + "'; expected frd or ned");
     }
     frame_ = frame == "ned" ? Px4Frame::Ned : Px4Frame::Frd;
-    world_from_optical_ =
-        world_from_optical(from_xyz_rpy(settings_.camera_in_world, "camera_in_world"));
+    // No camera: a volume's poses, in the world frame already.
+    if (!settings_.camera_in_world.empty()) {
+      world_from_optical_ =
+          world_from_optical(from_xyz_rpy(settings_.camera_in_world, "camera_in_world"));
+    }
     board_from_vehicle_ = from_xyz_rpy(settings_.vehicle_in_board, "vehicle_in_board");
     const double rate = settings_.rate_hz;
     publisher_ = create_publisher<VehicleOdometry>(topics::kPx4VisualOdometry);

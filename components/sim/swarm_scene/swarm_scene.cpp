@@ -89,6 +89,7 @@ SwarmLeg wander(double start_s, double end_s, const Eigen::Vector3d& about, doub
 
 Eigen::Isometry3d SwarmScene::pose(size_t robot, double time_s) const {
   const SwarmSceneRobot& r = robots.at(robot);
+  if (hold_s > 0) time_s = std::max(0.0, time_s - hold_s);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   if (!r.legs.empty()) {
     auto leg = std::find_if(r.legs.rbegin(), r.legs.rend(),
@@ -119,6 +120,7 @@ std::vector<Eigen::Vector3d> SwarmScene::markers(double time_s) const {
 SwarmScene SwarmScene::with(const SwarmScene& other) const {
   SwarmScene both = *this;
   both.duration_s = std::max(duration_s, other.duration_s);
+  both.hold_s = std::max(hold_s, other.hold_s);
   for (SwarmSceneRobot robot : other.robots) {
     const std::string name = robot.name;
     for (int n = 2; std::any_of(both.robots.begin(), both.robots.end(),

@@ -52,6 +52,10 @@ struct SwarmSceneRobot {
 struct SwarmScene {
   std::vector<SwarmSceneRobot> robots;
   double duration_s = 0;
+  // Seconds every robot stays where its flight starts before the flights begin (the flights'
+  // time 0 is then `hold_s`), as a swarm waits on the ground while its tracker comes up and
+  // finds each robot at its initial position.
+  double hold_s = 0;
 
   // The robot's pose at `time_s`: its origin where its legs put it.
   Eigen::Isometry3d pose(size_t robot, double time_s) const;

@@ -113,7 +113,7 @@ SwarmScene read_group(const Reader& reader, const YAML::Node& node,
 }
 
 SwarmScene read_scene(const Reader& reader, const YAML::Node& root) {
-  reader.check_keys(root, {"duration_s", "layouts", "groups"}, "the file");
+  reader.check_keys(root, {"duration_s", "hold_s", "layouts", "groups"}, "the file");
   const double duration_s = reader.positive(root, "duration_s", 60, 1e6);
   std::map<std::string, std::vector<Eigen::Vector3d>> layouts;
   for (const YAML::Node& node : reader.list(root, "layouts")) {
@@ -139,6 +139,7 @@ SwarmScene read_scene(const Reader& reader, const YAML::Node& root) {
     }
     scene = scene.with(group);
   }
+  scene.hold_s = reader.number(root, "hold_s", 0, 0, 3600);
   return scene;
 }
 

@@ -1,6 +1,7 @@
 // The canvases, from the viewer's state (state.js): a single camera's image with the
 // fiducials, constellations and poses' axes found in it; a volume's cameras side by side and
-// seen from above; the boards seen from above in the camera frame; the floor.
+// seen from above with its bodies, robots and marker cloud; the boards seen from above in the
+// camera frame; the floor.
 import { halfView, project, rotate, yaw } from "./geometry.js";
 import { foundIn, graph, inWorld, report } from "./state.js";
 import { subject } from "./topics.js";
@@ -9,6 +10,9 @@ const COLOURS = ["#ffd54a", "#5fd38d", "#6cb6ff", "#ff8f6b", "#d59bff"];
 const AXIS_LENGTH_M = 0.1;
 const AXIS_COLOURS = ["#ff5252", "#5fd38d", "#6cb6ff"];  // x, y, z
 const LATENCIES_KEPT = 1000;
+const WORLD = "world";
+// Above this many bodies in the volume, they are drawn small and without names.
+const CROWDED_BODIES = 20;
 
 const $ = (id) => document.getElementById(id);
 const camera = $("camera");
@@ -235,6 +239,7 @@ export function drawVolumeTop() {
   const at = (p) => [ox + p.x * ppm, oy - p.y * ppm];
   context.font = "12px system-ui, sans-serif";
   let cones = 0;
+  const drawn = new Set();
   for (const c of graph.cameras.values()) {
     const frame = c.image?.header.frame_id;
     const info = graph.infos.get(frame);
@@ -258,7 +263,34 @@ export function drawVolumeTop() {
     context.fillRect(px - 5, py - 5, 10, 10);
     context.fillText(c.name, px + 8, py + (py > oy ? 16 : -8));
     cones++;
+    drawn.add(frame);
   }
+  // Cameras that send no images (centroids, as motion-capture cameras do): where the fusion's
+  // /tf puts their optical frames, with the direction they look.
+  for (const [frame, t] of graph.tf) {
+    if (drawn.has(frame) || !frame.endsWith("_optical") || t.header.frame_id !== WORLD) continue;
+    const { translation, rotation } = t.transform;
+    const axis = rotate(rotation, { x: 0, y: 0, z: 1 });
+    const [px, py] = at(translation);
+    context.strokeStyle = "#7d8794";
+    context.beginPath();
+    context.moveTo(px, py);
+    context.lineTo(px + 40 * axis.x, py - 40 * axis.y);
+    context.stroke();
+    context.fillStyle = "#d8dee6";
+    context.fillRect(px - 5, py - 5, 10, 10);
+    context.fillText(frame.replace(/_optical$/, ""), px + 8, py + (py > oy ? 16 : -8));
+    drawn.add(frame);
+  }
+  // The marker cloud: markers a body or robot claims in its colour's grey, the others dimmer.
+  for (const m of graph.markers) {
+    const [px, py] = at(m);
+    context.fillStyle = m.body >= 0 ? "#d8dee6" : "#7d8794";
+    context.fillRect(px - 1.5, py - 1.5, 3, 3);
+  }
+  // A swarm's robots smaller and unnamed (the poses' table names them).
+  const crowded = graph.bodies.size > CROWDED_BODIES;
+  const radius = crowded ? 3 : 6;
   let k = 0;
   for (const [name, body] of graph.bodies) {
     const colour = COLOURS[k++ % COLOURS.length];
@@ -271,16 +303,21 @@ export function drawVolumeTop() {
     const [px, py] = at(body);
     context.fillStyle = colour;
     context.beginPath();
-    context.arc(px, py, 6, 0, 2 * Math.PI);
+    context.arc(px, py, radius, 0, 2 * Math.PI);
     context.fill();
-    context.beginPath();
-    context.moveTo(px, py);
-    context.lineTo(px + 16 * Math.cos(body.yaw), py - 16 * Math.sin(body.yaw));
-    context.stroke();
-    context.fillText(name, px + 9, py - 9);
+    if (body.yaw !== null) {
+      // No heading for a robot of one marker: it has no orientation.
+      context.beginPath();
+      context.moveTo(px, py);
+      context.lineTo(px + (radius + 10) * Math.cos(body.yaw), py - (radius + 10) * Math.sin(body.yaw));
+      context.stroke();
+    }
+    if (!crowded) context.fillText(name, px + 9, py - 9);
   }
   report.volumeConesDrawn = cones;
+  report.volumeCamerasDrawn = drawn.size;
   report.volumeBodiesDrawn = graph.bodies.size;
+  report.volumeMarkersDrawn = graph.markers.length;
 }
 
 export function drawTop() {

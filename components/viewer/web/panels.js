@@ -26,16 +26,21 @@ function pattern(topics) {
   return names[0].map((name, i) => (names.every((n) => n[i] === name) ? name : "<camera>")).join("/");
 }
 
-// Which panels this graph fills: a single camera's, or a volume's cameras side by side.
+// Which panels this graph fills: a single camera's, or a volume's: its cameras side by side
+// (none when they send centroids instead of images) and the volume from above.
 export function layout(channels) {
   const cameras = [...graph.cameras.keys()];
-  const volume = cameras.length > 1;
   const advertised = [...channels.values()];
   const types = new Set(advertised.map((c) => c.schemaName));
+  const volume = cameras.length > 1 || types.has(TYPES.markers);
   $("camera-topic").textContent = cameras.length === 1 ? cameras[0] : "";
   $("camera-note").textContent = cameras.length ? "" : `no ${TYPES.image} in this graph`;
   $("volume").hidden = !volume;
-  if (volume) $("volume-topics").textContent = `${pattern(cameras)} with their fiducials`;
+  if (volume) {
+    $("volume-topics").textContent = cameras.length
+      ? `${pattern(cameras)} with their fiducials`
+      : "none: the cameras send no images";
+  }
   // A volume alone: the single camera's panels (its image, its top view, the floor) stay empty.
   $("camera-section").hidden = volume;
   $("side-section").hidden = volume && !types.has(TYPES.robots) && !types.has(TYPES.footprints);

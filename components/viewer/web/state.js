@@ -2,6 +2,7 @@
 // of the channels topics.js chose, with which panels have news; draw.js and panels.js show it
 // at the browser's next animation frame.
 import { yaw } from "./geometry.js";
+import { points } from "./point_cloud.js";
 import { TYPES, subject } from "./topics.js";
 
 const WORLD = "world";
@@ -11,6 +12,9 @@ const POSES_FRESH_MS = 2000;
 const FLOOR_M = 0.2;
 const TRAIL_LENGTH = 150;
 const STAMPS_KEPT = 60;  // per frame: the last few images' fiducials, constellations, poses
+// A pose's orientation variance (rad^2) from which it has none: a robot of one marker carries
+// 1e9 (components/outputs/body_frames/body_frames.hpp).
+const UNKNOWN_ORIENTATION_VARIANCE = 1e6;
 
 // What was drawn: window.viewerState.
 export const report = {
@@ -33,7 +37,9 @@ export const report = {
   volumeImagesDrawn: {},  // camera -> images drawn
   volumeCirclesDrawn: {},  // camera -> circles drawn on its last image
   volumeConesDrawn: 0,  // cameras drawn from above with their view
-  volumeBodiesDrawn: 0,  // bodies drawn from above
+  volumeCamerasDrawn: 0,  // cameras drawn from above, with their view or (no images) from /tf
+  volumeBodiesDrawn: 0,  // bodies and robots drawn from above
+  volumeMarkersDrawn: 0,  // points of the marker cloud drawn from above
 };
 
 // The panels with news since the last animation frame.
@@ -45,7 +51,8 @@ export const graph = {
   poses: new Map(),  // topic of estimated poses -> its latest message
   tf: new Map(),  // child frame -> its latest transform, from every TFMessage topic
   trails: new Map(),  // board -> [{x, z}], seen from above in its camera's optical frame
-  bodies: new Map(),  // body -> {x, y, yaw, trail: [{x, y}]} in the world frame
+  bodies: new Map(),  // body -> {x, y, yaw (null: none), trail: [{x, y}]} in the world frame
+  markers: [],  // the newest marker cloud in the world frame: [{x, y, z, body}]
   bases: new Map(),  // topic -> the pose of what stands on the floor
   robots: new Map(),  // topic -> its latest robots
   footprints: new Map(),  // topic -> its latest cameras' footprints
@@ -93,11 +100,13 @@ function addToTrail(name, position) {
   graph.trails.set(name, trail);
 }
 
-function addToVolume(name, pose) {
+// `pose` in the world frame, with its covariance (ConstellationPose.msg).
+function addToVolume(name, pose, covariance) {
   const body = graph.bodies.get(name) ?? { trail: [] };
   body.x = pose.position.x;
   body.y = pose.position.y;
-  body.yaw = yaw(pose.orientation);
+  const oriented = [21, 28, 35].some((i) => covariance[i] < UNKNOWN_ORIENTATION_VARIANCE);
+  body.yaw = oriented ? yaw(pose.orientation) : null;
   body.trail.push({ x: body.x, y: body.y });
   if (body.trail.length > TRAIL_LENGTH) body.trail.shift();
   graph.bodies.set(name, body);
@@ -139,7 +148,7 @@ const handlers = {
     posesAt = Date.now();
     if (message.header.frame_id === WORLD) {
       // A volume's bodies.
-      for (const pose of message.poses) addToVolume(pose.name, pose.pose.pose);
+      for (const pose of message.poses) addToVolume(pose.name, pose.pose.pose, pose.covariance);
       dirty.volume = true;
     } else {
       for (const pose of message.poses) addToTrail(pose.name, pose.pose.pose.position);
@@ -183,6 +192,13 @@ const handlers = {
   [TYPES.footprints](message, topic) {
     graph.footprints.set(topic, message.cameras);
     dirty.side = true;
+  },
+  // A volume's marker cloud (volume_fusion's /mocap/markers, or any PointCloud2 in the world
+  // frame): the newest, drawn from above.
+  [TYPES.markers](message) {
+    if (message.header.frame_id !== WORLD) return;
+    graph.markers = points(message, ["x", "y", "z", "body"]);
+    dirty.volume = true;
   },
   [TYPES.alert](alert) {
     graph.alerts.unshift(alert);

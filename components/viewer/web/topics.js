@@ -18,6 +18,7 @@ export const TYPES = {
   robots: "mocap_msgs/msg/RobotPoseArray",
   footprints: "mocap_msgs/msg/CameraFootprintArray",
   alert: "mocap_msgs/msg/Alert",
+  markers: "sensor_msgs/msg/PointCloud2",
 };
 
 const namespace = (topic) => topic.slice(0, topic.lastIndexOf("/"));

@@ -1,7 +1,8 @@
 // The cameras' messages of one capture time, gathered for the fusion: a volume's cameras are
 // stamped at capture, and their messages arrive in any order, some late, some never (a camera
 // that stopped). A frame is complete when every live camera has given its message for that
-// capture time, or when the wait for the late ones has run out; a camera silent for longer than
+// capture time, or when the wait for the late ones has run out (sized to the frame rate, as the
+// capture times show it); a camera silent for longer than
 // `silent_after` (or not heard yet) is left out of the frames that follow, which then wait for
 // it no more (said by the frame, so coverage can be reported), until its next message, which
 // takes it back.
@@ -11,9 +12,11 @@
 //   for (auto& frame : frames.take_ready(now)) fuse(frame);
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
+#include <deque>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -26,8 +29,13 @@ struct FrameAssemblerOptions {
   // Messages whose stamps differ by no more than this are one capture time (cameras triggered
   // together still stamp a little apart).
   std::chrono::nanoseconds same_capture{std::chrono::milliseconds(2)};
-  // How long a frame waits for its late cameras after its first message arrived.
+  // How long a frame waits for its late cameras after its first message arrived, at most.
   std::chrono::nanoseconds wait{std::chrono::milliseconds(5)};
+  // The wait as a share of the frame period, when that is shorter than `wait`: at 240 Hz a frame
+  // lasts 4.2 ms, and a frame still waiting when the next is captured delays every frame behind
+  // it. The period is the median interval between the last capture times handed out (robust to
+  // a dropped frame). 0: `wait` alone.
+  double wait_share_of_frame = 1.0 / 3.0;
   // A camera with no message for this long is left out of the frames that follow.
   std::chrono::nanoseconds silent_after{std::chrono::milliseconds(500)};
 
@@ -81,9 +89,10 @@ class FrameAssembler {
       for (size_t c = 0; c < silent.size(); ++c) {
         complete = complete && (silent[c] || pending.frame.messages[c].has_value());
       }
-      if (!complete && now - pending.first_arrival < options_.wait) break;
+      if (!complete && now - pending.first_arrival < wait_) break;
       pending.frame.silent = silent;
       pending.frame.complete = complete;
+      if (handed_out_) measure_period(oldest->first - *handed_out_);
       handed_out_ = oldest->first;
       ready.push_back(std::move(pending.frame));
       pending_.erase(oldest);
@@ -92,8 +101,27 @@ class FrameAssembler {
   }
 
   int64_t late_drops() const { return late_drops_; }
+  // The frame period the capture times show (0 until enough frames came out), and the wait a
+  // frame gets now.
+  std::chrono::nanoseconds frame_period() const { return frame_period_; }
+  std::chrono::nanoseconds wait() const { return wait_; }
 
  private:
+  static constexpr size_t kIntervalsKept = 15;
+
+  void measure_period(int64_t interval_ns) {
+    intervals_.push_back(interval_ns);
+    if (intervals_.size() > kIntervalsKept) intervals_.pop_front();
+    if (intervals_.size() < kIntervalsKept / 2 + 1) return;
+    std::vector<int64_t> sorted(intervals_.begin(), intervals_.end());
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    frame_period_ = std::chrono::nanoseconds(sorted[sorted.size() / 2]);
+    if (options_.wait_share_of_frame > 0) {
+      wait_ = std::min(options_.wait, std::chrono::round<std::chrono::nanoseconds>(
+                                          frame_period_ * options_.wait_share_of_frame));
+    }
+  }
+
   struct Pending {
     AssembledFrame<Message> frame;
     Clock::time_point first_arrival;
@@ -122,6 +150,9 @@ class FrameAssembler {
   std::vector<std::optional<Clock::time_point>> last_heard_;
   std::map<int64_t, Pending> pending_;  // by capture time
   std::optional<int64_t> handed_out_;   // the latest capture time handed out
+  std::deque<int64_t> intervals_;       // between the last capture times handed out
+  std::chrono::nanoseconds frame_period_{0};
+  std::chrono::nanoseconds wait_ = options_.wait;
   int64_t late_drops_ = 0;
 };
 

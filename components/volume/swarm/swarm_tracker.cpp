@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -13,6 +14,9 @@
 namespace mocap::volume {
 namespace {
 
+// A robot is found upright (tilted less than this) where the markers found allow it turned: a
+// swarm starts on the ground or hovering.
+constexpr double kMostTiltAtStart_rad = 0.7854;  // 45 degrees
 // A robot not looked for by its track costs this many times its search radius squared when it
 // is left without what was found: any find within the radius is taken before none.
 constexpr double kUnfoundCostFactor = 4;
@@ -73,6 +77,52 @@ class PointGrid {
 // A marker's sigma (metres): the mean of its covariance's axes.
 double sigma_of(const CloudMarker& marker) { return std::sqrt(marker.covariance.trace() / 3); }
 
+// The relabellings of the markers `subset` of `layout` that a rotation maps onto themselves,
+// within `tolerance_m` (the fit's RMS), the identity first: three markers of a nearly isosceles
+// triangle have two, the second turned half a turn about the triangle's axis. Each relabelling
+// says, per marker of `subset`, the marker of `subset` it is taken for. Searches the
+// relabellings that keep every distance within twice the tolerance.
+std::vector<std::vector<size_t>> relabellings(const std::vector<Eigen::Vector3d>& layout,
+                                              const std::vector<int>& subset, double tolerance_m) {
+  const size_t k = subset.size();
+  std::vector<std::vector<size_t>> found;
+  std::vector<size_t> image(k);
+  std::vector<char> taken(k, 0);
+  const auto at = [&](size_t i) { return layout[static_cast<size_t>(subset[i])]; };
+  const std::function<void(size_t)> extend = [&](size_t i) {
+    if (i == k) {
+      std::vector<Eigen::Vector3d> from, to;
+      for (size_t j = 0; j < k; ++j) {
+        from.push_back(at(j));
+        to.push_back(at(image[j]));
+      }
+      if (best_fit_rms(from, to) <= tolerance_m) found.push_back(image);
+      return;
+    }
+    for (size_t c = 0; c < k; ++c) {
+      if (taken[c]) continue;
+      bool keeps = true;
+      for (size_t j = 0; j < i && keeps; ++j) {
+        keeps = std::abs((at(i) - at(j)).norm() - (at(c) - at(image[j])).norm()) <= 2 * tolerance_m;
+      }
+      if (!keeps) continue;
+      taken[c] = 1;
+      image[i] = c;
+      extend(i + 1);
+      taken[c] = 0;
+    }
+  };
+  if (k >= 3) extend(0);
+  // The identity first (it is always among them: the search tries the markers in order).
+  std::stable_partition(found.begin(), found.end(), [](const std::vector<size_t>& p) {
+    for (size_t j = 0; j < p.size(); ++j) {
+      if (p[j] != j) return false;
+    }
+    return true;
+  });
+  return found;
+}
+
 }  // namespace
 
 std::optional<std::string> SwarmTrackerOptions::problem() const {
@@ -116,6 +166,39 @@ bool SwarmTracker::reseed(const std::string& name, const Eigen::Vector3d& positi
     return true;
   }
   return false;
+}
+
+std::optional<SwarmTracker::Found> SwarmTracker::upright_fit(
+    size_t layout, const std::vector<int>& markers, const std::vector<CloudMarker>& cloud) {
+  std::vector<int> subset;
+  for (size_t k = 0; k < markers.size(); ++k) {
+    if (markers[k] >= 0) subset.push_back(static_cast<int>(k));
+  }
+  auto key = std::make_pair(layout, subset);
+  auto known = relabellings_.find(key);
+  if (known == relabellings_.end()) {
+    known = relabellings_
+                .emplace(std::move(key), relabellings(swarm_.layouts[layout].markers, subset,
+                                                      options_.layout_tolerance_m))
+                .first;
+  }
+  if (known->second.size() <= 1) return fit(layout, markers, cloud);
+  // Each relabelling's pose: the cloud marker taken for subset[j] is taken for subset[p[j]].
+  const double upright = std::cos(kMostTiltAtStart_rad);
+  std::optional<Found> chosen;
+  int upright_count = 0;
+  for (const std::vector<size_t>& p : known->second) {
+    std::vector<int> relabelled(markers.size(), -1);
+    for (size_t j = 0; j < subset.size(); ++j) {
+      relabelled[static_cast<size_t>(subset[p[j]])] = markers[static_cast<size_t>(subset[j])];
+    }
+    std::optional<Found> found = fit(layout, std::move(relabelled), cloud);
+    if (!found || found->world_from_body.linear()(2, 2) < upright) continue;
+    ++upright_count;
+    chosen = std::move(found);
+  }
+  if (upright_count != 1) return std::nullopt;
+  return chosen;
 }
 
 double SwarmTracker::search_radius(const Robot& robot, size_t layout, int64_t stamp_ns) const {
@@ -315,7 +398,7 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
             if (std::find(markers.begin(), markers.end(), m) == markers.end()) rest.push_back(m);
           }
           candidates = std::move(rest);
-          if (auto found = fit(layout, std::move(markers), cloud)) around.push_back(*found);
+          if (auto found = upright_fit(layout, markers, cloud)) around.push_back(*found);
         }
       }
       for (Found& found : around) {

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -143,6 +144,12 @@ class SwarmTracker {
   };
 
   double search_radius(const Robot& robot, size_t layout, int64_t stamp_ns) const;
+  // fit() of a robot found from scratch. Where a rotation maps the markers found (per layout
+  // marker, -1: none) onto themselves relabelled (three markers of a nearly isosceles
+  // triangle: the robot may be turned half a turn), the relabelling whose pose is upright,
+  // if exactly one is; nullopt otherwise. The relabellings are kept per layout and markers.
+  std::optional<Found> upright_fit(size_t layout, const std::vector<int>& markers,
+                                   const std::vector<CloudMarker>& cloud);
   // The layout's pose from the cloud markers given per layout marker (-1: none), the worst
   // left out while it is beyond max_fit_sigmas, with the pose's covariance from the markers';
   // nullopt when too few remain.
@@ -155,6 +162,8 @@ class SwarmTracker {
   SwarmTrackerOptions options_;
   std::vector<Robot> robots_;
   SwarmCounts counts_;
+  // (layout, its markers found) -> the relabellings a rotation makes of them, the identity first
+  std::map<std::pair<size_t, std::vector<int>>, std::vector<std::vector<size_t>>> relabellings_;
 };
 
 }  // namespace mocap::volume

@@ -4,7 +4,8 @@
 // Each camera's fiducials come on its own topic (/volume/{camera}/fiducials, the name in its
 // camera file), stamped at capture. The messages of one capture time are gathered
 // (frame_assembler.hpp): a frame is fused when every live camera has given its message, or
-// `wait_s` after its first one. A camera silent for `silent_after_s` is left out and reported
+// a third of the frame period (as the capture times show it) after its first one, `wait_s` at
+// most. A camera silent for `silent_after_s` is left out and reported
 // on /alerts, and taken back, also reported, at its next message; so is a camera found drifted
 // (its extrinsics moved: its residuals against the others' poses), and a body seen by one
 // camera only (its pose then rests on that camera alone).
@@ -151,7 +152,9 @@ const ParameterList<Settings> kParameters =
         .range(0.01, 100)
         .add("same_capture_s", "stamps this close are one capture time", &Settings::same_capture_s)
         .range(0, 1)
-        .add("wait_s", "how long a frame waits for late cameras after its first message",
+        .add("wait_s",
+             "how long a frame waits for late cameras after its first message, at most: a "
+             "third of the frame period when that is shorter",
              &Settings::wait_s)
         .range(0, 1)
         .add("silent_after_s", "a camera silent this long is left out until it returns",
@@ -262,8 +265,9 @@ class VolumeFusion final : public Component {
         cloud_(settings_.cloud),
         swarm_(load_robots(settings_, tracker_.bodies())),
         frames_(static_cast<int>(tracker_.cameras().size()),
-                {seconds(settings_.same_capture_s), seconds(settings_.wait_s),
-                 seconds(settings_.silent_after_s)}),
+                {.same_capture = seconds(settings_.same_capture_s),
+                 .wait = seconds(settings_.wait_s),
+                 .silent_after = seconds(settings_.silent_after_s)}),
         heard_(tracker_.cameras().size(), false),
         silent_(tracker_.cameras().size(), false),
         gaps_(tracker_.cameras().size()),
@@ -305,10 +309,12 @@ class VolumeFusion final : public Component {
     log().info(
         "{} frames fused ({} incomplete, {} skipped while behind), {} body poses ({} from one "
         "camera), {} robot poses, {} identifications, {} fits set aside as unusually poor, {} "
-        "late messages dropped; marker cloud: {} tracks started, {} detections left out as "
-        "merged, {} no marker explains{}",
+        "late messages dropped (a frame waited {:.2f} ms of its {:.2f}); marker cloud: {} tracks "
+        "started, {} detections left out as merged, {} no marker explains{}",
         fused_frames_, incomplete_frames_, skipped_frames_, body_poses_, single_camera_poses_,
         robot_poses_, tracker_.identifications(), tracker_.unusual_fits(), frames_.late_drops(),
+        std::chrono::duration<double, std::milli>(frames_.wait()).count(),
+        std::chrono::duration<double, std::milli>(frames_.frame_period()).count(),
         cloud_.totals().started, cloud_.totals().merged, cloud_.totals().unexplained, health);
   }
 
