@@ -5,7 +5,7 @@
 // figures: no false identification ever (a pose more than 5 cm or 5 degrees off is a wrong
 // answer handed to a robot: a frame the fusion cannot pose goes without), and 99.5 % of the
 // body-frames tracked, or, for the part of a run with a camera away, the 98 % the design gives
-// for one camera away (docs/targets.md). Real time: CI runs these one at a time, with nothing
+// for one camera away (docs/targets.md). Real time: CI runs these two at a time, with nothing
 // beside them but what it compiles in the scheduler's idle class (test/CMakeLists.txt, the
 // realtime part).
 #include <gtest/gtest.h>
