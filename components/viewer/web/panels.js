@@ -93,7 +93,7 @@ export function rates() {
   const cameras = [...graph.cameras.keys()].map(rate);
   const shown = cameras.length > 1
     ? `${cameras.length} cameras ${Math.min(...cameras)}–${Math.max(...cameras)} Hz shown`
-    : `camera ${cameras[0] ?? 0} Hz shown`;
+    : cameras.length === 1 ? `camera ${cameras[0]} Hz shown` : "no camera images";
   const poses = [...graph.poses.keys()].reduce((sum, topic) => sum + rate(topic), 0);
   $("rates").textContent = report.connected
     ? `${shown} · poses ${poses} Hz · latency to bridge ${report.latencyMs === null ? "—" : report.latencyMs.toFixed(1) + " ms"}`

@@ -2,10 +2,9 @@
 // stamped at capture, and their messages arrive in any order, some late, some never (a camera
 // that stopped). A frame is complete when every live camera has given its message for that
 // capture time, or when the wait for the late ones has run out (sized to the frame rate, as the
-// capture times show it); a camera silent for longer than
-// `silent_after` (or not heard yet) is left out of the frames that follow, which then wait for
-// it no more (said by the frame, so coverage can be reported), until its next message, which
-// takes it back.
+// capture times show it); a camera silent for longer than `silent_after` (or not heard yet) is
+// left out of the frames that follow, which then wait for it no more (said by the frame, so
+// coverage can be reported), until its next message, which takes it back.
 //
 //   FrameAssembler<FiducialArray> frames(camera_count, options);
 //   frames.add(camera, stamp, message, now);        // as each arrives

@@ -78,10 +78,10 @@ class PointGrid {
 double sigma_of(const CloudMarker& marker) { return std::sqrt(marker.covariance.trace() / 3); }
 
 // The relabellings of the markers `subset` of `layout` that a rotation maps onto themselves,
-// within `tolerance_m` (the fit's RMS), the identity first: three markers of a nearly isosceles
-// triangle have two, the second turned half a turn about the triangle's axis. Each relabelling
-// says, per marker of `subset`, the marker of `subset` it is taken for. Searches the
-// relabellings that keep every distance within twice the tolerance.
+// within `tolerance_m` (the fit's RMS), the identity among them: three markers of a nearly
+// isosceles triangle have two, the second turned half a turn about the triangle's axis. Each
+// relabelling says, per marker of `subset`, the marker of `subset` it is taken for. Searches
+// the relabellings that keep every distance within twice the tolerance.
 std::vector<std::vector<size_t>> relabellings(const std::vector<Eigen::Vector3d>& layout,
                                               const std::vector<int>& subset, double tolerance_m) {
   const size_t k = subset.size();
@@ -113,13 +113,6 @@ std::vector<std::vector<size_t>> relabellings(const std::vector<Eigen::Vector3d>
     }
   };
   if (k >= 3) extend(0);
-  // The identity first (it is always among them: the search tries the markers in order).
-  std::stable_partition(found.begin(), found.end(), [](const std::vector<size_t>& p) {
-    for (size_t j = 0; j < p.size(); ++j) {
-      if (p[j] != j) return false;
-    }
-    return true;
-  });
   return found;
 }
 

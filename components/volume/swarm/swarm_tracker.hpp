@@ -162,7 +162,7 @@ class SwarmTracker {
   SwarmTrackerOptions options_;
   std::vector<Robot> robots_;
   SwarmCounts counts_;
-  // (layout, its markers found) -> the relabellings a rotation makes of them, the identity first
+  // (layout, its markers found) -> the relabellings a rotation makes of them, the identity too
   std::map<std::pair<size_t, std::vector<int>>, std::vector<std::vector<size_t>>> relabellings_;
 };
 
