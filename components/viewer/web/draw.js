@@ -3,6 +3,7 @@
 // seen from above with its bodies, robots and marker cloud; the boards seen from above in the
 // camera frame; the floor.
 import { halfView, project, rotate, yaw } from "./geometry.js";
+import { points } from "./point_cloud.js";
 import { foundIn, graph, inWorld, report } from "./state.js";
 import { subject } from "./topics.js";
 
@@ -283,7 +284,13 @@ export function drawVolumeTop() {
     drawn.add(frame);
   }
   // The marker cloud: markers a body or robot claims in its colour's grey, the others dimmer.
-  for (const m of graph.markers) {
+  let markers = [];
+  try {
+    markers = graph.markers ? points(graph.markers, ["x", "y", "z", "body"]) : [];
+  } catch (error) {
+    console.warn(`marker cloud: ${error.message}`);
+  }
+  for (const m of markers) {
     const [px, py] = at(m);
     context.fillStyle = m.body >= 0 ? "#d8dee6" : "#7d8794";
     context.fillRect(px - 1.5, py - 1.5, 3, 3);
@@ -317,7 +324,7 @@ export function drawVolumeTop() {
   report.volumeConesDrawn = cones;
   report.volumeCamerasDrawn = drawn.size;
   report.volumeBodiesDrawn = graph.bodies.size;
-  report.volumeMarkersDrawn = graph.markers.length;
+  report.volumeMarkersDrawn = markers.length;
 }
 
 export function drawTop() {

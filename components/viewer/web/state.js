@@ -2,7 +2,6 @@
 // of the channels topics.js chose, with which panels have news; draw.js and panels.js show it
 // at the browser's next animation frame.
 import { yaw } from "./geometry.js";
-import { points } from "./point_cloud.js";
 import { TYPES, subject } from "./topics.js";
 
 const WORLD = "world";
@@ -52,7 +51,7 @@ export const graph = {
   tf: new Map(),  // child frame -> its latest transform, from every TFMessage topic
   trails: new Map(),  // board -> [{x, z}], seen from above in its camera's optical frame
   bodies: new Map(),  // body -> {x, y, yaw (null: none), trail: [{x, y}]} in the world frame
-  markers: [],  // the newest marker cloud in the world frame: [{x, y, z, body}]
+  markers: null,  // the newest marker cloud in the world frame (PointCloud2), read when drawn
   bases: new Map(),  // topic -> the pose of what stands on the floor
   robots: new Map(),  // topic -> its latest robots
   footprints: new Map(),  // topic -> its latest cameras' footprints
@@ -194,10 +193,10 @@ const handlers = {
     dirty.side = true;
   },
   // A volume's marker cloud (volume_fusion's /mocap/markers, or any PointCloud2 in the world
-  // frame): the newest, drawn from above.
+  // frame): the newest, drawn from above (its points read then, not at each of 240 a second).
   [TYPES.markers](message) {
     if (message.header.frame_id !== WORLD) return;
-    graph.markers = points(message, ["x", "y", "z", "body"]);
+    graph.markers = message;
     dirty.volume = true;
   },
   [TYPES.alert](alert) {
