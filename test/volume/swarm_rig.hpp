@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 
 #include "sim/centroid_camera/centroid_camera.hpp"
 #include "sim/swarm_scene/swarm_scene.hpp"
+#include "volume/frame_assembly/frame_assembler.hpp"
 #include "volume/marker_cloud/marker_cloud.hpp"
 #include "volume/swarm/swarm_tracker.hpp"
 
@@ -94,40 +97,86 @@ struct SwarmFigures {
   }
 };
 
+// A machine too busy to keep up, as a live graph on two saturated cores sees it (the swarm
+// demo beside a browser: some cameras' centroids late in most frames, the fusion's process
+// not run for a third of a second).
+struct Overload {
+  // Each camera's centroids miss a frame (late) with this probability.
+  double camera_late_fraction = 0;
+  // Every `stall_every_s`, the fusion stalls for between half and all of `stall_s`; then it
+  // fuses the frames of the backlog that volume_fusion's plugin fuses (frames_to_fuse).
+  double stall_every_s = 0;
+  double stall_s = 0;
+  double behind_max_gap_s = 0.02;
+  uint64_t seed = 1;
+};
+
 // The scene seen and tracked at `rate_hz` for `duration_s`.
 inline SwarmFigures track_swarm(const synthetic::SwarmScene& scene, SwarmRig& rig, double rate_hz,
                                 double duration_s, MarkerCloudOptions cloud_options = {},
-                                SwarmTrackerOptions swarm_options = {}) {
+                                SwarmTrackerOptions swarm_options = {}, Overload overload = {}) {
   MarkerCloudTracker cloud(cloud_options);
   SwarmTracker swarm(swarm_database_of(scene), swarm_options);
   SwarmFigures figures;
   const int frames = static_cast<int>(std::lround(duration_s * rate_hz));
   std::vector<Eigen::Vector3d> truth(scene.robots.size());
-  for (int f = 0; f < frames; ++f) {
-    const double time_s = f / rate_hz;
-    const auto stamp_ns = static_cast<int64_t>(std::llround(time_s * 1e9));
-    const std::vector<CloudMarker> markers = cloud.track(stamp_ns, rig.frame(scene, time_s));
-    const std::vector<SwarmRobotPose> poses = swarm.track(stamp_ns, markers);
-    for (size_t r = 0; r < scene.robots.size(); ++r) truth[r] = scene.pose(r, time_s).translation();
-    figures.robot_frames += static_cast<int64_t>(scene.robots.size());
-    figures.tracked += static_cast<int64_t>(poses.size());
-    for (const SwarmRobotPose& pose : poses) {
-      const Eigen::Vector3d at = pose.world_from_body.translation();
-      const double own = (at - truth[pose.robot]).norm();
-      for (size_t other = 0; other < truth.size(); ++other) {
-        if (other != pose.robot && (at - truth[other]).norm() < own) {
-          ++figures.identity_swaps;
-          break;
+  std::mt19937_64 random(overload.seed);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  double stall_until_s = -1;
+  std::vector<int> backlog;  // frames captured during a stall
+  std::optional<int64_t> last_fused_ns;
+  const auto stamp_of = [&](int f) { return std::llround(f / rate_hz * 1e9); };
+  for (int next = 0; next < frames; ++next) {
+    const double next_s = next / rate_hz;
+    if (overload.stall_every_s > 0 && next > 0 &&
+        std::floor(next_s / overload.stall_every_s) >
+            std::floor((next - 1) / rate_hz / overload.stall_every_s)) {
+      stall_until_s = next_s + overload.stall_s * (0.5 + 0.5 * uniform(random));
+    }
+    backlog.push_back(next);
+    if (next_s < stall_until_s) continue;
+    std::vector<int64_t> stamps;
+    for (int f : backlog) stamps.push_back(stamp_of(f));
+    std::vector<int> fused;
+    for (size_t i :
+         frames_to_fuse(stamps, last_fused_ns, 2, std::llround(overload.behind_max_gap_s * 1e9))) {
+      fused.push_back(backlog[i]);
+    }
+    last_fused_ns = stamps.back();
+    backlog.clear();
+    for (int f : fused) {
+      const double time_s = f / rate_hz;
+      const auto stamp_ns = static_cast<int64_t>(std::llround(time_s * 1e9));
+      std::vector<CameraDetections> seen = rig.frame(scene, time_s);
+      for (CameraDetections& camera : seen) {
+        if (uniform(random) >= overload.camera_late_fraction) continue;
+        camera.pixels.clear();
+        camera.pixel_sigma_px.clear();
+      }
+      const std::vector<CloudMarker> markers = cloud.track(stamp_ns, seen);
+      const std::vector<SwarmRobotPose> poses = swarm.track(stamp_ns, markers);
+      for (size_t r = 0; r < scene.robots.size(); ++r)
+        truth[r] = scene.pose(r, time_s).translation();
+      figures.robot_frames += static_cast<int64_t>(scene.robots.size());
+      figures.tracked += static_cast<int64_t>(poses.size());
+      for (const SwarmRobotPose& pose : poses) {
+        const Eigen::Vector3d at = pose.world_from_body.translation();
+        const double own = (at - truth[pose.robot]).norm();
+        for (size_t other = 0; other < truth.size(); ++other) {
+          if (other != pose.robot && (at - truth[other]).norm() < own) {
+            ++figures.identity_swaps;
+            break;
+          }
         }
+        figures.position_errors_m.push_back(own);
+        if (pose.orientation_known) {
+          const Eigen::AngleAxisd off(pose.world_from_body.linear() *
+                                      scene.pose(pose.robot, time_s).linear().transpose());
+          figures.orientation_errors_deg.push_back(off.angle() * 180 / 3.14159265358979323846);
+        }
+        const bool turned = pose.orientation_known && figures.orientation_errors_deg.back() > 5;
+        if (own > 0.05 || turned) ++figures.wrong_poses;
       }
-      figures.position_errors_m.push_back(own);
-      if (pose.orientation_known) {
-        const Eigen::AngleAxisd off(pose.world_from_body.linear() *
-                                    scene.pose(pose.robot, time_s).linear().transpose());
-        figures.orientation_errors_deg.push_back(off.angle() * 180 / 3.14159265358979323846);
-      }
-      const bool turned = pose.orientation_known && figures.orientation_errors_deg.back() > 5;
-      if (own > 0.05 || turned) ++figures.wrong_poses;
     }
   }
   figures.cloud = cloud.totals();

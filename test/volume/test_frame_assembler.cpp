@@ -152,6 +152,29 @@ TEST(FrameAssembler, TheWaitIsSizedToTheFrameRate) {
 
 // Not above 0, every camera would be silent and every frame complete at once; negative, no two
 // stamps would be one capture time. Refused, naming the field.
+// A fusion stalled for a third of a second (84 frames at 240 Hz ready at once) fuses the two
+// newest and, of the rest, every frame that keeps the fused ones at most 20 ms apart, counting
+// from the frame it fused before the stall; with nothing fused before, the newest two only.
+TEST(FramesToFuse, ABacklogIsThinnedToTheGapTheTracksBridge) {
+  const int64_t period_ns = 4'166'667, gap_ns = 20'000'000;
+  std::vector<int64_t> stamps;
+  for (int f = 1; f <= 84; ++f) stamps.push_back(f * period_ns);
+  const std::vector<size_t> fused = frames_to_fuse(stamps, 0, 2, gap_ns);
+  ASSERT_GE(fused.size(), 2u);
+  EXPECT_EQ(fused[fused.size() - 2], 82u);
+  EXPECT_EQ(fused.back(), 83u);
+  int64_t last = 0;
+  for (size_t i : fused) {
+    EXPECT_LE(stamps[i] - last, gap_ns) << "frame " << i;
+    last = stamps[i];
+  }
+  // Each fused frame is the last before the gap would run out: 4 frames of 4.17 ms apart.
+  EXPECT_EQ(fused.size(), 2u + 84 / 4 - 1);
+  EXPECT_EQ(fused[0], 3u);
+  EXPECT_EQ(frames_to_fuse(stamps, std::nullopt, 2, gap_ns), (std::vector<size_t>{82, 83}));
+  EXPECT_EQ(frames_to_fuse({}, 0, 2, gap_ns), std::vector<size_t>{});
+}
+
 TEST(FrameAssemblerOptions, NameTheFieldThatCannotBeUsed) {
   EXPECT_EQ(FrameAssemblerOptions{}.problem(), std::nullopt);
   EXPECT_EQ(FrameAssemblerOptions{.same_capture = std::chrono::microseconds(-1500)}.problem(),

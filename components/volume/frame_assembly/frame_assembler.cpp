@@ -27,4 +27,21 @@ std::optional<std::string> FrameAssemblerOptions::problem() const {
   return std::nullopt;
 }
 
+std::vector<size_t> frames_to_fuse(const std::vector<int64_t>& stamps_ns,
+                                   std::optional<int64_t> last_fused_ns, size_t newest,
+                                   int64_t max_gap_ns) {
+  std::vector<size_t> fused;
+  const size_t count = stamps_ns.size();
+  for (size_t i = 0; i < count; ++i) {
+    // Frame i is fused when it is among the newest, or when leaving it out would put the next
+    // frame further than the gap from the one fused before.
+    const bool needed =
+        i + newest >= count || (last_fused_ns && stamps_ns[i + 1] - *last_fused_ns > max_gap_ns);
+    if (!needed) continue;
+    fused.push_back(i);
+    last_fused_ns = stamps_ns[i];
+  }
+  return fused;
+}
+
 }  // namespace mocap::volume

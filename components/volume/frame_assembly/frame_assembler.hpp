@@ -155,4 +155,14 @@ class FrameAssembler {
   int64_t late_drops_ = 0;
 };
 
+// Which of the ready frames (their capture times, oldest first) a fusion that is behind fuses:
+// the newest `newest`, and enough of the older ones that no two frames fused one after the
+// other lie more than `max_gap_ns` apart, counting from `last_fused_ns` (the frame fused
+// before them, if any). A tracker bridges a gap that short with its motion model; a backlog
+// skipped whole (a tenth of a second on a busy machine) would lose every robot at once and
+// leave identical ones to be told apart afresh. Indices, ascending.
+std::vector<size_t> frames_to_fuse(const std::vector<int64_t>& stamps_ns,
+                                   std::optional<int64_t> last_fused_ns, size_t newest,
+                                   int64_t max_gap_ns);
+
 }  // namespace mocap::volume

@@ -232,6 +232,7 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
     marker.position = fit.position;
     marker.covariance = fit.covariance;
     marker.velocity = track.velocity_known ? track.velocity : Eigen::Vector3d::Zero();
+    marker.velocity_known = track.velocity_known;
     marker.rms_px = fit.rms_px;
     for (const Observation& o : observations) {
       marker.cameras |= 1u << o.camera;

@@ -61,6 +61,7 @@ struct CloudMarker {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // world frame, metres
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of the position, from the pixels' sigmas
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();    // m/s; zero on a track's first frame
+  bool velocity_known = false;                           // from a track's second frame on
   double rms_px = 0;                                     // reprojection error over its cameras
   uint32_t cameras = 0;                                  // bit c: camera c saw it
   // (camera, detection) pairs: the camera's index and the index of its pixel.

@@ -23,6 +23,13 @@ constexpr double kUnfoundCostFactor = 4;
 // The most instances of a layout looked for around one robot: two identical robots side by
 // side, and a third.
 constexpr int kMostInstancesPerSearch = 3;
+// A marker measured this many times less precisely than the median of its robot's is left
+// out: a blob merged with another in one camera's image is triangulated millimetres off, which
+// a fit of three markers would turn into degrees.
+constexpr double kPoorMarkerFactor = 5;
+// A tracked robot's gate reaches this many sigmas of the position its motion model's
+// acceleration noise allows since its last measurement.
+constexpr double kGateSigmas = 3;
 
 // Cloud markers by grid cell, for the markers near a point without looking at all of them.
 class PointGrid {
@@ -127,6 +134,8 @@ std::optional<std::string> SwarmTrackerOptions::problem() const {
   if (min_markers < 3) return fmt::format("min_markers: {} is below 3", min_markers);
   if (!(start_radius_m > 0))
     return fmt::format("start_radius_m: {} is not above 0", start_radius_m);
+  if (!(start_speed_mps > 0))
+    return fmt::format("start_speed_mps: {} is not above 0", start_speed_mps);
   if (!(lost_after_s >= 0)) return fmt::format("lost_after_s: {} is below 0", lost_after_s);
   if (!(max_search_radius_m >= start_radius_m)) {
     return fmt::format("max_search_radius_m: {} is below start_radius_m ({})", max_search_radius_m,
@@ -154,6 +163,7 @@ bool SwarmTracker::reseed(const std::string& name, const Eigen::Vector3d& positi
     if (swarm_.robots[r].name != name) continue;
     Robot& robot = robots_[r];
     robot.forget();
+    robot.missed_since_ns.reset();
     robot.anchor = position;
     robot.lost_since_ns.reset();
     return true;
@@ -194,11 +204,17 @@ std::optional<SwarmTracker::Found> SwarmTracker::upright_fit(
   return chosen;
 }
 
-double SwarmTracker::search_radius(const Robot& robot, size_t layout, int64_t stamp_ns) const {
-  if (!robot.lost_since_ns) return options_.start_radius_m;
-  const double lost_s = static_cast<double>(stamp_ns - *robot.lost_since_ns) * 1e-9;
-  return std::min(options_.max_search_radius_m,
-                  options_.start_radius_m + swarm_.layouts[layout].top_speed_mps * lost_s);
+SwarmTracker::Search SwarmTracker::search(const Robot& robot, size_t layout,
+                                          int64_t stamp_ns) const {
+  if (!robot.lost_since_ns) return {robot.anchor, options_.start_radius_m, true};
+  const double top_speed = swarm_.layouts[layout].top_speed_mps;
+  // The radius grows until it reaches its cap; the centre moves on with the robot's last
+  // velocity as long.
+  const double lost_s =
+      std::min(static_cast<double>(stamp_ns - *robot.lost_since_ns) * 1e-9,
+               (options_.max_search_radius_m - options_.start_radius_m) / top_speed);
+  return {robot.anchor + robot.lost_velocity * lost_s, options_.start_radius_m + top_speed * lost_s,
+          false};
 }
 
 std::optional<SwarmTracker::Found> SwarmTracker::fit(size_t layout, std::vector<int> markers,
@@ -216,6 +232,18 @@ std::optional<SwarmTracker::Found> SwarmTracker::fit(size_t layout, std::vector<
     return found;
   }
   const int needed = std::min(options_.min_markers, static_cast<int>(model.size()));
+  {
+    std::vector<double> sigmas;
+    for (int m : markers) {
+      if (m >= 0) sigmas.push_back(sigma_of(cloud[m]));
+    }
+    if (sigmas.empty()) return std::nullopt;
+    std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+    const double median = sigmas[sigmas.size() / 2];
+    for (int& m : markers) {
+      if (m >= 0 && sigma_of(cloud[m]) > kPoorMarkerFactor * median) m = -1;
+    }
+  }
   // The layout fitted to the markers given, and the furthest off of them in its own sigmas.
   auto fitted = [&](const std::vector<int>& given, Eigen::Isometry3d& pose, double& rms_m) {
     std::vector<Eigen::Vector3d> from, to;
@@ -302,14 +330,17 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
   std::vector<AllowedPair> allowed;
   std::vector<double> unassigned;
   std::vector<size_t> rows;  // each tracked robot's markers, robot by robot: the robot
+  const int64_t lost_after_ns = std::llround(options_.lost_after_s * 1e9);
   for (size_t r = 0; r < robots_.size(); ++r) {
     Robot& robot = robots_[r];
     if (!robot.tracked()) continue;
-    const double dt_s = static_cast<double>(stamp_ns - robot.stamp_ns) * 1e-9;
-    if (dt_s > options_.lost_after_s) {
+    if (robot.missed_since_ns && stamp_ns - *robot.missed_since_ns > lost_after_ns) {
       robot.anchor = robot.body ? robot.body->state().camera_from_body.translation()
                                 : robot.point->state().position;
+      robot.lost_velocity =
+          robot.body ? robot.body->state().linear_velocity : robot.point->state().velocity;
       robot.lost_since_ns = robot.stamp_ns;
+      robot.missed_since_ns.reset();
       robot.forget();
       continue;
     }
@@ -319,13 +350,28 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
     } else {
       start.translation() = robot.point->predicted(stamp_ns).position;
     }
+    // The position's variance a white-noise acceleration of density q adds over dt: q dt³ / 3.
+    const double dt_s = static_cast<double>(stamp_ns - robot.stamp_ns) * 1e-9;
+    const double gate_m = std::max(
+        options_.gate_m, kGateSigmas * std::sqrt(options_.motion.linear_acceleration_density *
+                                                 dt_s * dt_s * dt_s / 3));
     for (const Eigen::Vector3d& marker : swarm_.layouts[swarm_.robots[r].layout].markers) {
       const int row = static_cast<int>(rows.size());
-      grid.near(start * marker, options_.gate_m, [&](int m, double squared) {
-        if (!used[m]) allowed.push_back({row, m, squared});
-      });
+      const Eigen::Vector3d predicted = start * marker;
+      if (gate_m == options_.gate_m) {
+        grid.near(predicted, gate_m, [&](int m, double squared) {
+          if (!used[m]) allowed.push_back({row, m, squared});
+        });
+      } else {
+        for (size_t m = 0; m < cloud.size(); ++m) {
+          const double squared = (cloud[m].position - predicted).squaredNorm();
+          if (!used[m] && squared <= gate_m * gate_m) {
+            allowed.push_back({row, static_cast<int>(m), squared});
+          }
+        }
+      }
       rows.push_back(r);
-      unassigned.push_back(options_.gate_m * options_.gate_m);
+      unassigned.push_back(gate_m * gate_m);
     }
   }
   const std::vector<int> assigned = min_cost_assignment(
@@ -342,6 +388,8 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
       }
       poses[r] = posed(r, stamp_ns, *found, false);
       ++counts_.tracked;
+    } else if (!robots_[r].missed_since_ns) {
+      robots_[r].missed_since_ns = stamp_ns;
     }
   }
 
@@ -354,19 +402,27 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
     }
     if (searching.empty()) continue;
     std::vector<Found> finds;
+    std::vector<size_t> find_layouts;
     allowed.clear();
     unassigned.clear();
+    std::vector<Search> searches;
+    for (size_t r : searching)
+      searches.push_back(search(robots_[r], swarm_.robots[r].layout, stamp_ns));
     for (size_t row = 0; row < searching.size(); ++row) {
       const size_t r = searching[row];
-      const Robot& robot = robots_[r];
       const size_t layout = swarm_.robots[r].layout;
-      const double radius = search_radius(robot, layout, stamp_ns);
+      const Search& where = searches[row];
+      const double radius = where.radius_m;
       unassigned.push_back(kUnfoundCostFactor * radius * radius);
       std::vector<int> candidates;
       for (size_t m = 0; m < cloud.size(); ++m) {
-        if (!used[m] && (cloud[m].position - robot.anchor).norm() <= radius) {
-          candidates.push_back(static_cast<int>(m));
+        const CloudMarker& marker = cloud[m];
+        if (used[m] || (marker.position - where.centre).norm() > radius) continue;
+        if (where.at_rest && marker.velocity_known &&
+            marker.velocity.norm() > options_.start_speed_mps) {
+          continue;
         }
+        candidates.push_back(static_cast<int>(m));
       }
       std::vector<Found> around;
       if (!several) {
@@ -376,11 +432,23 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
             {RigidBody{swarm_.layouts[layout].name, swarm_.layouts[layout].markers}}};
         const RigidBodyIdentificationOptions identification{options_.layout_tolerance_m,
                                                             options_.min_markers};
+        // The instances nearest the centre first: the layout looked for among the nearest
+        // markers, twice as many each time, until one is found (a search grown over a grid of
+        // robots finds the robot itself before its neighbours).
+        std::sort(candidates.begin(), candidates.end(), [&](int a, int b) {
+          return (cloud[a].position - where.centre).squaredNorm() <
+                 (cloud[b].position - where.centre).squaredNorm();
+        });
+        const size_t first_window = swarm_.layouts[layout].markers.size() + 2;
         for (int instance = 0; instance < kMostInstancesPerSearch; ++instance) {
-          std::vector<Eigen::Vector3d> positions;
-          for (int m : candidates) positions.push_back(cloud[m].position);
-          const std::vector<IdentifiedBody> identified =
-              identify_rigid_bodies(one, positions, identification);
+          std::vector<IdentifiedBody> identified;
+          for (size_t window = std::min(first_window, candidates.size());;
+               window = std::min(2 * window, candidates.size())) {
+            std::vector<Eigen::Vector3d> positions;
+            for (size_t k = 0; k < window; ++k) positions.push_back(cloud[candidates[k]].position);
+            identified = identify_rigid_bodies(one, positions, identification);
+            if (!identified.empty() || window == candidates.size()) break;
+          }
           if (identified.empty()) break;
           std::vector<int> markers;
           for (int measured : identified[0].measured) {
@@ -395,17 +463,40 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
         }
       }
       for (Found& found : around) {
-        const double off = (found.world_from_body.translation() - robot.anchor).norm();
+        const double off = (found.world_from_body.translation() - where.centre).norm();
         if (off > radius) continue;
         // One find seen from two robots' searches is one column.
         auto same = std::find_if(finds.begin(), finds.end(), [&](const Found& other) {
           return other.markers == found.markers;
         });
         const int column = static_cast<int>(same - finds.begin());
-        if (same == finds.end()) finds.push_back(std::move(found));
+        if (same == finds.end()) {
+          finds.push_back(std::move(found));
+          find_layouts.push_back(layout);
+        }
         allowed.push_back({static_cast<int>(row), column, off * off});
       }
     }
+    // A find goes only to the robot of its layout looked for nearest to it, among all whose
+    // search reaches it, those that could not take it included (a start's markers not at
+    // rest): a lost robot whose search has grown over a neighbour not found this frame does not
+    // take the neighbour for itself.
+    std::vector<int> nearest(finds.size(), -1);
+    for (size_t column = 0; column < finds.size(); ++column) {
+      const Eigen::Vector3d at = finds[column].world_from_body.translation();
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t row = 0; row < searching.size(); ++row) {
+        const double off = (at - searches[row].centre).norm();
+        if (swarm_.robots[searching[row]].layout == find_layouts[column] &&
+            off <= searches[row].radius_m && off < best) {
+          best = off;
+          nearest[column] = static_cast<int>(row);
+        }
+      }
+    }
+    std::erase_if(allowed, [&](const AllowedPair& pair) {
+      return nearest[static_cast<size_t>(pair.column)] != pair.row;
+    });
     const std::vector<int> given = min_cost_assignment(
         static_cast<int>(searching.size()), static_cast<int>(finds.size()), allowed, unassigned);
     for (size_t row = 0; row < searching.size(); ++row) {
@@ -443,6 +534,7 @@ SwarmRobotPose SwarmTracker::posed(size_t r, int64_t stamp_ns, const Found& foun
   pose.fit_rms_m = found.rms_m;
   pose.found_afresh = afresh;
   if (afresh) robot.lost_since_ns.reset();
+  robot.missed_since_ns.reset();
   robot.stamp_ns = stamp_ns;
   if (several) {
     if (afresh) {

@@ -6,19 +6,28 @@
 //     Kalman filter of body_motion.hpp; for a robot of one marker, its linear half), and all of
 //     them are assigned to the cloud's markers at once, at the least total squared distance,
 //     each within `gate_m` of its prediction (min_cost_assignment.hpp, per group of robots
-//     whose gates overlap): robots that pass close by each other keep their own markers. A
+//     whose gates overlap): robots that pass close by each other keep their own markers. The
+//     gate widens with the time since the robot's last measurement as far as the motion
+//     model's acceleration allows (three of its sigmas), so that a fusion stalled for a tenth
+//     of a second (a busy machine) still finds each robot where its motion took it. A
 //     robot of several markers is measured by the best rigid fit of its layout to the markers
 //     it got (`min_markers` at least, none further off than `max_fit_sigmas` of its own
 //     sigmas); a robot of one marker by its marker. The measurement corrects the robot's filter,
 //     whose pose, velocities and covariances are what the robot's pose says.
 //  2. Robots to find: those not found yet, near their initial positions (or where they were
-//     re-seeded) within `start_radius_m`, and those lost (not posed for `lost_after_s`), near
-//     where they were last within a radius that grows with their layout's top speed and the
-//     time lost, up to `max_search_radius_m`. Only markers no robot took this frame are
+//     re-seeded) within `start_radius_m` and only while their markers are at rest (slower than
+//     `start_speed_mps`: a robot flying past another's start is not taken for it), and those
+//     lost (missed in the frames of `lost_after_s`), near where their last velocity carries
+//     them from where they were last, within a radius that grows with their layout's top speed
+//     and the time lost, up to `max_search_radius_m` (where the carrying stops too: a pair
+//     that crossed while lost is not found swapped). Only markers no robot took this frame are
 //     looked at: a lost robot never takes another's markers. Robots of several markers first
-//     (their layout found among the markers by its distances, within `layout_tolerance_m`),
-//     then robots of one marker; the robots are given what was found at the least total
-//     squared distance from where each is looked for. A robot found starts a new filter.
+//     (their layout found among the markers by its distances, within `layout_tolerance_m`,
+//     nearest where the robot is looked for first), then robots of one marker. A find goes
+//     only to the robot of its layout looked for nearest to it, among all whose search reaches
+//     it (those that could not take it too: a robot not yet at rest at its start is taken by
+//     no one), and the robots are given what was found at the least total squared distance
+//     from where each is looked for. A robot found starts a new filter.
 //
 //   SwarmTracker swarm(load_swarm("robots.yaml", SwarmTrackerOptions{}.layout_tolerance_m));
 //   std::vector<SwarmRobotPose> poses = swarm.track(stamp_ns, cloud);
@@ -53,18 +62,23 @@ struct SwarmTrackerOptions {
   double max_fit_sigmas = 6;
   // Fewest of a layout's markers that pose a robot of several (at least 3).
   int min_markers = 3;
-  // A robot not found yet is looked for this close to its initial (or re-seeded) position.
+  // A robot not found yet is looked for this close to its initial (or re-seeded) position,
   double start_radius_m = 0.1;
-  // A tracked robot not posed for this long is lost (seconds).
+  // among markers slower than this (m/s; a marker measured at 240 Hz to 0.07 mm seems to move
+  // at about 0.03 m/s when still).
+  double start_speed_mps = 0.25;
+  // A tracked robot missed in every frame for this long is lost (seconds). Only frames count:
+  // across a stall of the fusion, the robot is looked for where its motion took it.
   double lost_after_s = 0.05;
   // The widest a lost robot is looked for (metres).
   double max_search_radius_m = 1.0;
   // How quickly a robot may change its speed and turn rate: the filter's white-noise
   // acceleration densities. At 240 Hz the cloud measures a marker to about 0.07 mm; a swarm's
-  // robots change their speed by about a metre per second within a second (a quadrotor at 5
-  // m/s² for a fifth of a second), which a density of 1 m²/s³ follows with no lag worth
-  // measuring while it smooths the markers' noise.
-  tracking::BodyMotionOptions motion = {.linear_acceleration_density = 0.3,
+  // robots change their speed by under a metre per second within a second. Measured on every
+  // swarm scene (swarm_bench): a linear density of 0.15 m²/s³ gives the least position error
+  // (median up to 0.098 mm; 0.3: up to 0.101 mm, from the noise it smooths less), the flights'
+  // turns and take-offs included.
+  tracking::BodyMotionOptions motion = {.linear_acceleration_density = 0.15,
                                         .angular_acceleration_density = 1.0};
 
   // Why these options cannot be used, naming the field ("gate_m: 0 is not above 0"); nullopt
@@ -125,16 +139,18 @@ class SwarmTracker {
     // Tracked: one of the two filters (several markers: the pose; one marker: the position).
     std::optional<tracking::BodyMotionFilter> body;
     std::optional<tracking::PointMotionFilter> point;
-    int64_t stamp_ns = 0;  // of its last measurement
+    int64_t stamp_ns = 0;                    // of its last measurement
+    std::optional<int64_t> missed_since_ns;  // the first frame it was missed in since
     bool tracked() const { return body || point; }
     void forget() {
       body.reset();
       point.reset();
     }
     // Where it is looked for while not tracked, and since when it is lost (nullopt: not lost
-    // but not found yet, or re-seeded: the start radius).
+    // but not found yet, or re-seeded: the start radius); a lost robot's velocity then.
     Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
     std::optional<int64_t> lost_since_ns;
+    Eigen::Vector3d lost_velocity = Eigen::Vector3d::Zero();
   };
   struct Found {
     std::vector<int> markers;  // per layout marker
@@ -143,7 +159,13 @@ class SwarmTracker {
     Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   };
 
-  double search_radius(const Robot& robot, size_t layout, int64_t stamp_ns) const;
+  // Where and how far a robot not tracked is looked for.
+  struct Search {
+    Eigen::Vector3d centre;
+    double radius_m = 0;
+    bool at_rest = false;  // among markers at rest only: a start or a re-seed
+  };
+  Search search(const Robot& robot, size_t layout, int64_t stamp_ns) const;
   // fit() of a robot found from scratch. Where a rotation maps the markers found (per layout
   // marker, -1: none) onto themselves relabelled (three markers of a nearly isosceles
   // triangle: the robot may be turned half a turn), the relabelling whose pose is upright,

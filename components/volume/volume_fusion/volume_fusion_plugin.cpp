@@ -58,7 +58,7 @@ using tf2_msgs::msg::TFMessage;
 
 constexpr std::chrono::milliseconds kSingleCameraAlert{500};
 constexpr std::chrono::milliseconds kUnposedAlert{500};
-constexpr size_t kMaxBacklog = 2;  // frames fused at once; older ready ones are skipped
+constexpr size_t kMaxBacklog = 2;  // the newest frames fused at once when behind
 // A camera that misses this many frames in a row is said to be back when it returns.
 constexpr int kGapFramesLogged = 3;
 // A cloud marker this close to where a posed body puts one of its markers is that marker.
@@ -81,6 +81,7 @@ struct Settings : VolumeTrackerOptions {
   double same_capture_s = 0.002;
   double wait_s = 0.005;
   double silent_after_s = 0.5;
+  double behind_max_gap_s = 0.02;
 
   // The shipped bodies are told apart by 5 markers (config/volume/bodies.yaml).
   Settings() { identification.min_markers = 5; }
@@ -122,7 +123,12 @@ const ParameterList<Settings> kParameters =
              "how far from its initial (or re-seeded) position a robot is looked for",
              &Settings::swarm, &SwarmTrackerOptions::start_radius_m)
         .range(1e-3, 100)
-        .add("robot_lost_after_s", "a robot not posed this long is lost: looked for afresh",
+        .add("robot_start_speed_mps",
+             "a robot is found at its start only among markers slower than this: at rest",
+             &Settings::swarm, &SwarmTrackerOptions::start_speed_mps)
+        .range(1e-3, 100)
+        .add("robot_lost_after_s",
+             "a robot missed in every frame fused for this long is lost: looked for afresh",
              &Settings::swarm, &SwarmTrackerOptions::lost_after_s)
         .range(0, 3600)
         .add("body_tolerance_m",
@@ -159,7 +165,12 @@ const ParameterList<Settings> kParameters =
         .range(0, 1)
         .add("silent_after_s", "a camera silent this long is left out until it returns",
              &Settings::silent_after_s)
-        .range(0.001, 3600);
+        .range(0.001, 3600)
+        .add("behind_max_gap_s",
+             "a fusion that is behind skips frames, but fuses frames at most this far apart (or "
+             "two frame periods): the tracks bridge the gap",
+             &Settings::behind_max_gap_s)
+        .range(0.001, 10);
 
 std::vector<VolumeCamera> load_cameras(const std::vector<std::string>& files) {
   if (files.empty()) throw std::invalid_argument("cameras: no camera files");
@@ -333,14 +344,24 @@ class VolumeFusion final : public Component {
     camera_frames_.publish(frames);
   }
 
-  // A machine too busy to fuse every frame fuses the newest: poses late by a backlog are worth
-  // less than the next ones, and a backlog only grows.
+  // A machine too busy to fuse every frame fuses the newest and, of the backlog, no more than
+  // keeps the fused frames `behind_max_gap_s` apart (frames_to_fuse): poses late by a backlog
+  // are worth less than the next ones, and a backlog only grows, but tracks, identical robots'
+  // among them, must not lose their robots across the gap.
   void fuse_ready() {
     std::vector<AssembledFrame<FiducialArray>> ready =
         frames_.take_ready(std::chrono::steady_clock::now());
-    const size_t skip = ready.size() > kMaxBacklog ? ready.size() - kMaxBacklog : 0;
-    skipped_frames_ += skip;
-    for (size_t f = skip; f < ready.size(); ++f) fuse(ready[f]);
+    if (ready.empty()) return;
+    std::vector<int64_t> stamps;
+    for (const auto& frame : ready) stamps.push_back(frame.stamp_ns);
+    const int64_t max_gap_ns =
+        std::max<int64_t>(std::llround(settings_.behind_max_gap_s * 1e9),
+                          2 * static_cast<int64_t>(frames_.frame_period().count()));
+    const std::vector<size_t> fused =
+        frames_to_fuse(stamps, last_fused_ns_, kMaxBacklog, max_gap_ns);
+    skipped_frames_ += ready.size() - fused.size();
+    for (size_t f : fused) fuse(ready[f]);
+    last_fused_ns_ = ready.back().stamp_ns;
   }
 
   void fuse(const AssembledFrame<FiducialArray>& assembled) {
@@ -590,7 +611,8 @@ class VolumeFusion final : public Component {
   Publisher<TFMessage> camera_frames_;
   uint64_t fused_frames_ = 0;
   uint64_t incomplete_frames_ = 0;
-  uint64_t skipped_frames_ = 0;  // behind: older than the newest kMaxBacklog ready
+  uint64_t skipped_frames_ = 0;  // behind: not among the frames_to_fuse
+  std::optional<int64_t> last_fused_ns_;
   uint64_t body_poses_ = 0;
   uint64_t robot_poses_ = 0;
 };
