@@ -36,16 +36,22 @@ struct SwarmRig {
     }
   }
 
-  // Every camera's centroids of the scene's markers at `time_s`.
+  // Every camera's centroids of the scene's markers at `time_s`, behind its occluders.
   std::vector<CameraDetections> frame(const synthetic::SwarmScene& scene, double time_s) {
-    return frame(scene.markers(time_s));
+    std::vector<synthetic::OccludingSphere> occluders;
+    for (const synthetic::SwarmOccluder& o : scene.occluders) {
+      occluders.push_back({o.centre, o.radius_m});
+    }
+    return frame(scene.markers(time_s), occluders);
   }
   // Every camera's centroids of `markers` (world frame).
-  std::vector<CameraDetections> frame(const std::vector<Eigen::Vector3d>& markers) {
+  std::vector<CameraDetections> frame(
+      const std::vector<Eigen::Vector3d>& markers,
+      const std::vector<synthetic::OccludingSphere>& occluders = {}) {
     std::vector<CameraDetections> detections;
     for (synthetic::CentroidCamera& camera : centroid_cameras) {
       CameraDetections seen{&camera.model(), camera.camera_from_world(), {}, {}};
-      for (const synthetic::Centroid& centroid : camera.project(markers)) {
+      for (const synthetic::Centroid& centroid : camera.project(markers, occluders)) {
         seen.pixels.push_back(centroid.pixel);
         seen.pixel_sigma_px.push_back(centroid.sigma_px);
       }

@@ -145,6 +145,28 @@ TEST(SwarmScene, AHoldKeepsEveryRobotWhereItsFlightStarts) {
   }
 }
 
+// Occluders stand where the file puts them; one without its radius is refused on its line.
+TEST(SwarmScene, OccludersStandWhereTheFileSays) {
+  const std::string flights =
+      "layouts:\n  - {name: single, markers: [[0, 0, 0]]}\n"
+      "groups:\n  - {flight: formation_circle, layout: single, count: 3, radius_m: 1,"
+      " height_m: 1, rate_rad_s: 0.5}\n";
+  const SwarmScene pillared = synthetic::parse_swarm_scene(
+      "occluders:\n  - {centre: [0, 0.5, 1], radius_m: 0.3}\n" + flights, "scene.yaml");
+  ASSERT_EQ(pillared.occluders.size(), 1u);
+  EXPECT_EQ(pillared.occluders[0].centre, Eigen::Vector3d(0, 0.5, 1));
+  EXPECT_EQ(pillared.occluders[0].radius_m, 0.3);
+  EXPECT_EQ(pillared.shifted(Eigen::Vector3d(1, 0, 0)).occluders[0].centre,
+            Eigen::Vector3d(1, 0.5, 1));
+  try {
+    synthetic::parse_swarm_scene("occluders:\n  - {centre: [0, 0.5, 1]}\n" + flights, "scene.yaml");
+    ADD_FAILURE() << "an occluder without a radius accepted";
+  } catch (const synthetic::SwarmSceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.yaml:2:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("radius_m"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SwarmScene, AFileThatCannotBeFlownIsRefusedWithOneLineNamingIt) {
   const std::string layouts = "layouts:\n  - {name: single, markers: [[0, 0, 0]]}\n";
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -214,6 +236,27 @@ TEST(SwarmTracker, AMixedSwarmOfFiftyQuadrotorsAndFiftySingleMarkerRobots) {
   const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
   expect_targets(figures, false);
   EXPECT_LE(test::SwarmFigures::median(figures.orientation_errors_deg), 0.2);
+}
+
+// A pillar's stretch (an occluder of the scene file) stands beside the lanes of a crossing pair:
+// as the pair passes it, cameras behind it lose sight of them, and the pair is tracked through.
+TEST(SwarmTracker, APairPassingAPillarIsTrackedThroughWhatItHides) {
+  SwarmScene scene =
+      synthetic::crossing_pairs(synthetic::marker_deck_layout(), 1, 0.05, 1.0, 0.5, 1.0, 3.0);
+  scene.occluders.push_back({Eigen::Vector3d(0, 0.5, 1.0), 0.3});
+  test::SwarmRig rig = eight_cameras(13);
+  const auto centroids = [](const std::vector<CameraDetections>& cameras) {
+    size_t count = 0;
+    for (const CameraDetections& camera : cameras) count += camera.pixels.size();
+    return count;
+  };
+  size_t hidden = 0;
+  for (double time_s = 0; time_s < scene.duration_s; time_s += 0.05) {
+    hidden += centroids(rig.frame(scene.markers(time_s))) - centroids(rig.frame(scene, time_s));
+  }
+  EXPECT_GT(hidden, 0u) << "the pillar hid nothing";
+  const test::SwarmFigures figures = test::track_swarm(scene, rig, kRate_hz, scene.duration_s);
+  expect_targets(figures, true);
 }
 
 // Quadrotors on the floor among robots of one marker: from scratch, some are seen by three
@@ -336,6 +379,40 @@ TEST(SwarmTracker, ARobotNotAtRestAtItsStartIsNotTakenByALostOne) {
   // B slows below the start speed about 0.15 s before it stops.
   EXPECT_GT(b_found_s, 0.7);
   EXPECT_LT(b_found_s, 1.05);
+}
+
+// Bodies and robots in one volume: a rigid body's markers (claimed by the body's tracker, as
+// volume_fusion labels them) are nobody's robot, even a robot of the same layout looked for
+// right where the body stands.
+TEST(SwarmTracker, MarkersABodyClaimsAreNotTakenForARobot) {
+  const SwarmScene scene =
+      synthetic::crossing_pairs(synthetic::marker_deck_layout(), 1, 0.05, 1.0, 0.5, 1.0, 1.0);
+  SwarmDatabase one_robot = test::swarm_database_of(scene);
+  one_robot.robots.erase(one_robot.robots.begin() + 1);  // robot 0 is looked for; 1 is a body
+  one_robot.robots[0].initial_position = scene.pose(1, 0).translation();
+  test::SwarmRig rig = eight_cameras(14);
+  MarkerCloudTracker cloud;
+  SwarmTracker swarm(one_robot);
+  int claimed_frames = 0;
+  for (int f = 0; f < 240; ++f) {
+    const double time_s = f / kRate_hz;
+    const auto stamp_ns = static_cast<int64_t>(time_s * 1e9);
+    const std::vector<CloudMarker> markers = cloud.track(stamp_ns, rig.frame(scene, time_s));
+    const Eigen::Isometry3d body = scene.pose(1, time_s);
+    std::vector<char> claimed(markers.size(), 0);
+    for (size_t m = 0; m < markers.size(); ++m) {
+      for (const Eigen::Vector3d& marker : scene.robots[1].markers) {
+        if ((markers[m].position - body * marker).norm() < 0.005) claimed[m] = 1;
+      }
+    }
+    claimed_frames += std::count(claimed.begin(), claimed.end(), 1) >= 3 ? 1 : 0;
+    for (const SwarmRobotPose& pose : swarm.track(stamp_ns, markers, claimed)) {
+      EXPECT_GT((pose.world_from_body.translation() - body.translation()).norm(), 0.01)
+          << "the robot was posed on the body's markers at " << time_s << " s";
+    }
+  }
+  EXPECT_GT(claimed_frames, 200);
+  EXPECT_EQ(swarm.counts().searching, 1);
 }
 
 TEST(SwarmTracker, ARobotCarriedAwayIsFoundWhereItIsReseeded) {

@@ -77,9 +77,9 @@ class CentroidCameraComponent final : public Component {
     spec.description(
         "A motion-capture camera that sends centroids: a swarm scene's markers projected to "
         "fiducials with the sensor's sub-pixel noise, merged where their images touch, hidden "
-        "behind robots and the image's edge; no image is rendered. Frames are taken at "
-        "multiples of the period on the system clock, the scene's time counted from the "
-        "launch's start.");
+        "behind robots and the scene's occluders, and cut by the image's edge; no image is "
+        "rendered. Frames are taken at multiples of the period on the system clock, the "
+        "scene's time counted from the launch's start.");
     kParameters.declare(spec);
     spec.publishes<FiducialArray>(topics::kFiducials, Qos::sensor_data(),
                                   "the centroids of each frame, stamped with its capture time");
@@ -120,6 +120,9 @@ class CentroidCameraComponent final : public Component {
             .count();
     std::vector<Eigen::Vector3d> markers;
     std::vector<OccludingSphere> bodies;
+    for (const SwarmOccluder& occluder : scene_.occluders) {
+      bodies.push_back({occluder.centre, occluder.radius_m});
+    }
     std_msgs::msg::Header header;
     header.stamp(to_time_msg(stamp));
     header.frame_id("world");

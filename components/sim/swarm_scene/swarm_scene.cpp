@@ -121,6 +121,7 @@ SwarmScene SwarmScene::with(const SwarmScene& other) const {
   SwarmScene both = *this;
   both.duration_s = std::max(duration_s, other.duration_s);
   both.hold_s = std::max(hold_s, other.hold_s);
+  both.occluders.insert(both.occluders.end(), other.occluders.begin(), other.occluders.end());
   for (SwarmSceneRobot robot : other.robots) {
     const std::string name = robot.name;
     for (int n = 2; std::any_of(both.robots.begin(), both.robots.end(),
@@ -141,6 +142,7 @@ SwarmScene SwarmScene::shifted(const Eigen::Vector3d& offset) const {
       leg.to += offset;
     }
   }
+  for (SwarmOccluder& occluder : moved.occluders) occluder.centre += offset;
   return moved;
 }
 

@@ -49,8 +49,16 @@ struct SwarmSceneRobot {
   double tilt_rad = 0;  // roll and pitch swing up to this
 };
 
+// An opaque sphere standing in the volume (a pillar's stretch, a person, a ladder): what lies
+// behind it is hidden from a camera, as behind a robot.
+struct SwarmOccluder {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // world frame, metres
+  double radius_m = 0;
+};
+
 struct SwarmScene {
   std::vector<SwarmSceneRobot> robots;
+  std::vector<SwarmOccluder> occluders;
   double duration_s = 0;
   // Seconds every robot stays where its flight starts before the flights begin (the flights'
   // time 0 is then `hold_s`), as a swarm waits on the ground while its tracker comes up and
@@ -62,9 +70,9 @@ struct SwarmScene {
   // Every robot's markers in the world at `time_s`, robot after robot.
   std::vector<Eigen::Vector3d> markers(double time_s) const;
   // The scene's robots and then `other`'s (renamed when a name is taken), over the longer
-  // duration.
+  // duration; both scenes' occluders.
   SwarmScene with(const SwarmScene& other) const;
-  // The same flights moved by `offset` (world frame, metres).
+  // The same flights and occluders moved by `offset` (world frame, metres).
   SwarmScene shifted(const Eigen::Vector3d& offset) const;
 };
 

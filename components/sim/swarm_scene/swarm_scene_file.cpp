@@ -113,7 +113,7 @@ SwarmScene read_group(const Reader& reader, const YAML::Node& node,
 }
 
 SwarmScene read_scene(const Reader& reader, const YAML::Node& root) {
-  reader.check_keys(root, {"duration_s", "hold_s", "layouts", "groups"}, "the file");
+  reader.check_keys(root, {"duration_s", "hold_s", "layouts", "groups", "occluders"}, "the file");
   const double duration_s = reader.positive(root, "duration_s", 60, 1e6);
   std::map<std::string, std::vector<Eigen::Vector3d>> layouts;
   for (const YAML::Node& node : reader.list(root, "layouts")) {
@@ -140,6 +140,17 @@ SwarmScene read_scene(const Reader& reader, const YAML::Node& root) {
     scene = scene.with(group);
   }
   scene.hold_s = reader.number(root, "hold_s", 0, 0, 3600);
+  if (root["occluders"]) {
+    for (const YAML::Node& node : reader.list(root, "occluders")) {
+      reader.check_keys(node, {"centre", "radius_m"}, "an occluder");
+      SwarmOccluder occluder;
+      occluder.centre =
+          reader.vector<3>(reader.required(node, "centre", "an occluder"), "centre", -1000, 1000);
+      reader.required(node, "radius_m", "an occluder");
+      occluder.radius_m = reader.positive(node, "radius_m", 0, 100);
+      scene.occluders.push_back(occluder);
+    }
+  }
   return scene;
 }
 
