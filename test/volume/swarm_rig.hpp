@@ -92,6 +92,10 @@ struct SwarmFigures {
   std::vector<double> position_errors_m;
   std::vector<double> orientation_errors_deg;  // robots of several markers
   MarkerCloudCounts cloud;
+  // The cloud's markers over every frame, and those further than 5 mm from every true marker
+  // (ghosts: rays of different markers taken for one).
+  int64_t cloud_markers = 0;
+  int64_t ghost_markers = 0;
 
   double tracked_fraction() const {
     return robot_frames == 0 ? 0 : static_cast<double>(tracked) / static_cast<double>(robot_frames);
@@ -161,6 +165,13 @@ inline SwarmFigures track_swarm(const synthetic::SwarmScene& scene, SwarmRig& ri
       }
       const std::vector<CloudMarker> markers = cloud.track(stamp_ns, seen);
       const std::vector<SwarmRobotPose> poses = swarm.track(stamp_ns, markers);
+      const std::vector<Eigen::Vector3d> true_markers = scene.markers(time_s);
+      figures.cloud_markers += static_cast<int64_t>(markers.size());
+      for (const CloudMarker& marker : markers) {
+        figures.ghost_markers += std::none_of(
+            true_markers.begin(), true_markers.end(),
+            [&](const Eigen::Vector3d& truth) { return (truth - marker.position).norm() < 0.005; });
+      }
       for (size_t r = 0; r < scene.robots.size(); ++r)
         truth[r] = scene.pose(r, time_s).translation();
       figures.robot_frames += static_cast<int64_t>(scene.robots.size());
