@@ -108,6 +108,57 @@ TEST(MarkerCloud, ADetectionOneCameraAloneSeesIsCountedNotTriangulated) {
   EXPECT_EQ(cloud.counts().unexplained, 1);
 }
 
+// A tracked marker seen by two cameras only, in one of them as a blob merged with a
+// neighbour's (stated with a wide sigma, its centre 2 px off): two rays meet anywhere on the
+// epipolar line, so the marker is not placed from them; the markers both cameras see cleanly
+// are.
+TEST(MarkerCloud, AMarkerOfTwoCamerasOneOfThemAMergedBlobIsNotPlaced) {
+  test::SwarmRig rig = eight_cameras();
+  const SwarmScene scene =
+      synthetic::random_flight(synthetic::single_marker_layout(), 20, 3.0, 1.0, 0.1, 1.0, 5);
+  MarkerCloudTracker cloud;
+  ASSERT_EQ(cloud.track(0, rig.frame(scene, 0)).size(), 20u);
+  const double time_s = 1 / kRate_hz;
+  std::vector<CameraDetections> frame = rig.frame(scene, time_s);
+  for (size_t c = 2; c < frame.size(); ++c) {
+    frame[c].pixels.clear();
+    frame[c].pixel_sigma_px.clear();
+  }
+  // The detection of a marker both cameras see, in camera `c`; nullopt if it does not.
+  const auto detection_of = [&](const Eigen::Vector3d& marker, size_t c) -> std::optional<size_t> {
+    const std::optional<Eigen::Vector2d> at = rig.centroid_cameras[c].model().project(
+        rig.centroid_cameras[c].camera_from_world() * marker);
+    for (size_t d = 0; at && d < frame[c].pixels.size(); ++d) {
+      if ((frame[c].pixels[d] - *at).norm() < 0.5) return d;
+    }
+    return std::nullopt;
+  };
+  Eigen::Vector3d blurred;
+  std::optional<size_t> blob;
+  for (const Eigen::Vector3d& marker : scene.markers(time_s)) {
+    blurred = marker;
+    blob = detection_of(marker, 1);
+    if (blob && detection_of(marker, 0)) break;
+  }
+  ASSERT_TRUE(blob.has_value()) << "no marker both cameras see";
+  const std::optional<Eigen::Vector2d> at = rig.centroid_cameras[1].model().project(
+      rig.centroid_cameras[1].camera_from_world() * blurred);
+  // Along camera 0's ray as camera 1 sees it (the epipolar line): consistent with camera 0.
+  const Eigen::Vector3d from_camera_0 =
+      blurred - rig.centroid_cameras[0].camera_from_world().inverse().translation();
+  const std::optional<Eigen::Vector2d> further = rig.centroid_cameras[1].model().project(
+      rig.centroid_cameras[1].camera_from_world() * (blurred + 0.01 * from_camera_0.normalized()));
+  ASSERT_TRUE(further.has_value());
+  frame[1].pixels[*blob] += 1.5 * (*further - *at).normalized();
+  frame[1].pixel_sigma_px[*blob] = 1.0;
+  const std::vector<CloudMarker> markers = cloud.track(static_cast<int64_t>(time_s * 1e9), frame);
+  EXPECT_GE(markers.size(), 10u);
+  for (const CloudMarker& marker : markers) {
+    EXPECT_LT(nearest_truth(scene.markers(time_s), marker.position).second, 0.5e-3);
+    EXPECT_GT((marker.position - blurred).norm(), 0.005) << "placed from the merged blob";
+  }
+}
+
 TEST(MarkerCloud, DetectionsWhereTwoMarkersMergeAreLeftOut) {
   // Two markers 25 mm apart along x: the two cameras on the x axis see them nearly end on, their
   // images merged; the others see them apart.

@@ -15,6 +15,8 @@ namespace {
 
 // The sigma of a pixel whose camera states none (as the fusion assumes).
 constexpr double kUnstatedSigmaPx = 0.1;
+// A detection stated this many times less precise than its camera's median is a merged blob.
+constexpr double kMergedSigmaFactor = 3;
 // A detection two tracks reach goes to the nearer when it is this much nearer.
 constexpr double kMuchNearer = 0.5;
 // Gauss-Newton steps at most, and the step (metres) that ends them sooner.
@@ -294,6 +296,13 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
   for (size_t c = 0; c < camera_count; ++c) {
     for (size_t d = 0; d < cameras[c].pixels.size(); ++d) counts_.merged += claims[c].merged(d);
   }
+  std::vector<double> median_sigma(camera_count, 0);  // of each camera's detections
+  for (size_t c = 0; c < camera_count; ++c) {
+    std::vector<double> sigmas = cameras[c].pixel_sigma_px;
+    if (sigmas.empty()) continue;
+    std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+    median_sigma[c] = sigmas[sigmas.size() / 2];
+  }
   std::vector<char> observed(tracks_.size(), 0);
   for (size_t t = 0; t < tracks_.size(); ++t) {
     std::vector<Observation> observations;
@@ -304,6 +313,19 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
       }
     }
     if (cameras_in(observations) < 2) continue;
+    // Two cameras' rays meet wherever the second detection lies on the first's epipolar line,
+    // and a blob merged with a neighbour's (stated with a wide sigma) lies millimetres off: a
+    // third camera would refuse it, two cannot. A marker of two cameras, one of them such a
+    // blob, waits for a better frame; its detections are its track's, not a new marker's.
+    if (cameras_in(observations) == 2 &&
+        std::any_of(observations.begin(), observations.end(), [&](const Observation& o) {
+          const std::vector<double>& sigmas = cameras[o.camera].pixel_sigma_px;
+          return !sigmas.empty() &&
+                 sigmas[o.detection] > kMergedSigmaFactor * median_sigma[o.camera];
+        })) {
+      for (const Observation& o : observations) taken[o.camera][o.detection] = 1;
+      continue;
+    }
     const Fit fit =
         fit_consistent(geometry, cameras, observations, predictions[t], options_.tolerance_px, 2);
     if (!fit.valid) continue;
