@@ -15,8 +15,8 @@
 //     sigmas); a robot of one marker by its marker. The measurement corrects the robot's filter,
 //     whose pose, velocities and covariances are what the robot's pose says.
 //  2. Robots to find: those not found yet, near their initial positions (or where they were
-//     re-seeded) within `start_radius_m` and only while their markers are at rest (slower than
-//     `start_speed_mps`: a robot flying past another's start is not taken for it), and those
+//     re-seeded) within `start_radius_m`, among markers not known to move faster than
+//     `start_speed_mps` (a robot flying past another's start is not taken for it), and those
 //     lost (missed in the frames of `lost_after_s`), near where their last velocity carries
 //     them from where they were last, within a radius that grows with their layout's top speed
 //     and the time lost, up to `max_search_radius_m` (where the carrying stops too: a pair
@@ -64,8 +64,8 @@ struct SwarmTrackerOptions {
   int min_markers = 3;
   // A robot not found yet is looked for this close to its initial (or re-seeded) position,
   double start_radius_m = 0.1;
-  // among markers slower than this (m/s; a marker measured at 240 Hz to 0.07 mm seems to move
-  // at about 0.03 m/s when still).
+  // among markers not known to move faster than this (m/s; a marker measured at 240 Hz to
+  // 0.07 mm seems to move at about 0.03 m/s when still; in its first frame its speed is unknown).
   double start_speed_mps = 0.25;
   // A tracked robot missed in every frame for this long is lost (seconds). Only frames count:
   // across a stall of the fusion, the robot is looked for where its motion took it.

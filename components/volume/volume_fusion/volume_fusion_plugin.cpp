@@ -124,7 +124,8 @@ const ParameterList<Settings> kParameters =
              &Settings::swarm, &SwarmTrackerOptions::start_radius_m)
         .range(1e-3, 100)
         .add("robot_start_speed_mps",
-             "a robot is found at its start only among markers slower than this: at rest",
+             "a robot is found at its start only among markers not known to move faster than "
+             "this: at rest",
              &Settings::swarm, &SwarmTrackerOptions::start_speed_mps)
         .range(1e-3, 100)
         .add("robot_lost_after_s",
