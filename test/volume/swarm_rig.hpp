@@ -38,11 +38,7 @@ struct SwarmRig {
 
   // Every camera's centroids of the scene's markers at `time_s`, behind its occluders.
   std::vector<CameraDetections> frame(const synthetic::SwarmScene& scene, double time_s) {
-    std::vector<synthetic::OccludingSphere> occluders;
-    for (const synthetic::SwarmOccluder& o : scene.occluders) {
-      occluders.push_back({o.centre, o.radius_m});
-    }
-    return frame(scene.markers(time_s), occluders);
+    return frame(scene.markers(time_s), scene.occluders);
   }
   // Every camera's centroids of `markers` (world frame).
   std::vector<CameraDetections> frame(

@@ -22,6 +22,8 @@
 
 #include <mocap/calibration/camera_model.hpp>
 
+#include "sim/centroid_camera/occluding_sphere.hpp"
+
 namespace mocap::synthetic {
 
 struct CentroidCameraOptions {
@@ -36,12 +38,6 @@ struct CentroidCameraOptions {
   // Why these options cannot be used, naming the field ("noise_px: -1 is below 0"); nullopt
   // when they can. CentroidCamera's constructor throws std::invalid_argument with it.
   std::optional<std::string> problem() const;
-};
-
-// An opaque sphere in the world (metres): what lies behind it, seen from the camera, is hidden.
-struct OccludingSphere {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  double radius_m = 0;
 };
 
 struct Centroid {

@@ -119,10 +119,7 @@ class CentroidCameraComponent final : public Component {
         std::chrono::duration<double>(stamp.time_since_epoch() - scene_start_.time_since_epoch())
             .count();
     std::vector<Eigen::Vector3d> markers;
-    std::vector<OccludingSphere> bodies;
-    for (const SwarmOccluder& occluder : scene_.occluders) {
-      bodies.push_back({occluder.centre, occluder.radius_m});
-    }
+    std::vector<OccludingSphere> hiding = scene_.occluders;  // and each robot, below
     std_msgs::msg::Header header;
     header.stamp(to_time_msg(stamp));
     header.frame_id("world");
@@ -134,7 +131,7 @@ class CentroidCameraComponent final : public Component {
         markers.push_back(pose * marker);
       }
       if (settings_.body_radius_m > 0) {
-        bodies.push_back({pose.translation() - Eigen::Vector3d(0, 0, settings_.body_radius_m),
+        hiding.push_back({pose.translation() - Eigen::Vector3d(0, 0, settings_.body_radius_m),
                           settings_.body_radius_m});
       }
       const Eigen::Vector3d velocity = (scene_.pose(r, time_s + kVelocityStep_s).translation() -
@@ -151,7 +148,7 @@ class CentroidCameraComponent final : public Component {
     auto fiducials = std::make_shared<FiducialArray>();
     header.frame_id(frame_id_);
     fiducials->header(header);
-    for (const Centroid& centroid : camera_->project(markers, bodies)) {
+    for (const Centroid& centroid : camera_->project(markers, hiding)) {
       mocap_msgs::msg::Fiducial fiducial;
       fiducial.x(static_cast<float>(centroid.pixel.x()));
       fiducial.y(static_cast<float>(centroid.pixel.y()));

@@ -142,7 +142,7 @@ SwarmScene SwarmScene::shifted(const Eigen::Vector3d& offset) const {
       leg.to += offset;
     }
   }
-  for (SwarmOccluder& occluder : moved.occluders) occluder.centre += offset;
+  for (OccludingSphere& occluder : moved.occluders) occluder.centre += offset;
   return moved;
 }
 

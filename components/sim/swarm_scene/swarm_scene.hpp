@@ -19,6 +19,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "sim/centroid_camera/occluding_sphere.hpp"
+
 namespace mocap::synthetic {
 
 // One part of a robot's flight, from `start_s` to `end_s` (scene seconds).
@@ -49,16 +51,11 @@ struct SwarmSceneRobot {
   double tilt_rad = 0;  // roll and pitch swing up to this
 };
 
-// An opaque sphere standing in the volume (a pillar's stretch, a person, a ladder): what lies
-// behind it is hidden from a camera, as behind a robot.
-struct SwarmOccluder {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // world frame, metres
-  double radius_m = 0;
-};
-
 struct SwarmScene {
   std::vector<SwarmSceneRobot> robots;
-  std::vector<SwarmOccluder> occluders;
+  // Standing in the volume (a pillar's stretch, a person, a ladder): what lies behind one is
+  // hidden from a camera, as behind a robot.
+  std::vector<OccludingSphere> occluders;
   double duration_s = 0;
   // Seconds every robot stays where its flight starts before the flights begin (the flights'
   // time 0 is then `hold_s`), as a swarm waits on the ground while its tracker comes up and

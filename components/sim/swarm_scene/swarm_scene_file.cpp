@@ -143,7 +143,7 @@ SwarmScene read_scene(const Reader& reader, const YAML::Node& root) {
   if (root["occluders"]) {
     for (const YAML::Node& node : reader.list(root, "occluders")) {
       reader.check_keys(node, {"centre", "radius_m"}, "an occluder");
-      SwarmOccluder occluder;
+      OccludingSphere occluder;
       occluder.centre =
           reader.vector<3>(reader.required(node, "centre", "an occluder"), "centre", -1000, 1000);
       reader.required(node, "radius_m", "an occluder");

@@ -43,15 +43,15 @@ class PointGrid {
     std::sort(cells_.begin(), cells_.end());
   }
 
-  // Calls visit(index, squared distance) for each marker within `radius_m` (at most the cell
-  // size) of `at`.
+  // Calls visit(index, squared distance) for each marker within `radius_m` of `at`.
   template <class Visit>
   void near(const Eigen::Vector3d& at, double radius_m, Visit visit) const {
     const Eigen::Vector3<int64_t> cell = cell_of(at);
+    const auto span = static_cast<int64_t>(std::ceil(radius_m / cell_m_));
     const double limit = radius_m * radius_m;
-    for (int64_t z = cell.z() - 1; z <= cell.z() + 1; ++z) {
-      for (int64_t y = cell.y() - 1; y <= cell.y() + 1; ++y) {
-        const int64_t first = key({cell.x() - 1, y, z}), last = key({cell.x() + 1, y, z});
+    for (int64_t z = cell.z() - span; z <= cell.z() + span; ++z) {
+      for (int64_t y = cell.y() - span; y <= cell.y() + span; ++y) {
+        const int64_t first = key({cell.x() - span, y, z}), last = key({cell.x() + span, y, z});
         for (auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(first, -1));
              it != cells_.end() && it->first <= last; ++it) {
           const double squared = ((*cloud_)[it->second].position - at).squaredNorm();
@@ -357,19 +357,9 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
                                                  dt_s * dt_s * dt_s / 3));
     for (const Eigen::Vector3d& marker : swarm_.layouts[swarm_.robots[r].layout].markers) {
       const int row = static_cast<int>(rows.size());
-      const Eigen::Vector3d predicted = start * marker;
-      if (gate_m == options_.gate_m) {
-        grid.near(predicted, gate_m, [&](int m, double squared) {
-          if (!used[m]) allowed.push_back({row, m, squared});
-        });
-      } else {
-        for (size_t m = 0; m < cloud.size(); ++m) {
-          const double squared = (cloud[m].position - predicted).squaredNorm();
-          if (!used[m] && squared <= gate_m * gate_m) {
-            allowed.push_back({row, static_cast<int>(m), squared});
-          }
-        }
-      }
+      grid.near(start * marker, gate_m, [&](int m, double squared) {
+        if (!used[m]) allowed.push_back({row, m, squared});
+      });
       rows.push_back(r);
       unassigned.push_back(gate_m * gate_m);
     }
