@@ -120,6 +120,31 @@ TEST_F(BridgeTest, ATopicGoneFromTheDomainIsUnadvertisedAndADeclaredOneStays) {
   EXPECT_EQ(bridge.channel_count(), 2u);  // the two declared ones
 }
 
+// A topic that is not latched is read only while a client watches it: with nobody watching,
+// a volume's every camera topic would be read on the cores its fusion needs.
+TEST_F(BridgeTest, ATopicThatIsNotLatchedIsReadOnlyWhileAClientWatchesIt) {
+  FoxgloveBridge bridge = make({.topics = ".*"});
+  EXPECT_TRUE(graph.subscribed.contains("/alerts"));  // latched: its last message waits
+  EXPECT_FALSE(graph.subscribed.contains("/hidden/alerts"));
+  bridge.opened(1);
+  uint32_t id = 0;
+  for (const json& channel : links.texts[1][1]["channels"]) {
+    if (channel["topic"] == "/hidden/alerts") id = channel["id"];
+  }
+  ASSERT_NE(id, 0u) << "offered, though nobody reads it yet";
+  bridge.received(
+      1, json{{"op", "subscribe"}, {"subscriptions", {{{"id", 5}, {"channelId", id}}}}}.dump());
+  EXPECT_FALSE(graph.subscribed.contains("/hidden/alerts")) << "subscribed on the server's thread";
+  bridge.run_once();
+  ASSERT_TRUE(graph.subscribed.contains("/hidden/alerts"));
+  EXPECT_EQ(graph.subscribed.at("/hidden/alerts").durability, Durability::Volatile);
+
+  bridge.received(1, json{{"op", "unsubscribe"}, {"subscriptionIds", {5}}}.dump());
+  bridge.run_once();
+  EXPECT_FALSE(graph.subscribed.contains("/hidden/alerts"));
+  EXPECT_TRUE(graph.subscribed.contains("/alerts")) << "a latched topic is kept";
+}
+
 TEST_F(BridgeTest, AClientPublishingWhileItIsOffIsClosed) {
   FoxgloveBridge bridge = make();
   bridge.opened(3);

@@ -42,6 +42,24 @@ std::pair<size_t, double> nearest_truth(const std::vector<Eigen::Vector3d>& trut
   return {best, (truth[best] - position).norm()};
 }
 
+// Two markers 25 mm apart along x, flying together from `from` to `to` (the first's places) in
+// a second.
+SwarmScene two_markers_25mm_apart(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  SwarmScene scene;
+  scene.duration_s = 1;
+  for (double x : {0.0, 0.025}) {
+    synthetic::SwarmSceneRobot robot;
+    robot.name = "m" + std::to_string(scene.robots.size());
+    robot.markers = synthetic::single_marker_layout();
+    synthetic::SwarmLeg leg;
+    leg.from = from + Eigen::Vector3d(x, 0, 0);
+    leg.to = to + Eigen::Vector3d(x, 0, 0);
+    robot.legs.push_back(leg);
+    scene.robots.push_back(robot);
+  }
+  return scene;
+}
+
 TEST(MarkerCloud, AHundredMarkersFromScratchAreFoundWithoutGhosts) {
   test::SwarmRig rig = eight_cameras();
   const SwarmScene scene =
@@ -162,18 +180,8 @@ TEST(MarkerCloud, AMarkerOfTwoCamerasOneOfThemAMergedBlobIsNotPlaced) {
 TEST(MarkerCloud, DetectionsWhereTwoMarkersMergeAreLeftOut) {
   // Two markers 25 mm apart along x: the two cameras on the x axis see them nearly end on, their
   // images merged; the others see them apart.
-  synthetic::SwarmScene scene;
-  scene.duration_s = 1;
-  for (double x : {0.0, 0.025}) {
-    synthetic::SwarmSceneRobot robot;
-    robot.name = "m" + std::to_string(scene.robots.size());
-    robot.markers = synthetic::single_marker_layout();
-    synthetic::SwarmLeg leg;
-    leg.from = Eigen::Vector3d(x - 0.2, 0, 1);
-    leg.to = Eigen::Vector3d(x + 0.2, 0.1, 1);
-    robot.legs.push_back(leg);
-    scene.robots.push_back(robot);
-  }
+  const SwarmScene scene =
+      two_markers_25mm_apart(Eigen::Vector3d(-0.2, 0, 1), Eigen::Vector3d(0.2, 0.1, 1));
   test::SwarmRig rig = eight_cameras();
   MarkerCloudTracker cloud;
   int merged = 0;
@@ -189,6 +197,60 @@ TEST(MarkerCloud, DetectionsWhereTwoMarkersMergeAreLeftOut) {
   }
   EXPECT_GT(merged, 0) << "no camera saw the two markers merged: the test tests nothing";
   EXPECT_EQ(cloud.totals().started, 2);
+}
+
+// A blob two tracks claim about equally (two markers merged in a camera's image) is theirs:
+// three cameras' blobs of the same pair meet at the point between the markers, where there is
+// none, and would start (or move a track to) a marker there.
+TEST(MarkerCloud, BlobsTwoTracksClaimStartNoMarkerBetweenThem) {
+  // About 7 px apart in the images of the cameras that see them apart, each within a 5 px gate
+  // of the point between them.
+  const SwarmScene scene =
+      two_markers_25mm_apart(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0.01, 1));
+  test::SwarmRig rig = eight_cameras();
+  MarkerCloudOptions options;
+  options.gate_px = 5;
+  MarkerCloudTracker cloud(options);
+  for (int f = 0; f < 10; ++f) {
+    const double time_s = f / kRate_hz;
+    ASSERT_EQ(cloud.track(static_cast<int64_t>(time_s * 1e9), rig.frame(scene, time_s)).size(), 2u)
+        << "frame " << f;
+  }
+  const double time_s = 10 / kRate_hz;
+  const std::vector<Eigen::Vector3d> truth = scene.markers(time_s);
+  const Eigen::Vector3d between = (truth[0] + truth[1]) / 2;
+  std::vector<CameraDetections> frame = rig.frame(scene, time_s);
+  // Cameras 0 to 2 see one blob between the two markers; the others neither.
+  for (size_t c = 0; c < frame.size(); ++c) {
+    const synthetic::CentroidCamera& camera = rig.centroid_cameras[c];
+    auto pixel_of = [&](const Eigen::Vector3d& point) {
+      return camera.model().project(camera.camera_from_world() * point);
+    };
+    for (size_t d = frame[c].pixels.size(); d-- > 0;) {
+      bool of_the_pair = false;
+      for (const Eigen::Vector3d& marker : truth) {
+        const std::optional<Eigen::Vector2d> at = pixel_of(marker);
+        of_the_pair = of_the_pair || (at && (frame[c].pixels[d] - *at).norm() < 3);
+      }
+      if (!of_the_pair) continue;
+      frame[c].pixels.erase(frame[c].pixels.begin() + static_cast<long>(d));
+      frame[c].pixel_sigma_px.erase(frame[c].pixel_sigma_px.begin() + static_cast<long>(d));
+    }
+    if (c < 3) {
+      const std::optional<Eigen::Vector2d> blob = pixel_of(between);
+      ASSERT_TRUE(blob.has_value());
+      frame[c].pixels.push_back(*blob);
+      frame[c].pixel_sigma_px.push_back(1.0);
+    }
+  }
+  const std::vector<CloudMarker> markers = cloud.track(static_cast<int64_t>(time_s * 1e9), frame);
+  EXPECT_EQ(cloud.counts().merged, 3) << "the blobs are not both tracks': the test tests nothing";
+  for (const CloudMarker& marker : markers) {
+    EXPECT_GT((marker.position - between).norm(), 0.003) << "a marker where there is none";
+  }
+  EXPECT_EQ(cloud.counts().started, 0);
+  EXPECT_EQ(cloud.counts().continued, 0);
+  EXPECT_EQ(cloud.counts().coasting, 2);
 }
 
 TEST(MarkerCloud, BadOptionsAreRefusedNamingTheField) {

@@ -17,8 +17,31 @@ struct MarkerImage {
   double diameter_px = 0;
 };
 
-bool hidden_by(const OccludingSphere& sphere, const Eigen::Vector3d& camera,
-               const Eigen::Vector3d& marker) {
+// A sphere as the camera sees it: the cone of directions it covers. A marker outside the cone
+// is not behind it, which one dot product tells; only those inside get the exact test.
+struct SphereInView {
+  const OccludingSphere* sphere = nullptr;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // unit, camera to centre
+  double cone_cosine = -1;  // of the cone's half angle; -1 with the camera in the sphere
+};
+
+SphereInView in_view(const OccludingSphere& sphere, const Eigen::Vector3d& camera) {
+  SphereInView view;
+  view.sphere = &sphere;
+  const Eigen::Vector3d to_centre = sphere.centre - camera;
+  const double distance = to_centre.norm();
+  if (distance > sphere.radius_m) {
+    view.direction = to_centre / distance;
+    const double sine = sphere.radius_m / distance;
+    view.cone_cosine = std::sqrt(1 - sine * sine);
+  }
+  return view;
+}
+
+bool hidden_by(const SphereInView& view, const Eigen::Vector3d& camera,
+               const Eigen::Vector3d& marker, const Eigen::Vector3d& marker_direction) {
+  if (view.direction.dot(marker_direction) <= view.cone_cosine) return false;
+  const OccludingSphere& sphere = *view.sphere;
   // A marker on the sphere's surface (or in it) belongs to what the sphere stands for.
   if ((marker - sphere.centre).norm() <= sphere.radius_m) return false;
   const Eigen::Vector3d line = marker - camera;
@@ -61,6 +84,9 @@ std::vector<Centroid> CentroidCamera::project(
     const std::vector<Eigen::Vector3d>& markers, const std::vector<OccludingSphere>& spheres,
     const std::vector<Eigen::AlignedBox2d>& hidden_regions) {
   const double focal_px = model_->focal_length_px();
+  std::vector<SphereInView> views;
+  views.reserve(spheres.size());
+  for (const OccludingSphere& sphere : spheres) views.push_back(in_view(sphere, centre_in_world_));
   std::vector<MarkerImage> images;
   for (size_t i = 0; i < markers.size(); ++i) {
     const Eigen::Vector3d in_camera = camera_from_world_ * markers[i];
@@ -76,10 +102,11 @@ std::vector<Centroid> CentroidCamera::project(
         pixel->y() + radius > model_->height() - 0.5) {
       continue;
     }
+    const Eigen::Vector3d direction = (markers[i] - centre_in_world_).normalized();
     if (std::any_of(hidden_regions.begin(), hidden_regions.end(),
                     [&](const Eigen::AlignedBox2d& region) { return region.contains(*pixel); }) ||
-        std::any_of(spheres.begin(), spheres.end(), [&](const OccludingSphere& sphere) {
-          return hidden_by(sphere, centre_in_world_, markers[i]);
+        std::any_of(views.begin(), views.end(), [&](const SphereInView& view) {
+          return hidden_by(view, centre_in_world_, markers[i], direction);
         })) {
       continue;
     }

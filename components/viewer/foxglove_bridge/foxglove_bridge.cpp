@@ -123,7 +123,9 @@ void FoxgloveBridge::update(const std::vector<KnownTopic>& present, bool announc
           std::all_of(topic.publishers.begin(), topic.publishers.end(),
                       [](const Qos& qos) { return qos.durability == Durability::TransientLocal; });
       auto [known, added] = topics_.emplace(topic.topic, TopicState{topic.type, latched, 0});
-      if (added && topic.type->name() != kImageType) {
+      // A latched topic's last message waits here for the clients to come; the others are
+      // read only while a client watches them (subscribe_first_asked).
+      if (added && latched) {
         known->second.subscribed = true;
         new_topics.emplace_back(topic.topic, known->second);
       } else if (known->second.type != topic.type && warned_types_.insert(topic.topic).second) {
@@ -169,7 +171,7 @@ void FoxgloveBridge::update(const std::vector<KnownTopic>& present, bool announc
   }
 }
 
-// Images whose last watching client unsubscribed or left (`unwatched_`): let go of, unless a
+// Topics whose last watching client unsubscribed or left (`unwatched_`): let go of, unless a
 // client asked for them again since.
 void FoxgloveBridge::unsubscribe_unwatched() {
   std::vector<std::string> names;
@@ -198,11 +200,12 @@ bool FoxgloveBridge::watched(uint32_t channel_id) const {
          });
 }
 
-// Requires mutex_. The images among `channels` that nobody watches now, for the timer.
+// Requires mutex_. The topics among `channels`, latched ones aside, that nobody watches now,
+// for the timer.
 void FoxgloveBridge::note_unwatched(const std::vector<uint32_t>& channels) {
   for (uint32_t id : channels) {
     auto channel = channels_.find(id);
-    if (channel == channels_.end() || channel->second.type->name() != kImageType) continue;
+    if (channel == channels_.end() || channel->second.latched) continue;
     if (!watched(id)) unwatched_.insert(channel->second.channel.topic);
   }
 }

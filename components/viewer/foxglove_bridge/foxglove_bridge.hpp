@@ -108,11 +108,11 @@ class FoxgloveBridge {
   BridgeCounts counts() const;
 
  private:
-  // A topic the bridge offers; advertised while it has a channel. Images are subscribed to
-  // when a client first asks for them, and let go of when the last client that asked stops
-  // watching: a volume's cameras would otherwise stream every frame of every camera to the
-  // bridge's host with nobody watching. The rest at once, so that a latched topic's last
-  // message is there for the first client.
+  // A topic the bridge offers; advertised while it has a channel. Subscribed to when a client
+  // first asks for it, and let go of when the last client that asked stops watching: a
+  // volume's cameras would otherwise stream every frame of every camera to the bridge's host
+  // with nobody watching, and the bridge read them on the cores the fusion needs. Latched
+  // topics at once, so that their last message is there for the first client.
   struct TopicState {
     const MessageType* type = nullptr;
     bool latched = false;
@@ -171,8 +171,8 @@ class FoxgloveBridge {
   std::set<std::string> warned_types_;  // topics published with two types, warned about once
   mutable std::mutex mutex_;            // guards what follows
   std::map<std::string, TopicState> topics_;
-  std::set<std::string> first_asked_;  // images a client asked for, not subscribed to yet
-  std::set<std::string> unwatched_;    // images the last watching client stopped watching
+  std::set<std::string> first_asked_;  // topics a client asked for, not subscribed to yet
+  std::set<std::string> unwatched_;    // topics the last watching client stopped watching
   std::map<uint32_t, ChannelState> channels_;
   uint32_t next_channel_id_ = 1;
   std::map<ClientId, ClientState> clients_;

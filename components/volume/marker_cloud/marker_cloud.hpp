@@ -10,12 +10,13 @@
 //     markers merged into one blob there: the detection is left out, and counted). A track
 //     observed by two cameras or more is triangulated (Gauss-Newton on the pixel errors, from
 //     the prediction), observations further than `tolerance_px` off left out.
-//  2. New markers. The detections no track took are matched across cameras: each pair of
-//     cameras proposes a marker for two detections whose rays pass within `tolerance_px` of
-//     each other; a proposal gathers the other cameras' free detections it projects onto, and
-//     is triangulated from them all. Proposals seen by `min_cameras_to_start` cameras or more,
-//     the most cameras first, then the lowest error, become markers; one that lies where a
-//     track not observed this frame is predicted continues that track.
+//  2. New markers. The detections no track took, a blob two tracks claim aside (it is theirs,
+//     merged), are matched across cameras: each pair of cameras proposes a marker for two
+//     detections whose rays pass within `tolerance_px` of each other; a proposal gathers the
+//     other cameras' free detections it projects onto, and is triangulated from them all. Proposals
+//     seen by `min_cameras_to_start` cameras or more, the most cameras first, then the lowest
+//     error, become markers; one that lies where a track not observed this frame is predicted
+//     continues that track.
 //  3. What is left: a detection no marker explains (seen by one camera only, or a blob of
 //     several markers) is counted, never triangulated.
 // A track not observed for `lost_after_s` is dropped.

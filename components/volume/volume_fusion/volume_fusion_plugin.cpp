@@ -398,17 +398,22 @@ class VolumeFusion final : public Component {
       message->poses().push_back(std::move(pose));
       report_single_camera(body, assembled.stamp_ns);
     }
-    track_markers(assembled.stamp_ns, frame, poses, *message);
+    std::shared_ptr<PointCloud2> markers =
+        track_markers(assembled.stamp_ns, frame, poses, *message);
     body_poses_ += poses.size();
     poses_.publish(std::move(message));
+    markers_.publish(std::move(markers));
     report_unposed(poses, assembled.stamp_ns);
     report_drift();
   }
 
   // The marker cloud of every camera's detections; the bodies' markers in it labeled, the
-  // robots tracked in the rest and added to `message`; the cloud published.
-  void track_markers(int64_t stamp_ns, const std::vector<CameraFrame>& frame,
-                     const std::vector<TrackedBodyPose>& poses, ConstellationPoseArray& message) {
+  // robots tracked in the rest and added to `message`; the cloud's message, published after
+  // the poses (which it would otherwise delay).
+  std::shared_ptr<PointCloud2> track_markers(int64_t stamp_ns,
+                                             const std::vector<CameraFrame>& frame,
+                                             const std::vector<TrackedBodyPose>& poses,
+                                             ConstellationPoseArray& message) {
     std::vector<CameraDetections> detections;
     for (size_t c = 0; c < frame.size(); ++c) {
       const VolumeCamera& camera = tracker_.cameras()[c];
@@ -469,7 +474,7 @@ class VolumeFusion final : public Component {
                          static_cast<uint16_t>(owners[m].marker), cloud[m].id,
                          static_cast<float>(cloud[m].rms_px), cloud[m].cameras});
     }
-    markers_.publish(std::make_shared<PointCloud2>(to_point_cloud(message.header(), labeled)));
+    return std::make_shared<PointCloud2>(to_point_cloud(message.header(), labeled));
   }
 
   void reseed(const NamedPoseArray& array) {
