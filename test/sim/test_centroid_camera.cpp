@@ -3,8 +3,11 @@
 // hides them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <random>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
@@ -91,6 +94,61 @@ TEST(CentroidCamera, AMarkerTheFramesEdgeCutsOrSomethingHidesIsNotReported) {
       Eigen::AlignedBox2d(Eigen::Vector2d(300, 200), Eigen::Vector2d(340, 280))};
   EXPECT_TRUE(camera.project({{0, 0, 2.0}}, {}, hidden).empty());
   EXPECT_EQ(camera.project({{0.3, 0, 2.0}}, {}, hidden).size(), 1u);
+}
+
+// Hundreds of markers among a hundred spheres, some of them around or behind the camera, the
+// camera turned: exactly the markers a segment from the camera through some sphere leaves are
+// hidden (the camera tests a marker only against the spheres of its image column).
+TEST(CentroidCamera, HidesExactlyTheMarkersBehindASphere) {
+  Eigen::Isometry3d camera_from_world = Eigen::Isometry3d::Identity();
+  camera_from_world.linear() =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0.5).normalized()).toRotationMatrix();
+  camera_from_world.translation() = Eigen::Vector3d(0.2, -0.1, 0.3);
+  const Eigen::Vector3d camera_centre = camera_from_world.inverse().translation();
+  std::mt19937 random(3);
+  // Across a little more than the 640x480 image's field (x / z within 0.53, y / z 0.4).
+  std::uniform_real_distribution<double> across(-0.6, 0.6), depth(0.2, 4.0), radius(0.01, 0.1);
+  const auto in_front = [&] {
+    const double z = depth(random);
+    return camera_from_world.inverse() * Eigen::Vector3d(across(random) * z, across(random) * z, z);
+  };
+  std::vector<OccludingSphere> spheres;
+  for (int s = 0; s < 100; ++s) spheres.push_back({in_front(), radius(random)});
+  spheres.push_back({camera_centre + Eigen::Vector3d(0, 0.05, 0), 0.1});  // around the camera
+  spheres.push_back({camera_from_world.inverse() * Eigen::Vector3d(0, 0, -1), 0.5});  // behind
+  std::vector<Eigen::Vector3d> markers;
+  for (int m = 0; m < 400; ++m) markers.push_back(in_front());
+
+  // By hand, every marker against every sphere: on a sphere's surface or in it, a marker
+  // belongs to it; otherwise it is hidden when the point of its line of sight nearest the
+  // sphere's centre lies between the camera and the marker, inside the sphere.
+  const auto hidden = [&](const Eigen::Vector3d& marker) {
+    for (const OccludingSphere& sphere : spheres) {
+      if ((marker - sphere.centre).norm() <= sphere.radius_m) continue;
+      const Eigen::Vector3d line = marker - camera_centre;
+      const double along = (sphere.centre - camera_centre).dot(line) / line.squaredNorm();
+      if (along > 0 && along < 1 &&
+          (camera_centre + along * line - sphere.centre).norm() < sphere.radius_m) {
+        return true;
+      }
+    }
+    return false;
+  };
+  CentroidCamera camera(ideal_camera(), camera_from_world, without_noise(), 1);
+  std::set<int> in_the_image, seen;
+  for (const Centroid& centroid : camera.project(markers)) {
+    in_the_image.insert(centroid.markers.begin(), centroid.markers.end());
+  }
+  for (const Centroid& centroid : camera.project(markers, spheres)) {
+    seen.insert(centroid.markers.begin(), centroid.markers.end());
+  }
+  std::set<int> expected;
+  for (int m : in_the_image) {
+    if (!hidden(markers[static_cast<size_t>(m)])) expected.insert(m);
+  }
+  EXPECT_EQ(seen, expected);
+  EXPECT_GT(in_the_image.size(), expected.size() + 50) << "too few hidden: the test tests little";
+  EXPECT_GT(expected.size(), 20u) << "too few seen: the test tests little";
 }
 
 TEST(CentroidCamera, BadOptionsAreRefusedNamingTheField) {

@@ -88,6 +88,56 @@ TEST(BodyMotionFilter, MeasuresTheVelocitiesOfASteadyMotion) {
             0.003);
 }
 
+// The prediction's covariance, written block by block, is F P Fᵀ + Q with F the model's whole
+// 12 x 12 transition (p += dt v, θ ← turn θ + dt ω); the correction's, the Joseph form's.
+TEST(BodyMotionFilter, PropagatesTheCovarianceOfTheWholeModel) {
+  BodyMotionOptions options;
+  Matrix6d measured = Matrix6d::Identity() * 1e-6;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation_from_vector(Eigen::Vector3d(0.3, -0.2, 0.5));
+  BodyMotionFilter filter(pose, measured, 0, options);
+  // Two corrections: velocities and a covariance with every block filled.
+  pose.translation() += Eigen::Vector3d(0.01, 0.002, -0.003);
+  pose.linear() = rotation_from_vector(Eigen::Vector3d(0.02, 0.01, -0.03)) * pose.linear();
+  filter.correct(10'000'000, pose, measured);
+  pose.translation() += Eigen::Vector3d(0.012, 0.001, -0.002);
+  filter.correct(20'000'000, pose, measured);
+  const BodyState& state = filter.state();
+  const double dt = 0.004;
+  Matrix12d f = Matrix12d::Identity();
+  f.block<3, 3>(0, 6) = dt * Eigen::Matrix3d::Identity();
+  f.block<3, 3>(3, 3) = rotation_from_vector(state.angular_velocity * dt);
+  f.block<3, 3>(3, 9) = dt * Eigen::Matrix3d::Identity();
+  Matrix12d expected = f * state.covariance * f.transpose();
+  const double q = options.linear_acceleration_density, r = options.angular_acceleration_density;
+  for (int axis = 0; axis < 3; ++axis) {
+    expected(axis, axis) += q * dt * dt * dt / 3;
+    expected(axis, 6 + axis) += q * dt * dt / 2;
+    expected(6 + axis, axis) += q * dt * dt / 2;
+    expected(6 + axis, 6 + axis) += q * dt;
+    expected(3 + axis, 3 + axis) += r * dt * dt * dt / 3;
+    expected(3 + axis, 9 + axis) += r * dt * dt / 2;
+    expected(9 + axis, 3 + axis) += r * dt * dt / 2;
+    expected(9 + axis, 9 + axis) += r * dt;
+  }
+  const BodyState prior = filter.predicted(20'000'000 + 4'000'000);
+  EXPECT_LT((prior.covariance - expected).cwiseAbs().maxCoeff(),
+            1e-12 * expected.cwiseAbs().maxCoeff());
+  EXPECT_GT((prior.covariance - state.covariance).cwiseAbs().maxCoeff(), 0)
+      << "the test tests nothing";
+
+  // And the correction's, in Joseph form: (I − K H) P (I − K H)ᵀ + K R Kᵀ, H = [I 0].
+  const Matrix6d innovation = prior.covariance.topLeftCorner<6, 6>() + measured;
+  const Eigen::Matrix<double, 12, 6> gain = prior.covariance.leftCols<6>() * innovation.inverse();
+  Matrix12d keep = Matrix12d::Identity();
+  keep.leftCols<6>() -= gain;
+  const Matrix12d joseph =
+      keep * prior.covariance * keep.transpose() + gain * measured * gain.transpose();
+  filter.correct(20'000'000 + 4'000'000, pose, measured);
+  EXPECT_LT((filter.state().covariance - joseph).cwiseAbs().maxCoeff(),
+            1e-9 * joseph.cwiseAbs().maxCoeff());
+}
+
 TEST(PointMotionFilter, SmoothsAPointAndMeasuresItsVelocity) {
   // A marker at 240 Hz measured to 0.07 mm per axis, moving steadily.
   const Eigen::Vector3d v(0.5, -0.2, 0.1);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <span>
 #include <stdexcept>
 #include <utility>
 
@@ -50,6 +51,60 @@ bool hidden_by(const SphereInView& view, const Eigen::Vector3d& camera,
   return (camera + along * line - sphere.centre).norm() < sphere.radius_m;
 }
 
+// The spheres by the columns of the image plane (x / z in the camera's frame) their shadows
+// reach: a marker is tested against its column's spheres only, not against every robot.
+class ShadowColumns {
+ public:
+  ShadowColumns(const std::vector<SphereInView>& views,
+                const Eigen::Isometry3d& camera_from_world) {
+    std::vector<std::pair<int, int>> reach(views.size());  // columns, first and last
+    std::vector<int> counts(kColumns + 1, 0);
+    for (size_t s = 0; s < views.size(); ++s) {
+      const OccludingSphere& sphere = *views[s].sphere;
+      const Eigen::Vector3d centre = camera_from_world * sphere.centre;
+      const double r = sphere.radius_m;
+      if (centre.z() - r <= 0) {
+        reach[s] = {0, kColumns - 1};  // reaches behind the camera: anywhere
+      } else {
+        // x / z over the box around the sphere is extreme at its corners.
+        const double lo =
+            std::min((centre.x() - r) / (centre.z() - r), (centre.x() - r) / (centre.z() + r));
+        const double hi =
+            std::max((centre.x() + r) / (centre.z() - r), (centre.x() + r) / (centre.z() + r));
+        reach[s] = {column_of(lo), column_of(hi)};
+      }
+      for (int c = reach[s].first; c <= reach[s].second; ++c) ++counts[static_cast<size_t>(c) + 1];
+    }
+    for (size_t c = 1; c < counts.size(); ++c) counts[c] += counts[c - 1];
+    starts_ = counts;
+    spheres_.resize(static_cast<size_t>(counts.back()));
+    for (size_t s = 0; s < views.size(); ++s) {
+      for (int c = reach[s].first; c <= reach[s].second; ++c) {
+        spheres_[static_cast<size_t>(counts[static_cast<size_t>(c)]++)] = static_cast<int>(s);
+      }
+    }
+  }
+
+  // The spheres whose shadows may reach a point at `x_over_z`.
+  std::span<const int> near(double x_over_z) const {
+    const auto c = static_cast<size_t>(column_of(x_over_z));
+    return {spheres_.data() + starts_[c], static_cast<size_t>(starts_[c + 1] - starts_[c])};
+  }
+
+ private:
+  // Columns over x / z in [-2, 2] (63 degrees either side), the edge ones open-ended.
+  static constexpr int kColumns = 80;
+  static constexpr double kExtent = 2;
+  static int column_of(double x_over_z) {
+    const double column = std::floor((x_over_z + kExtent) / (2 * kExtent) * kColumns);
+    if (!(column > 0)) return 0;
+    return column < kColumns - 1 ? static_cast<int>(column) : kColumns - 1;
+  }
+
+  std::vector<int> starts_;   // column c's spheres: [starts_[c], starts_[c + 1])
+  std::vector<int> spheres_;  // indices into the views
+};
+
 int root_of(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
@@ -87,7 +142,9 @@ std::vector<Centroid> CentroidCamera::project(
   std::vector<SphereInView> views;
   views.reserve(spheres.size());
   for (const OccludingSphere& sphere : spheres) views.push_back(in_view(sphere, centre_in_world_));
+  const ShadowColumns shadows(views, camera_from_world_);
   std::vector<MarkerImage> images;
+  images.reserve(markers.size());
   for (size_t i = 0; i < markers.size(); ++i) {
     const Eigen::Vector3d in_camera = camera_from_world_ * markers[i];
     if (in_camera.z() <= 0) continue;
@@ -105,8 +162,8 @@ std::vector<Centroid> CentroidCamera::project(
     const Eigen::Vector3d direction = (markers[i] - centre_in_world_).normalized();
     if (std::any_of(hidden_regions.begin(), hidden_regions.end(),
                     [&](const Eigen::AlignedBox2d& region) { return region.contains(*pixel); }) ||
-        std::any_of(views.begin(), views.end(), [&](const SphereInView& view) {
-          return hidden_by(view, centre_in_world_, markers[i], direction);
+        std::ranges::any_of(shadows.near(in_camera.x() / in_camera.z()), [&](int s) {
+          return hidden_by(views[static_cast<size_t>(s)], centre_in_world_, markers[i], direction);
         })) {
       continue;
     }
@@ -130,14 +187,26 @@ std::vector<Centroid> CentroidCamera::project(
       }
     }
   }
-  std::vector<std::vector<int>> blobs(images.size());
+  // Each blob's discs together, blob by blob in the order of their roots (a counting sort).
+  std::vector<int> root(images.size());
+  std::vector<size_t> blob_starts(images.size() + 1, 0);
   for (size_t i = 0; i < images.size(); ++i) {
-    blobs[root_of(parent, static_cast<int>(i))].push_back(static_cast<int>(i));
+    root[i] = root_of(parent, static_cast<int>(i));
+    ++blob_starts[static_cast<size_t>(root[i]) + 1];
+  }
+  for (size_t r = 1; r < blob_starts.size(); ++r) blob_starts[r] += blob_starts[r - 1];
+  std::vector<int> in_blobs(images.size());
+  std::vector<size_t> filled(blob_starts.begin(), blob_starts.end() - 1);
+  for (size_t i = 0; i < images.size(); ++i) {
+    in_blobs[filled[static_cast<size_t>(root[i])]++] = static_cast<int>(i);
   }
 
   std::normal_distribution<double> noise(0, options_.noise_px);
   std::vector<Centroid> centroids;
-  for (const std::vector<int>& blob : blobs) {
+  centroids.reserve(images.size());
+  for (size_t r = 0; r < images.size(); ++r) {
+    const std::span<const int> blob(in_blobs.data() + blob_starts[r],
+                                    blob_starts[r + 1] - blob_starts[r]);
     if (blob.empty()) continue;
     Centroid centroid;
     double area = 0;

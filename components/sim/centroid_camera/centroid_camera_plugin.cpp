@@ -108,10 +108,10 @@ class CentroidCameraComponent final : public Component {
     create_worker("capture", [this, period](std::stop_token stop) {
       capture_on_the_clock(period, stop, [this](Clock::time_point capture) { frame(capture); });
     });
-    size_t markers = 0;
-    for (const SwarmSceneRobot& robot : scene_.robots) markers += robot.markers.size();
+    for (const SwarmSceneRobot& robot : scene_.robots) marker_count_ += robot.markers.size();
     log().info("{} robots ({} markers) of {} seen from {} at {} Hz on {}", scene_.robots.size(),
-               markers, settings_.scene, settings_.camera, settings_.rate_hz, fiducials_.topic());
+               marker_count_, settings_.scene, settings_.camera, settings_.rate_hz,
+               fiducials_.topic());
   }
 
  private:
@@ -122,6 +122,9 @@ class CentroidCameraComponent final : public Component {
     std::vector<Eigen::Isometry3d> poses;
     std::vector<Eigen::Vector3d> markers;
     std::vector<OccludingSphere> hiding = scene_.occluders;  // and each robot, below
+    poses.reserve(scene_.robots.size());
+    markers.reserve(marker_count_);
+    hiding.reserve(hiding.size() + scene_.robots.size());
     for (size_t r = 0; r < scene_.robots.size(); ++r) {
       poses.push_back(scene_.pose(r, time_s));
       for (const Eigen::Vector3d& marker : scene_.robots[r].markers) {
@@ -138,7 +141,9 @@ class CentroidCameraComponent final : public Component {
     header.frame_id(frame_id_);
     auto fiducials = std::make_shared<FiducialArray>();
     fiducials->header(header);
-    for (const Centroid& centroid : camera_->project(markers, hiding)) {
+    const std::vector<Centroid> centroids = camera_->project(markers, hiding);
+    fiducials->fiducials().reserve(centroids.size());
+    for (const Centroid& centroid : centroids) {
       mocap_msgs::msg::Fiducial fiducial;
       fiducial.x(static_cast<float>(centroid.pixel.x()));
       fiducial.y(static_cast<float>(centroid.pixel.y()));
@@ -172,6 +177,7 @@ class CentroidCameraComponent final : public Component {
   }
 
   SwarmScene scene_;
+  size_t marker_count_ = 0;                 // of all the scene's robots
   std::unique_ptr<CentroidCamera> camera_;  // only the capture thread uses it
   std::string frame_id_;
   std::chrono::system_clock::time_point scene_start_;

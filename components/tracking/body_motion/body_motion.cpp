@@ -74,19 +74,33 @@ BodyMotionFilter::BodyMotionFilter(const Eigen::Isometry3d& camera_from_body,
   state_.covariance.block<3, 3>(9, 9) = sw * sw * Eigen::Matrix3d::Identity();
 }
 
+Eigen::Isometry3d BodyMotionFilter::predicted_pose(int64_t stamp_ns) const {
+  const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
+  Eigen::Isometry3d pose = state_.camera_from_body;
+  if (dt == 0) return pose;
+  pose.translation() += state_.linear_velocity * dt;
+  pose.linear() = rotation_from_vector(state_.angular_velocity * dt) * pose.linear();
+  return pose;
+}
+
 BodyState BodyMotionFilter::predicted(int64_t stamp_ns) const {
   const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
   BodyState next = state_;
   next.stamp_ns = stamp_ns;
   if (dt == 0) return next;
   const Eigen::Matrix3d turn = rotation_from_vector(state_.angular_velocity * dt);
-  next.camera_from_body.translation() += state_.linear_velocity * dt;
-  next.camera_from_body.linear() = turn * state_.camera_from_body.linear();
-  Matrix12d f = Matrix12d::Identity();
-  f.block<3, 3>(0, 6) = dt * Eigen::Matrix3d::Identity();
-  f.block<3, 3>(3, 3) = turn;
-  f.block<3, 3>(3, 9) = dt * Eigen::Matrix3d::Identity();
-  next.covariance = f * state_.covariance * f.transpose();
+  next.camera_from_body = predicted_pose(stamp_ns);
+  // F P Fᵀ with F = I but for p += dt v, θ ← turn θ + dt ω, written by its 3-row and 3-column
+  // blocks: a swarm predicts each robot every frame, and the full 12 x 12 products cost ten
+  // times as much.
+  const Matrix12d& p = state_.covariance;
+  Matrix12d fp = p;
+  fp.middleRows<3>(0) += dt * p.middleRows<3>(6);
+  fp.middleRows<3>(3) = turn * p.middleRows<3>(3) + dt * p.middleRows<3>(9);
+  next.covariance = fp;
+  next.covariance.middleCols<3>(0) += dt * fp.middleCols<3>(6);
+  next.covariance.middleCols<3>(3) =
+      fp.middleCols<3>(3) * turn.transpose() + dt * fp.middleCols<3>(9);
   add_acceleration_noise(next.covariance, 0, 6, options_.linear_acceleration_density, dt);
   add_acceleration_noise(next.covariance, 3, 9, options_.angular_acceleration_density, dt);
   return next;
@@ -129,11 +143,13 @@ double BodyMotionFilter::correct(int64_t stamp_ns, const Eigen::Isometry3d& meas
       rotation_from_vector(delta.segment<3>(3)) * prior.camera_from_body.linear();
   state_.linear_velocity += delta.segment<3>(6);
   state_.angular_velocity += delta.segment<3>(9);
-  // Joseph form: stays symmetric and positive however the gain was rounded.
-  Matrix12d keep = Matrix12d::Identity();
-  keep.leftCols<6>() -= gain;
-  state_.covariance =
-      keep * prior.covariance * keep.transpose() + gain * pose_covariance * gain.transpose();
+  // Joseph form, (I − K H) P (I − K H)ᵀ + K R Kᵀ: stays symmetric and positive however the gain
+  // was rounded. With H = [I 0], (I − K H) P = P − K P's first six rows, and X Hᵀ is X's first
+  // six columns.
+  const Matrix12d& p = prior.covariance;
+  const Matrix12d kept = p - gain * p.topRows<6>();
+  const Eigen::Matrix<double, 12, 6> gain_r = gain * pose_covariance;
+  state_.covariance = kept - kept.leftCols<6>() * gain.transpose() + gain_r * gain.transpose();
   ++corrections_;
   return residual.dot(solver.solve(residual));
 }
@@ -153,12 +169,17 @@ PointMotionFilter::PointMotionFilter(const Eigen::Vector3d& position,
   state_.covariance.bottomRightCorner<3, 3>() = sv * sv * Eigen::Matrix3d::Identity();
 }
 
+Eigen::Vector3d PointMotionFilter::predicted_position(int64_t stamp_ns) const {
+  const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
+  return state_.position + state_.velocity * dt;
+}
+
 PointState PointMotionFilter::predicted(int64_t stamp_ns) const {
   const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
   PointState next = state_;
   next.stamp_ns = stamp_ns;
   if (dt == 0) return next;
-  next.position += state_.velocity * dt;
+  next.position = predicted_position(stamp_ns);
   Matrix6d f = Matrix6d::Identity();
   f.block<3, 3>(0, 3) = dt * Eigen::Matrix3d::Identity();
   next.covariance = f * state_.covariance * f.transpose();

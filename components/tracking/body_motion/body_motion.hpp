@@ -66,6 +66,8 @@ class BodyMotionFilter {
 
   // The state carried forward (or back) to `stamp_ns` by the constant-velocity model.
   BodyState predicted(int64_t stamp_ns) const;
+  // Its pose alone, without the covariance's 12 x 12 products: where to look for the body.
+  Eigen::Isometry3d predicted_pose(int64_t stamp_ns) const;
 
   // Moves the state to `stamp_ns` and corrects it with a measured pose of covariance
   // `pose_covariance`. Returns the squared Mahalanobis distance of the measurement from the
@@ -104,6 +106,8 @@ class PointMotionFilter {
                     int64_t stamp_ns, BodyMotionOptions options = {});
 
   PointState predicted(int64_t stamp_ns) const;
+  // Its position alone.
+  Eigen::Vector3d predicted_position(int64_t stamp_ns) const;
   // As BodyMotionFilter::correct, over 3 degrees of freedom.
   double correct(int64_t stamp_ns, const Eigen::Vector3d& measured,
                  const Eigen::Matrix3d& position_covariance);

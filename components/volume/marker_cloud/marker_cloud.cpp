@@ -19,10 +19,11 @@ constexpr double kUnstatedSigmaPx = 0.1;
 constexpr double kMergedSigmaFactor = 3;
 // A detection two tracks reach goes to the nearer when it is this much nearer.
 constexpr double kMuchNearer = 0.5;
-// Gauss-Newton steps at most, and the step (metres) that ends them sooner: a thousandth of a
-// millimetre, against markers placed to a tenth of one.
+// Gauss-Newton steps at most, and the step (metres) that ends them sooner: 10 um, after which
+// the point is a few percent of that (the Jacobian's error) from the solution, against markers
+// placed to a tenth of a millimetre. From a track's prediction, two passes.
 constexpr int kMaxSteps = 5;
-constexpr double kConvergedStep_m = 1e-6;
+constexpr double kConvergedStep_m = 1e-5;
 
 // What a frame computes once per camera.
 struct CameraGeometry {
@@ -34,24 +35,30 @@ struct CameraGeometry {
 };
 
 // One camera's detections by grid cell, for the detections near a pixel without looking at
-// all of them: sorted by row, then column, with where each row starts.
+// all of them: bucketed by row (a counting sort: a frame's grids cost no sort), each row's
+// cells in no order.
 class PixelGrid {
  public:
   PixelGrid(const std::vector<Eigen::Vector2d>& pixels, double cell_px)
       : pixels_(&pixels), cell_px_(cell_px) {
     if (pixels.empty()) return;
-    cells_.reserve(pixels.size());
+    std::vector<int64_t> rows(pixels.size());
+    first_row_ = std::numeric_limits<int64_t>::max();
+    int64_t last_row = std::numeric_limits<int64_t>::min();
     for (size_t i = 0; i < pixels.size(); ++i) {
-      cells_.push_back(
-          {cell_of(pixels[i].y()) * kRowLength + cell_of(pixels[i].x()), static_cast<int>(i)});
+      rows[i] = cell_of(pixels[i].y());
+      first_row_ = std::min(first_row_, rows[i]);
+      last_row = std::max(last_row, rows[i]);
     }
-    std::sort(cells_.begin(), cells_.end(),
-              [](const Cell& a, const Cell& b) { return a.key < b.key; });
-    first_row_ = row_of(cells_.front());
-    row_starts_.assign(static_cast<size_t>(row_of(cells_.back()) - first_row_) + 2, 0);
-    for (const Cell& cell : cells_)
-      ++row_starts_[static_cast<size_t>(row_of(cell) - first_row_) + 1];
+    row_starts_.assign(static_cast<size_t>(last_row - first_row_) + 2, 0);
+    for (int64_t row : rows) ++row_starts_[static_cast<size_t>(row - first_row_) + 1];
     for (size_t r = 1; r < row_starts_.size(); ++r) row_starts_[r] += row_starts_[r - 1];
+    cells_.resize(pixels.size());
+    std::vector<int> filled(row_starts_.begin(), row_starts_.end() - 1);
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      cells_[static_cast<size_t>(filled[static_cast<size_t>(rows[i] - first_row_)]++)] = {
+          cell_of(pixels[i].x()), static_cast<int>(i)};
+    }
   }
 
   // The detection nearest `at` within `radius_px` (at most the cell size) that `usable`
@@ -67,9 +74,7 @@ class PixelGrid {
       const int end = row_starts_[static_cast<size_t>(row) + 1];
       for (int k = row_starts_[static_cast<size_t>(row)]; k < end; ++k) {
         const Cell& cell = cells_[static_cast<size_t>(k)];
-        const int64_t column = cell.key - (row + first_row_) * kRowLength;
-        if (column < cx - 1) continue;
-        if (column > cx + 1) break;
+        if (cell.column < cx - 1 || cell.column > cx + 1) continue;
         const double squared = ((*pixels_)[cell.detection] - at).squaredNorm();
         if (squared <= best_squared && usable(cell.detection)) {
           best = cell.detection;
@@ -82,25 +87,24 @@ class PixelGrid {
 
  private:
   struct Cell {
-    int64_t key = 0;  // row * kRowLength + column
+    int64_t column = 0;
     int detection = 0;
   };
   // Cells far outside any image (and a pixel that is not a number) are folded onto the edge
   // cells, which keeps the row index small; lookups compare true distances, so nothing is
   // found that is not near.
-  static constexpr double kSpan = 4096;
-  static constexpr int64_t kRowLength = 4 * 4096;  // columns are in [0, 2 kSpan]
+  static constexpr int64_t kSpan = 4096;
   int64_t cell_of(double pixel) const {
-    double cell = std::floor(pixel / cell_px_);
-    if (!(cell > -kSpan)) cell = -kSpan;
-    if (!(cell < kSpan)) cell = kSpan;
-    return static_cast<int64_t>(cell + kSpan);
+    // Shifted to be positive, where truncation is the floor (std::floor is a call here).
+    const double shifted = pixel / cell_px_ + static_cast<double>(kSpan);
+    if (!(shifted > 0)) return -kSpan;
+    if (!(shifted < static_cast<double>(2 * kSpan))) return kSpan;
+    return static_cast<int64_t>(shifted) - kSpan;
   }
-  static int64_t row_of(const Cell& cell) { return cell.key / kRowLength; }
 
   const std::vector<Eigen::Vector2d>* pixels_;
   double cell_px_;
-  std::vector<Cell> cells_;  // sorted by key: by row, then column
+  std::vector<Cell> cells_;  // by row
   int64_t first_row_ = 0;
   std::vector<int> row_starts_;  // row r's cells: [row_starts_[r], row_starts_[r + 1])
 };
@@ -124,10 +128,13 @@ struct Fit {
 // themselves go through the camera's model). The errors and the covariance are those of the
 // last point evaluated: the result itself when the steps run out, a step of less than
 // kConvergedStep_m back when they converge (no pass over the cameras for a change in the
-// errors far below a thousandth of a pixel).
+// errors far below a thousandth of a pixel). `start_pixels`, when given, are `start`'s
+// projections in the observations' cameras, in their order: a track's prediction, projected
+// already to find its detections.
 Fit fit_point(const std::vector<CameraGeometry>& geometry,
               const std::vector<CameraDetections>& cameras,
-              const std::vector<Observation>& observations, const Eigen::Vector3d& start) {
+              const std::vector<Observation>& observations, const Eigen::Vector3d& start,
+              const Eigen::Vector2d* start_pixels = nullptr) {
   Fit fit;
   fit.position = start;
   fit.errors_px.resize(observations.size());
@@ -145,7 +152,8 @@ Fit fit_point(const std::vector<CameraGeometry>& geometry,
       const CameraGeometry& camera = geometry[o.camera];
       const Eigen::Vector3d in_camera = camera.camera_from_world * fit.position;
       if (in_camera.z() <= 0) return fit;
-      const std::optional<Eigen::Vector2d> pixel = camera.model->project(in_camera);
+      const std::optional<Eigen::Vector2d> pixel =
+          step == 0 && start_pixels ? start_pixels[k] : camera.model->project(in_camera);
       if (!pixel) return fit;
       const Eigen::Vector2d error_px = *pixel - cameras[o.camera].pixels[o.detection];
       fit.errors_px[k] = error_px.norm();
@@ -179,15 +187,17 @@ int cameras_in(const std::vector<Observation>& observations) {
 }
 
 // fit_point, the observations further than `tolerance_px` off left out one by one, worst first,
-// while `min_cameras` remain; an invalid fit when fewer do.
+// while `min_cameras` remain; an invalid fit when fewer do. `start_pixels` as fit_point's.
 Fit fit_consistent(const std::vector<CameraGeometry>& geometry,
                    const std::vector<CameraDetections>& cameras,
                    std::vector<Observation>& observations, const Eigen::Vector3d& start,
-                   double tolerance_px, int min_cameras) {
+                   double tolerance_px, int min_cameras,
+                   const Eigen::Vector2d* start_pixels = nullptr) {
   Fit fit;
   Eigen::Vector3d from = start;
   while (cameras_in(observations) >= min_cameras) {
-    fit = fit_point(geometry, cameras, observations, from);
+    fit = fit_point(geometry, cameras, observations, from, start_pixels);
+    start_pixels = nullptr;  // the next fit starts from this one's point
     if (!fit.valid) return fit;
     const auto worst = std::max_element(fit.errors_px.begin(), fit.errors_px.end());
     if (*worst <= tolerance_px) return fit;
@@ -286,6 +296,7 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
   };
   std::vector<Claims> claims(camera_count);
   std::vector<Eigen::Vector3d> predictions(tracks_.size());
+  std::vector<Eigen::Vector2d> projected(tracks_.size() * camera_count);  // where d is nearest
   for (size_t c = 0; c < camera_count; ++c) {
     claims[c].best_px.assign(cameras[c].pixels.size(), infinity);
     claims[c].second_px.assign(cameras[c].pixels.size(), infinity);
@@ -304,6 +315,7 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
       const int d = grids[c].nearest(*pixel, options_.gate_px, [](int) { return true; });
       if (d < 0) continue;
       nearest[t * camera_count + c] = d;
+      projected[t * camera_count + c] = *pixel;
       Claims& claim = claims[c];
       const double off = (cameras[c].pixels[d] - *pixel).norm();
       if (off < claim.best_px[d]) {
@@ -326,12 +338,16 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
     median_sigma[c] = sigmas[sigmas.size() / 2];
   }
   std::vector<char> observed(tracks_.size(), 0);
+  std::vector<Observation> observations;
+  std::vector<Eigen::Vector2d> predicted_pixels;
   for (size_t t = 0; t < tracks_.size(); ++t) {
-    std::vector<Observation> observations;
+    observations.clear();
+    predicted_pixels.clear();
     for (size_t c = 0; c < camera_count; ++c) {
       const int d = nearest[t * camera_count + c];
       if (d >= 0 && claims[c].held_by(static_cast<size_t>(d), static_cast<int>(t))) {
         observations.push_back({static_cast<int>(c), d});
+        predicted_pixels.push_back(projected[t * camera_count + c]);
       }
     }
     if (cameras_in(observations) < 2) continue;
@@ -348,8 +364,8 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
       for (const Observation& o : observations) taken[o.camera][o.detection] = 1;
       continue;
     }
-    const Fit fit =
-        fit_consistent(geometry, cameras, observations, predictions[t], options_.tolerance_px, 2);
+    const Fit fit = fit_consistent(geometry, cameras, observations, predictions[t],
+                                   options_.tolerance_px, 2, predicted_pixels.data());
     if (!fit.valid) continue;
     update(tracks_[t], stamp_ns, fit.position);
     observed[t] = 1;

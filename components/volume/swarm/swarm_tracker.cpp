@@ -346,9 +346,9 @@ std::vector<SwarmRobotPose> SwarmTracker::track(int64_t stamp_ns,
     }
     Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
     if (robot.body) {
-      start = robot.body->predicted(stamp_ns).camera_from_body;
+      start = robot.body->predicted_pose(stamp_ns);
     } else {
-      start.translation() = robot.point->predicted(stamp_ns).position;
+      start.translation() = robot.point->predicted_position(stamp_ns);
     }
     // The position's variance a white-noise acceleration of density q adds over dt: q dt³ / 3.
     const double dt_s = static_cast<double>(stamp_ns - robot.stamp_ns) * 1e-9;

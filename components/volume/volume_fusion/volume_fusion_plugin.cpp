@@ -398,22 +398,22 @@ class VolumeFusion final : public Component {
       message->poses().push_back(std::move(pose));
       report_single_camera(body, assembled.stamp_ns);
     }
-    std::shared_ptr<PointCloud2> markers =
+    const std::vector<LabeledMarker> markers =
         track_markers(assembled.stamp_ns, frame, poses, *message);
+    const std_msgs::msg::Header header = message->header();
     body_poses_ += poses.size();
     poses_.publish(std::move(message));
-    markers_.publish(std::move(markers));
+    markers_.publish(std::make_shared<PointCloud2>(to_point_cloud(header, markers)));
     report_unposed(poses, assembled.stamp_ns);
     report_drift();
   }
 
   // The marker cloud of every camera's detections; the bodies' markers in it labeled, the
-  // robots tracked in the rest and added to `message`; the cloud's message, published after
-  // the poses (which it would otherwise delay).
-  std::shared_ptr<PointCloud2> track_markers(int64_t stamp_ns,
-                                             const std::vector<CameraFrame>& frame,
-                                             const std::vector<TrackedBodyPose>& poses,
-                                             ConstellationPoseArray& message) {
+  // robots tracked in the rest and added to `message`; the cloud, published after the poses
+  // (which its message would otherwise delay).
+  std::vector<LabeledMarker> track_markers(int64_t stamp_ns, const std::vector<CameraFrame>& frame,
+                                           const std::vector<TrackedBodyPose>& poses,
+                                           ConstellationPoseArray& message) {
     std::vector<CameraDetections> detections;
     for (size_t c = 0; c < frame.size(); ++c) {
       const VolumeCamera& camera = tracker_.cameras()[c];
@@ -474,7 +474,7 @@ class VolumeFusion final : public Component {
                          static_cast<uint16_t>(owners[m].marker), cloud[m].id,
                          static_cast<float>(cloud[m].rms_px), cloud[m].cameras});
     }
-    return std::make_shared<PointCloud2>(to_point_cloud(message.header(), labeled));
+    return labeled;
   }
 
   void reseed(const NamedPoseArray& array) {
