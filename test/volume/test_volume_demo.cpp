@@ -355,5 +355,33 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
 }
 
+// The swarm demo as the README runs it (launch_yaml/swarm_demo.yaml: 100 robots, 50 of them
+// identical quadrotors, 8 camera processes sending centroids at 240 Hz, pairs crossing 5 cm
+// apart every 2 s and two exchanging places every 4 s), 20 s of it: every robot under its own
+// name (no identity swap, no false identification), each where it is to a tenth of a millimetre
+// and a fifth of a degree (the figures). Tracked: 99.93 % and 99.97 % in 60 s runs on a
+// quiet machine; here beside another real-time test, at least 99 % (swarm_bench holds the
+// scenes to 99.9 % with no clock in the way).
+TEST(VolumeDemo, TheSwarmDemosHundredRobotsKeepTheirNames) {
+  test::TempDir dir;
+  const auto summary = dir / "summary.yaml";
+  auto [code, output] =
+      test::run_command({(test::bin_dir() / "mocap_launch").string(),
+                         (test::source_dir() / "launch_yaml" / "swarm_demo.yaml").string(),
+                         "--duration", "20", "--set", "evaluator.summary_file=" + summary.string(),
+                         "--set", "viewer.port=0", "--set", "evaluator.skip_first_s=1"},
+                        environment(84), std::chrono::seconds(90));
+  ASSERT_EQ(code, 0) << output;
+  const Figures figures = read_figures(summary);
+  std::printf("%s", test::read_file(summary).c_str());
+  EXPECT_EQ(figures.node["robots"].as<int>(), 100);
+  EXPECT_GT(figures.node["frames"].as<int>(), 4000) << output;  // 240 Hz, less the start
+  EXPECT_EQ(figures.node["identity_swaps"].as<int>(), 0) << output;
+  EXPECT_EQ(figures.false_identifications(), 0) << output;
+  EXPECT_GE(figures.tracked_share(), 0.99) << test::read_file(summary);
+  EXPECT_LE(figures.node["position_error_median_m"].as<double>(), 1e-4);
+  EXPECT_LE(figures.node["orientation_error_median_deg"].as<double>(), 0.2);
+}
+
 }  // namespace
 }  // namespace mocap
