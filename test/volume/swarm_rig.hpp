@@ -153,7 +153,8 @@ inline SwarmFigures track_swarm(const synthetic::SwarmScene& scene, SwarmRig& ri
     for (int f : fused) {
       const double time_s = f / rate_hz;
       const auto stamp_ns = static_cast<int64_t>(std::llround(time_s * 1e9));
-      std::vector<CameraDetections> seen = rig.frame(scene, time_s);
+      const std::vector<Eigen::Vector3d> true_markers = scene.markers(time_s);
+      std::vector<CameraDetections> seen = rig.frame(true_markers, scene.occluders);
       for (CameraDetections& camera : seen) {
         if (uniform(random) >= overload.camera_late_fraction) continue;
         camera.pixels.clear();
@@ -161,7 +162,6 @@ inline SwarmFigures track_swarm(const synthetic::SwarmScene& scene, SwarmRig& ri
       }
       const std::vector<CloudMarker> markers = cloud.track(stamp_ns, seen);
       const std::vector<SwarmRobotPose> poses = swarm.track(stamp_ns, markers);
-      const std::vector<Eigen::Vector3d> true_markers = scene.markers(time_s);
       figures.cloud_markers += static_cast<int64_t>(markers.size());
       for (const CloudMarker& marker : markers) {
         figures.ghost_markers += std::none_of(

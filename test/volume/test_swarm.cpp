@@ -28,6 +28,18 @@ test::SwarmRig eight_cameras(uint64_t seed = 1) {
   return test::SwarmRig((mocap::test::source_dir() / "config").string(), 8, options, seed);
 }
 
+// Why a scene file's text is refused ("scene.yaml:LINE: ..."); empty, and a failure, when it is
+// accepted.
+std::string refusal_of(const std::string& text) {
+  try {
+    synthetic::parse_swarm_scene(text, "scene.yaml");
+  } catch (const synthetic::SwarmSceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return "";
+}
+
 // The swarm issue's targets.
 void expect_targets(const test::SwarmFigures& figures, bool oriented) {
   fmt::print(
@@ -136,13 +148,9 @@ TEST(SwarmScene, AHoldKeepsEveryRobotWhereItsFlightStarts) {
   }
   // Without the hold, 1.2 s in, the first robot has flown more than half way to the other end.
   EXPECT_GT((flying.pose(0, 1.2).translation() - flying.pose(0, 0).translation()).norm(), 0.6);
-  try {
-    synthetic::parse_swarm_scene("hold_s: -1\n" + flights, "scene.yaml");
-    ADD_FAILURE() << "a negative hold accepted";
-  } catch (const synthetic::SwarmSceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.yaml:1:"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("hold_s"), std::string::npos) << e.what();
-  }
+  const std::string negative = refusal_of("hold_s: -1\n" + flights);
+  EXPECT_NE(negative.find("scene.yaml:1:"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("hold_s"), std::string::npos) << negative;
 }
 
 // Occluders stand where the file puts them; one without its radius is refused on its line.
@@ -158,13 +166,9 @@ TEST(SwarmScene, OccludersStandWhereTheFileSays) {
   EXPECT_EQ(pillared.occluders[0].radius_m, 0.3);
   EXPECT_EQ(pillared.shifted(Eigen::Vector3d(1, 0, 0)).occluders[0].centre,
             Eigen::Vector3d(1, 0.5, 1));
-  try {
-    synthetic::parse_swarm_scene("occluders:\n  - {centre: [0, 0.5, 1]}\n" + flights, "scene.yaml");
-    ADD_FAILURE() << "an occluder without a radius accepted";
-  } catch (const synthetic::SwarmSceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("scene.yaml:2:"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("radius_m"), std::string::npos) << e.what();
-  }
+  const std::string no_radius = refusal_of("occluders:\n  - {centre: [0, 0.5, 1]}\n" + flights);
+  EXPECT_NE(no_radius.find("scene.yaml:2:"), std::string::npos) << no_radius;
+  EXPECT_NE(no_radius.find("radius_m"), std::string::npos) << no_radius;
 }
 
 TEST(SwarmScene, AFileThatCannotBeFlownIsRefusedWithOneLineNamingIt) {
@@ -186,12 +190,8 @@ TEST(SwarmScene, AFileThatCannotBeFlownIsRefusedWithOneLineNamingIt) {
        "scene.yaml:5: robot 'robot_01' is named twice: give the group its own prefix"},
   };
   for (const auto& [text, expected] : cases) {
-    try {
-      synthetic::parse_swarm_scene(text, "scene.yaml");
-      ADD_FAILURE() << "accepted:\n" << text;
-    } catch (const synthetic::SwarmSceneError& e) {
-      EXPECT_EQ(std::string(e.what()).substr(0, expected.size()), expected) << e.what();
-    }
+    const std::string refusal = refusal_of(text);
+    EXPECT_EQ(refusal.substr(0, expected.size()), expected) << refusal;
   }
 }
 

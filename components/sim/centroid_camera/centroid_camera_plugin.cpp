@@ -108,10 +108,10 @@ class CentroidCameraComponent final : public Component {
     create_worker("capture", [this, period](std::stop_token stop) {
       capture_on_the_clock(period, stop, [this](Clock::time_point capture) { frame(capture); });
     });
-    for (const SwarmSceneRobot& robot : scene_.robots) marker_count_ += robot.markers.size();
+    size_t markers = 0;
+    for (const SwarmSceneRobot& robot : scene_.robots) markers += robot.markers.size();
     log().info("{} robots ({} markers) of {} seen from {} at {} Hz on {}", scene_.robots.size(),
-               marker_count_, settings_.scene, settings_.camera, settings_.rate_hz,
-               fiducials_.topic());
+               markers, settings_.scene, settings_.camera, settings_.rate_hz, fiducials_.topic());
   }
 
  private:
@@ -123,7 +123,6 @@ class CentroidCameraComponent final : public Component {
     std::vector<Eigen::Vector3d> markers;
     std::vector<OccludingSphere> hiding = scene_.occluders;  // and each robot, below
     poses.reserve(scene_.robots.size());
-    markers.reserve(marker_count_);
     hiding.reserve(hiding.size() + scene_.robots.size());
     for (size_t r = 0; r < scene_.robots.size(); ++r) {
       poses.push_back(scene_.pose(r, time_s));
@@ -177,7 +176,6 @@ class CentroidCameraComponent final : public Component {
   }
 
   SwarmScene scene_;
-  size_t marker_count_ = 0;                 // of all the scene's robots
   std::unique_ptr<CentroidCamera> camera_;  // only the capture thread uses it
   std::string frame_id_;
   std::chrono::system_clock::time_point scene_start_;

@@ -74,13 +74,22 @@ BodyMotionFilter::BodyMotionFilter(const Eigen::Isometry3d& camera_from_body,
   state_.covariance.block<3, 3>(9, 9) = sw * sw * Eigen::Matrix3d::Identity();
 }
 
+namespace {
+
+// The state's pose `dt` on, `turn` the rotation its angular velocity makes in that time.
+Eigen::Isometry3d moved_on(const BodyState& state, double dt, const Eigen::Matrix3d& turn) {
+  Eigen::Isometry3d pose = state.camera_from_body;
+  pose.translation() += state.linear_velocity * dt;
+  pose.linear() = turn * pose.linear();
+  return pose;
+}
+
+}  // namespace
+
 Eigen::Isometry3d BodyMotionFilter::predicted_pose(int64_t stamp_ns) const {
   const double dt = static_cast<double>(stamp_ns - state_.stamp_ns) * 1e-9;
-  Eigen::Isometry3d pose = state_.camera_from_body;
-  if (dt == 0) return pose;
-  pose.translation() += state_.linear_velocity * dt;
-  pose.linear() = rotation_from_vector(state_.angular_velocity * dt) * pose.linear();
-  return pose;
+  if (dt == 0) return state_.camera_from_body;
+  return moved_on(state_, dt, rotation_from_vector(state_.angular_velocity * dt));
 }
 
 BodyState BodyMotionFilter::predicted(int64_t stamp_ns) const {
@@ -89,7 +98,7 @@ BodyState BodyMotionFilter::predicted(int64_t stamp_ns) const {
   next.stamp_ns = stamp_ns;
   if (dt == 0) return next;
   const Eigen::Matrix3d turn = rotation_from_vector(state_.angular_velocity * dt);
-  next.camera_from_body = predicted_pose(stamp_ns);
+  next.camera_from_body = moved_on(state_, dt, turn);
   // F P Fᵀ with F = I but for p += dt v, θ ← turn θ + dt ω, written by its 3-row and 3-column
   // blocks: a swarm predicts each robot every frame, and the full 12 x 12 products cost ten
   // times as much.

@@ -544,7 +544,7 @@ std::vector<CloudMarker> MarkerCloudTracker::track(int64_t stamp_ns,
   // 3. What no marker explains, and tracks given up.
   for (size_t c = 0; c < camera_count; ++c) {
     for (size_t d = 0; d < taken[c].size(); ++d) {
-      if (!taken[c][d] && !claims[c].merged(d)) ++counts_.unexplained;
+      if (!taken[c][d]) ++counts_.unexplained;  // merged blobs were taken before step 2
     }
   }
   size_t kept = 0;
