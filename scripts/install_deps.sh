@@ -48,6 +48,9 @@ test=(
   debootstrap
   # benchmarks: instruction counts
   valgrind
+  # a camera host's clock shifted for the clock check's tests; chrony to check the
+  # synchronisation configurations the README gives
+  faketime chrony
   # containers: the engine and compose, for scripts/docker_test.sh
   docker.io docker-compose
 )

@@ -20,7 +20,10 @@
 #                                CN=NAME, signed by the CA)
 #   NAME.permissions.xml, .smime what NAME may do, signed by the CA: publish and subscribe to
 #                                every topic of every domain; with --subscribe-only NAME,
-#                                subscribe only. Anything else is denied.
+#                                subscribe only, but for its process's health: its statuses
+#                                (rt/diagnostics) and its clock's answers to probes
+#                                (rt/mocap/clock/reply), which every process of mocap_launch
+#                                publishes. Anything else is denied.
 #
 # A launch file uses it with `dds: {security: {directory: OUT_DIR, identity: NAME}}`.
 #
@@ -176,8 +179,9 @@ EOF
 }
 publish='        <publish><topics><topic>*</topic></topics></publish>'
 subscribe='        <subscribe><topics><topic>*</topic></topics></subscribe>'
+health='        <publish><topics><topic>rt/diagnostics</topic><topic>rt/mocap/clock/reply</topic></topics></publish>'
 for name in "${publishers[@]}"; do permissions "$name" "$publish"$'\n'"$subscribe"; done
-for name in "${subscribers[@]}"; do permissions "$name" "$subscribe"; done
+for name in "${subscribers[@]}"; do permissions "$name" "$health"$'\n'"$subscribe"; done
 chmod 644 ./*.cert.pem ./*.xml ./*.smime
 
 made="${publishers[*]}"

@@ -839,5 +839,79 @@ TEST(ComponentHostHealth, AHealthFileThatCannotBeWrittenStopsTheStart) {
   }
 }
 
+// Health (mocap/health.hpp): each component's report_health() runs once a second on its own
+// strand, never beside its callbacks, and process_health() gives every component of the process
+// with the runtime's counts of its topics.
+struct HealthRecord {
+  std::atomic<bool> in_callback{false};
+  std::atomic<int> overlaps{0};
+  std::atomic<int> reports{0};
+  std::mutex mutex;
+  std::vector<ComponentHealth> seen;
+} health_record;
+
+class Reporter final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit Reporter(Context& context) : Component(context) {
+    create_timer(std::chrono::microseconds(300), [this] {
+      health_record.in_callback = true;
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+      ++ticks_;
+      health_record.in_callback = false;
+    });
+  }
+  void report_health(HealthReport& report) override {
+    if (health_record.in_callback) ++health_record.overlaps;
+    ++health_record.reports;
+    report.add("ticks", std::to_string(ticks_));
+    report.flag(HealthLevel::warn, "a test's warning");
+  }
+
+ private:
+  int ticks_ = 0;
+};
+
+class HealthWatcher final : public Component {
+ public:
+  static void declare(ComponentSpec&) {}
+  explicit HealthWatcher(Context& context) : Component(context) {
+    create_timer(std::chrono::milliseconds(2500), [this] {
+      std::lock_guard lock(health_record.mutex);
+      health_record.seen = this->context().process_health();
+      request_shutdown(0);
+    });
+  }
+};
+
+TEST_F(ComponentHostTest, EachComponentReportsItsHealthOnItsStrandWithTheRuntimesCounts) {
+  ComponentHost host({.name = "healthy", .threads = 4, .dds = {.enabled = false}});
+  host.add(kSource, {.name = "source"});
+  host.add(kSink, {.name = "sink", .parameters = {{"expect", int64_t{1000}}}});
+  host.add(make_component_factory<Reporter>("reporter"), {.name = "reporter"});
+  host.add(make_component_factory<HealthWatcher>("watcher"), {.name = "watcher"});
+  EXPECT_EQ(host.run(std::chrono::seconds(30)), 0);
+  EXPECT_EQ(health_record.overlaps, 0);
+  EXPECT_GE(health_record.reports, 2);
+  std::lock_guard lock(health_record.mutex);
+  ASSERT_EQ(health_record.seen.size(), 4u);
+  const ComponentHealth& source = health_record.seen[0];
+  EXPECT_EQ(source.name, "source");
+  EXPECT_EQ(source.plugin, "source");
+  ASSERT_EQ(source.published.size(), 1u);
+  EXPECT_EQ(source.published[0].topic, "/numbers");
+  EXPECT_EQ(source.published[0].messages, 50u);
+  const ComponentHealth& sink = health_record.seen[1];
+  ASSERT_EQ(sink.received.size(), 1u);
+  EXPECT_EQ(sink.received[0].messages, 50u);
+  const ComponentHealth& reporter = health_record.seen[2];
+  EXPECT_EQ(reporter.report.level, HealthLevel::warn);
+  EXPECT_EQ(reporter.report.message, "a test's warning");
+  ASSERT_EQ(reporter.report.values.size(), 1u);
+  EXPECT_EQ(reporter.report.values[0].first, "ticks");
+  EXPECT_GT(std::stoi(reporter.report.values[0].second), 100);
+  EXPECT_NE(reporter.reported_at, std::chrono::steady_clock::time_point{});
+}
+
 }  // namespace
 }  // namespace mocap

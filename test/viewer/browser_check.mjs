@@ -9,7 +9,8 @@
 // bridge asking for a token the URL lacks) it checks that the page says it is disconnected;
 // with --tf (a bridge offering /tf but not /mocap/poses), that the top view draws the boards;
 // with --volume (a volume of cameras), every camera's image with its fiducials and the volume
-// from above with the cameras, their views and the bodies; with --swarm COUNT (a volume whose
+// from above with the cameras, their views and the bodies, and every status of /diagnostics OK;
+// with --swarm COUNT (a volume whose
 // cameras send centroids), the volume from above with its cameras from /tf, COUNT robots and
 // at least as many markers of the cloud, and no camera panel.
 // HTTPS certificates are not checked (the TLS test's is self-signed). One line per check; exit 0
@@ -66,6 +67,11 @@ try {
       `${seen.volumeCirclesDrawn[c]} fiducials`).join("; ")}`);
     check(true, `from above: ${seen.volumeConesDrawn} cameras with their views, ${seen.volumeBodiesDrawn} bodies`);
     check(await page.isHidden("#camera-section"), "the single camera's panel is hidden");
+    // The health panel: every process and component of the demo (5 processes, 17 components
+    // with their diagnostics), all OK.
+    const healthy = await snapshot(page, (s) => Object.keys(s?.healthRows ?? {}).length >= 22 &&
+      Object.values(s.healthRows).every((level) => level === "OK"), 30000);
+    check(true, `health: ${Object.keys(healthy.healthRows).length} statuses, all OK`);
     await page.waitForTimeout(1000);
     await page.screenshot({ path: screenshot, fullPage: true });
     check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);

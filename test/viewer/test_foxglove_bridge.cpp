@@ -303,6 +303,37 @@ TEST_F(FoxgloveBridgeTest, RosOwnDefinitionsDecodeTheStandardOutputs) {
   EXPECT_GE(transforms, 10);
 }
 
+// /diagnostics as ROS 2 publishes it: decoded with ROS 2's own diagnostic_msgs, a status for the
+// process and for each of the demo's components, all OK, with the runtime's rates and the
+// stages' latencies.
+TEST_F(FoxgloveBridgeTest, RosOwnDefinitionsDecodeTheDiagnostics) {
+  auto messages = receive(3, {"/diagnostics"}, true);
+  EXPECT_EQ(decoded_with_["/diagnostics"], "ros2humble");
+  ASSERT_GE(messages["/diagnostics"].size(), 3u);
+  const json& array = messages["/diagnostics"].back();
+  std::map<std::string, json> statuses;
+  for (const json& status : array["status"]) statuses[status["name"]] = status;
+  for (const char* name : {"robot", "robot/camera", "robot/tracker", "robot/boards",
+                           "robot/ros_outputs", "robot/servos", "robot/turret", "robot/drive",
+                           "robot/base", "robot/monitor", "robot/viewer", "robot/diagnostics"}) {
+    ASSERT_TRUE(statuses.count(name)) << name << " in " << array.dump();
+    EXPECT_EQ(statuses[name]["level"], 0) << statuses[name].dump();
+    EXPECT_EQ(statuses[name]["message"], "OK") << statuses[name].dump();
+  }
+  auto value = [](const json& status, const std::string& key) -> std::string {
+    for (const json& pair : status["values"]) {
+      if (pair["key"] == key) return pair["value"];
+    }
+    return "(none)";
+  };
+  EXPECT_EQ(value(statuses["robot"], "restarts"), "0");
+  // The camera's 30 Hz, and its fiducials' latency from the capture stamp.
+  EXPECT_NEAR(std::stod(value(statuses["robot/camera"], "out /camera/ir/image_raw (msg/s)")), 30, 3)
+      << statuses["robot/camera"].dump();
+  EXPECT_GT(std::stod(value(statuses["robot/tracker"], "capture -> fiducials sent median (ms)")), 0)
+      << statuses["robot/tracker"].dump();
+}
+
 TEST_F(FoxgloveBridgeTest, ClientsThatBreakTheProtocolAreClosedWithTheReason) {
   auto [code, output] = test::run_command(
       {"node", (viewer_tests() / "bad_clients.mjs").string(), url()}, {}, std::chrono::seconds(60));
@@ -566,9 +597,10 @@ TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
 }
 
 // launch_yaml/volume_demo.yaml as shipped: the page shows each of the four cameras' images with
-// their fiducials side by side, and the volume from above with the cameras, their views and the
-// four boards. Screenshot: MOCAP_VIEWER_SCREENSHOT with "_volume" before the extension, else the
-// test's folder (docs/viewer_volume.png is made this way).
+// their fiducials side by side, the volume from above with the cameras, their views and the
+// four boards, and the health of every process and component (/diagnostics), all OK. Screenshot:
+// MOCAP_VIEWER_SCREENSHOT with "_volume" before the extension, else the test's folder
+// (docs/viewer_volume.png is made this way).
 TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
   test::TempDir dir;
   const int port = free_port();
@@ -592,6 +624,7 @@ TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
   EXPECT_EQ(code, 0) << page << graph.output();
   EXPECT_NE(page.find("PASS from above: 4 cameras with their views, 4 bodies"), std::string::npos)
       << page;
+  EXPECT_NE(page.find("PASS health: 22 statuses, all OK"), std::string::npos) << page;
 }
 
 // The swarm demo as shipped (100 robots, 8 cameras that send centroids at 240 Hz): no camera

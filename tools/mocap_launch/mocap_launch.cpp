@@ -22,6 +22,8 @@
 
 namespace {
 
+constexpr const char* kDiagnosticsPlugin = "diagnostics";
+
 constexpr const char* kUsage = R"(usage:
   mocap_launch FILE [--group NAME] [--set COMPONENT.PARAM=VALUE]... [--duration SECONDS]
                [--health-file PATH] [--check]
@@ -48,7 +50,9 @@ the others go on. Its launch-file keys change that: `respawn: false` leaves it d
 `required: true` ends the deployment. One that dies 5 times within 60 s is given up on. A
 group that exits with code 0 ends the deployment, as does one that fails while starting.
 Restarts and give-ups are logged and published on /alerts (mocap_msgs/Alert) by this process's
-DDS participant "launch".
+DDS participant "launch"; a restarted group's /diagnostics say how many times it was restarted.
+Every group gets a `diagnostics` component (its statuses on /diagnostics once a second, its
+clock for the fusion's clock check) unless the file gives it one.
 Exit code: 0, or that of the first group that failed for good (128 + N for signal N): it
 failed to start, a required group died, or one was given up on or not restarted.
 )";
@@ -81,9 +85,19 @@ std::string describe(const mocap::LoadedPlugin& plugin) {
   return out;
 }
 
+// Every group publishes its statuses on /diagnostics and answers clock probes (the
+// diagnostics plugin), unless the file gives it one of its own.
+void add_diagnostics(mocap::ComponentHost& host, const mocap::LaunchGroup& group,
+                     mocap::PluginLoader& plugins) {
+  for (const mocap::LaunchComponent& component : group.components) {
+    if (component.plugin->name == kDiagnosticsPlugin) return;
+  }
+  host.add(*plugins.load(kDiagnosticsPlugin).factory, {.name = kDiagnosticsPlugin});
+}
+
 int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
-              std::optional<double> duration, const std::string& health_file,
-              mocap::SupervisorReadyNotice& ready) {
+              mocap::PluginLoader& plugins, std::optional<double> duration,
+              const std::string& health_file, mocap::SupervisorReadyNotice& ready) {
   try {
     mocap::ComponentHost host(
         {group.name, group.threads, file.dds_of(group), mocap::known_topics(file), health_file});
@@ -95,6 +109,7 @@ int run_group(const mocap::LaunchFile& file, const mocap::LaunchGroup& group,
         return 1;
       }
     }
+    add_diagnostics(host, group, plugins);
     host.start();
     ready.started();
     std::optional<std::chrono::duration<double>> run_for;
@@ -270,6 +285,8 @@ int main(int argc, char** argv) {
              .c_str(),
          0);
   if (!group && launch.groups.size() == 1) group = &launch.groups.front();
-  if (group) return run_group(launch, *group, options.duration, options.health_file, ready);
+  if (group) {
+    return run_group(launch, *group, plugins, options.duration, options.health_file, ready);
+  }
   return run_groups(launch, options);
 }

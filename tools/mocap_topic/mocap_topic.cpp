@@ -24,6 +24,7 @@
 #include "host/plugin_loader.hpp"
 #include "messages/cdr_format.hpp"
 #include "messages/idl_schema.hpp"
+#include "mocap_topic/doctor_run.hpp"
 
 namespace {
 
@@ -32,7 +33,9 @@ constexpr const char* kUsage = R"(usage:
   mocap_topic echo TOPIC [--count N] [--full] [--idl FILE]...
   mocap_topic hz TOPIC [--window N] [--count N]
   mocap_topic reseed ROBOT X Y Z [--topic TOPIC] [--wait SECONDS]
-options for all: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
+  mocap_topic doctor [LAUNCH_FILE] [--seconds S] [--domains LIST]
+                     [--security DIR --identity NAME]
+options for all: --domain ID (default: MOCAP_DOMAIN_ID, else the launch file's, else 0)
 
   list   topics seen on the domain, with their types and endpoint counts, and each
          publisher/subscriber pair that cannot connect (QoS or type) and why
@@ -43,6 +46,17 @@ options for all: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
   reseed tell the volume a swarm robot was carried to (X, Y, Z) (world frame, metres): it is
          looked for there; published on /mocap/reseed (--topic) once the fusion listens,
          waiting up to --wait seconds (default 5)
+  doctor why you see nothing: listens for S seconds (default 4) and prints one line per
+         finding, each problem with what to do: the processes up and their hosts; participants
+         on other domains (it listens to the discovery traffic of domains 0 to 9 and the
+         graph's; --domains 0-20,42 for others; a Cyclone DDS participant announces itself
+         every 30 s once started, Fast DDS every 3 s); participants that use DDS Security
+         (--security and --identity: credentials from scripts/make_security.sh, to see their
+         topics); publishers and subscribers that cannot connect (type, QoS); each process's
+         clock against this host's; every /diagnostics status that is not OK, and processes
+         whose diagnostics stopped. With LAUNCH_FILE, also its groups that do not run and its
+         topics without a writer or a reader. ("all well" when nothing is wrong; mocap-graph
+         uses no DDS partitions.) Exit code: 0 all well, 1 problems found, 2 it cannot run.
 )";
 
 [[noreturn]] void usage_error(std::string_view message) {
@@ -284,6 +298,24 @@ int reseed(mocap::DdsTransport& transport, const std::string& topic, const std::
 
 }  // namespace
 
+// "0-9,42" -> 0..9 and 42.
+std::vector<int> parse_domains(const std::string& text) {
+  std::vector<int> domains;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    const size_t dash = item.find('-');
+    const size_t first = parse_number("--domains", item.substr(0, dash), 0, 232);
+    const size_t last = dash == std::string::npos
+                            ? first
+                            : parse_number("--domains", item.substr(dash + 1), first, 232);
+    for (size_t d = first; d <= last; ++d) domains.push_back(static_cast<int>(d));
+    start = comma + 1;
+  }
+  return domains;
+}
+
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) usage_error("no command given");
@@ -299,6 +331,7 @@ int main(int argc, char** argv) {
   std::optional<double> wait_seconds;  // list: 1.5, reseed: 5
   bool full = false;
   std::vector<std::string> idl_files;
+  mocap::doctor::DoctorCommand doctor;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& arg = args[i];
     auto value = [&]() -> const std::string& {
@@ -315,6 +348,14 @@ int main(int argc, char** argv) {
       wait_seconds = std::atof(value().c_str());
     } else if (arg == "--topic" && command == "reseed") {
       topic = value();
+    } else if (arg == "--seconds" && command == "doctor") {
+      doctor.seconds = static_cast<double>(parse_number(arg, value(), 1, 600));
+    } else if (arg == "--domains" && command == "doctor") {
+      doctor.domains = parse_domains(value());
+    } else if (arg == "--security" && command == "doctor") {
+      doctor.security_directory = value();
+    } else if (arg == "--identity" && command == "doctor") {
+      doctor.security_identity = value();
     } else if (arg == "--full") {
       full = true;
     } else if (arg == "--idl") {
@@ -335,13 +376,22 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 3; ++i) position[i] = parse_coordinate(positional[i + 1]);
     if (!topic) topic = "/mocap/reseed";
   }
-  if (command != "list" && !topic) usage_error(fmt::format("{} needs a TOPIC", command));
+  if (command != "list" && command != "doctor" && !topic) {
+    usage_error(fmt::format("{} needs a TOPIC", command));
+  }
+  if (doctor.security_directory.empty() != doctor.security_identity.empty()) {
+    usage_error("--security and --identity go together");
+  }
   if (domain) setenv("MOCAP_DOMAIN_ID", std::to_string(*domain).c_str(), 1);
 
   mocap::ShutdownSignal::install();
   mocap::generated_message_types();  // registers the known types for echo
   for (const std::string& error : mocap::PluginLoader().load_message_libraries()) {
     fmt::print(stderr, "mocap_topic: {}\n", error);  // its types stay unknown: echo says so
+  }
+  if (command == "doctor") {
+    doctor.launch_file = topic;
+    return mocap::doctor::run_doctor(doctor);
   }
   try {
     auto dds = mocap::make_dds_transport(mocap::DdsOptions{}, "mocap_topic");

@@ -46,6 +46,11 @@ inline constexpr const char* kCmdVel = "/cmd_vel";                         // ge
 inline constexpr const char* kBasePose = "/base/pose";                     // PoseStamped, world
 inline constexpr const char* kAlerts = "/alerts";                          // mocap_msgs/Alert
 
+// Health: every process's statuses, and the clock probes a fusion measures hosts' clocks with.
+inline constexpr const char* kDiagnostics = "/diagnostics";       // diagnostic_msgs/DiagnosticArray
+inline constexpr const char* kClockProbe = "/mocap/clock/probe";  // mocap_msgs/ClockProbe
+inline constexpr const char* kClockReply = "/mocap/clock/reply";  // mocap_msgs/ClockProbeReply
+
 // PixArt localization.
 inline constexpr const char* kPixartRaw = "/pixart/raw";  // mocap_msgs/PixartRawPointArray
 inline constexpr const char* kPixartFiducials = "/pixart/{camera}/fiducials";  // FiducialArray

@@ -186,6 +186,16 @@ class PoseOutputs final : public Component {
         unpublishable_.size());
   }
 
+  void report_health(HealthReport& report) override {
+    latency_.report(report, "capture -> outputs sent");
+    report.add("poses in another frame", std::to_string(wrong_frame_));
+    report.add("invalid poses", std::to_string(invalid_));
+    if (wrong_frame_ > 0) {
+      report.flag(HealthLevel::warn, fmt::format("{} pose(s) in another frame than '{}' skipped",
+                                                 wrong_frame_, settings_.optical_frame));
+    }
+  }
+
  private:
   struct BoardOutputs {
     Publisher<PoseStamped> pose;
@@ -253,6 +263,7 @@ class PoseOutputs final : public Component {
     }
     if (!transforms.transforms().empty()) tf_.publish(transforms);
     if (!named.poses().empty()) named_.publish(named);
+    latency_.add(now() - from_time_msg(poses.header().stamp()));
   }
 
   // The board's publishers, made when it is first seen; null when its name makes no topic
@@ -281,6 +292,7 @@ class PoseOutputs final : public Component {
   std::set<std::string> unpublishable_;
   Publisher<NamedPoseArray> named_;
   uint64_t arrays_ = 0, boards_published_ = 0, wrong_frame_ = 0, invalid_ = 0;
+  LatencyFigures latency_;
 };
 
 }  // namespace

@@ -114,6 +114,10 @@ class CentroidCameraComponent final : public Component {
                markers, settings_.scene, settings_.camera, settings_.rate_hz, fiducials_.topic());
   }
 
+  void report_health(HealthReport& report) override {
+    latency_.report(report, "capture -> fiducials sent");
+  }
+
  private:
   void frame(Clock::time_point stamp) {
     const double time_s =
@@ -153,6 +157,7 @@ class CentroidCameraComponent final : public Component {
       fiducials->fiducials().push_back(fiducial);
     }
     fiducials_.publish(std::move(fiducials));
+    latency_.add(now() - stamp);
     // The truth after the centroids, which it would otherwise delay, and only while someone
     // reads it (in the demos, the one camera whose truth the evaluator takes): it costs as
     // much as the centroids.
@@ -176,6 +181,7 @@ class CentroidCameraComponent final : public Component {
   }
 
   SwarmScene scene_;
+  LatencyFigures latency_;                  // added by the capture thread
   std::unique_ptr<CentroidCamera> camera_;  // only the capture thread uses it
   std::string frame_id_;
   std::chrono::system_clock::time_point scene_start_;

@@ -191,6 +191,10 @@ class SyntheticIrCamera final : public Component {
                time_step_s_);
   }
 
+  void report_health(HealthReport& report) override {
+    latency_.report(report, "capture -> image sent");
+  }
+
  private:
   // `capture`: the synchronized capture time; none: now, and scene time by the frame count.
   void tick(std::optional<Clock::time_point> capture = std::nullopt) {
@@ -253,6 +257,7 @@ class SyntheticIrCamera final : public Component {
       truth->poses().push_back(std::move(pose));
     }
     images_.publish(std::move(image));
+    latency_.add(now() - stamp);
     truths_.publish(std::move(truth));
     if (infos_) {
       auto info = std::make_shared<sensor_msgs::msg::CameraInfo>(camera_info_);
@@ -277,6 +282,7 @@ class SyntheticIrCamera final : public Component {
   Publisher<sensor_msgs::msg::Image> images_;
   Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
   Publisher<sensor_msgs::msg::CameraInfo> infos_;  // none for a lens camera_info cannot describe
+  LatencyFigures latency_;                         // added by the capture thread when synchronized
 };
 
 }  // namespace

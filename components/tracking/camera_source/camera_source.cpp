@@ -69,37 +69,44 @@ std::optional<std::string> VideoDeviceOptions::problem() const {
   return std::nullopt;
 }
 
-VideoDeviceSource::VideoDeviceSource(const std::string& device, const VideoDeviceOptions& options)
-    : device_(device) {
+namespace {
+
+std::string device_path(const std::string& device) {
+  return is_index(device) ? "/dev/video" + device : device;
+}
+
+V4l2Capture open_device(const std::string& device, const VideoDeviceOptions& options,
+                        std::unique_ptr<V4l2Io> io) {
   if (auto problem = options.problem()) {
     throw std::invalid_argument("VideoDeviceOptions::" + *problem);
   }
-  if (is_index(device)) {
-    capture_.open(std::stoi(device), cv::CAP_V4L2);
-  } else {
-    std::error_code error;
-    if (!fs::exists(device, error)) {
-      throw std::runtime_error(fmt::format("video device '{}' does not exist", device));
-    }
-    capture_.open(device, cv::CAP_V4L2);
-  }
-  if (!capture_.isOpened()) {
-    throw std::runtime_error(fmt::format(
-        "cannot open video device '{}' (not a V4L2 capture device, busy, or no permission)",
-        device));
-  }
-  if (options.width > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, options.width);
-  if (options.height > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, options.height);
+  return V4l2Capture(device_path(device), {.width = options.width, .height = options.height},
+                     std::move(io));
+}
+
+}  // namespace
+
+VideoDeviceSource::VideoDeviceSource(const std::string& device, const VideoDeviceOptions& options,
+                                     std::unique_ptr<V4l2Io> io)
+    : device_(device_path(device)), capture_(open_device(device, options, std::move(io))) {}
+
+std::string VideoDeviceSource::description() const {
+  return fmt::format("device {} ({}x{} {}, stamped {})", device_, capture_.width(),
+                     capture_.height(), capture_.pixel_format(),
+                     capture_.exposure() ? "mid-exposure" : "as the driver does");
 }
 
 bool VideoDeviceSource::read(cv::Mat& mono8) {
-  if (!capture_.read(frame_) || frame_.empty()) {
-    throw std::runtime_error(
-        fmt::format("video device '{}' delivered no frame (disconnected?)", device_));
-  }
-  to_mono8(frame_, mono8);
+  do {
+    last_ = capture_.read(mono8);
+  } while (!last_);
   ++frames_read_;
   return true;
+}
+
+std::optional<std::chrono::system_clock::time_point> VideoDeviceSource::captured() const {
+  if (!last_) return std::nullopt;
+  return last_->captured;
 }
 
 // --- VideoFileSource ----------------------------------------------------------------------

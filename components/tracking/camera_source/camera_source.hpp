@@ -1,7 +1,9 @@
-// Where camera frames come from: a V4L2 device, a video file or a directory of images, each
-// delivered as mono8 (the one layout the image components read, image_message.hpp).
+// Where camera frames come from: a V4L2 device (read directly: v4l2_capture.hpp), a video file
+// or a directory of images (through OpenCV), each delivered as mono8 (the one layout the image
+// components read, image_message.hpp).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -12,6 +14,8 @@
 
 #include <opencv2/core/mat.hpp>
 #include <opencv2/videoio.hpp>
+
+#include "tracking/camera_source/v4l2_capture.hpp"
 
 namespace mocap::capture {
 
@@ -35,6 +39,13 @@ class FrameSource {
   virtual bool is_live() const = 0;
   // Frames delivered so far (counting every pass of a loop).
   uint64_t frames_read() const { return frames_read_; }
+  // When the last frame read was captured, as its device says (system clock); nullopt when the
+  // source does not know (recorded input: the reader stamps it).
+  virtual std::optional<std::chrono::system_clock::time_point> captured() const {
+    return std::nullopt;
+  }
+  // Frames the device dropped before they could be read (its sequence's gaps).
+  virtual uint64_t dropped() const { return 0; }
 
  protected:
   uint64_t frames_read_ = 0;
@@ -51,20 +62,25 @@ struct VideoDeviceOptions {
   std::optional<std::string> problem() const;
 };
 
-// A V4L2 camera through cv::VideoCapture: `device` is a path ("/dev/video0") or an index
-// ("0"). Throws std::invalid_argument for options that cannot be used, std::runtime_error
-// naming the device when it cannot be opened.
+// A V4L2 camera read directly (v4l2_capture.hpp): `device` is a path ("/dev/video0") or an
+// index ("0": /dev/video0). Each frame is stamped with the driver's capture time and the
+// driver's dropped frames are counted. Throws std::invalid_argument for options that cannot be
+// used, std::runtime_error naming the device when it cannot be opened or read. `io`: the
+// kernel's, or a test's recorded buffers.
 class VideoDeviceSource final : public FrameSource {
  public:
-  explicit VideoDeviceSource(const std::string& device, const VideoDeviceOptions& options = {});
+  explicit VideoDeviceSource(const std::string& device, const VideoDeviceOptions& options = {},
+                             std::unique_ptr<V4l2Io> io = system_v4l2_io());
   bool read(cv::Mat& mono8) override;
-  std::string description() const override { return "device " + device_; }
+  std::string description() const override;
   bool is_live() const override { return true; }
+  std::optional<std::chrono::system_clock::time_point> captured() const override;
+  uint64_t dropped() const override { return capture_.dropped(); }
 
  private:
   std::string device_;
-  cv::VideoCapture capture_;
-  cv::Mat frame_;
+  V4l2Capture capture_;
+  std::optional<V4l2Frame> last_;
 };
 
 // A video file through cv::VideoCapture: what OpenCV's FFmpeg backend decodes, or its own

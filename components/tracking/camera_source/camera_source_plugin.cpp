@@ -1,5 +1,6 @@
 // camera_source: publishes mono8 images from a V4L2 camera, a video file or a directory of
-// images (camera_source.hpp).
+// images (camera_source.hpp). A camera's images are stamped with its driver's capture time
+// (mid-exposure where the exposure is known); recorded input with the moment it was read.
 //
 // Frames are read on a thread of the component's own, so a device's blocking grab never holds
 // the executor. Recorded input is paced at rate_hz and, by default, waits for its first
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <mocap/component.hpp>
 #include <mocap/message_time.hpp>
 #include <sensor_msgs/msg/image.hpp>
@@ -36,8 +38,8 @@ struct Settings {
 const ParameterList<Settings> kParameters =
     ParameterList<Settings>()
         .add("device",
-             "V4L2 camera: a path (/dev/video0) or an index (0); frames come at the "
-             "device's rate",
+             "V4L2 camera: a path (/dev/video0) or an index (0), GREY, Y16 or YUYV; frames come "
+             "at the device's rate, stamped with its driver's capture time",
              &Settings::device)
         .add("file", "video file (whatever OpenCV decodes)", &Settings::file)
         .path()
@@ -92,7 +94,23 @@ class CameraSource final : public Component {
     create_worker("capture", [this](std::stop_token stop) { capture(stop); });
   }
 
-  ~CameraSource() override { log().info("published {} frames", published_.load()); }
+  ~CameraSource() override {
+    log().info("published {} frames; {} dropped by the device", published_.load(),
+               dropped_by_device_.load());
+  }
+
+  void report_health(HealthReport& report) override {
+    latency_.report(report, "capture -> image sent");
+    const uint64_t dropped = dropped_by_device_.load();
+    report.add("frames dropped by the device", std::to_string(dropped));
+    if (dropped > reported_drops_) {
+      report.flag(HealthLevel::warn,
+                  fmt::format("the device dropped {} frame(s) since the last status: the reader "
+                              "or the USB bus cannot keep up",
+                              dropped - reported_drops_));
+    }
+    reported_drops_ = dropped;
+  }
 
  private:
   std::unique_ptr<FrameSource> open_source() {
@@ -135,11 +153,15 @@ class CameraSource final : public Component {
           log().info("end of input after {} frames", source_->frames_read());
           return;
         }
+        // A camera's own capture time (its driver's), else the moment it was read.
+        const Clock::time_point captured = source_->captured().value_or(now());
         auto message = std::make_shared<sensor_msgs::msg::Image>();
-        message->header().stamp(to_time_msg(now()));
+        message->header().stamp(to_time_msg(captured));
         message->header().frame_id(settings_.frame_id);
         fill_image_message(frame, *message);
         publisher_.publish(std::move(message));
+        latency_.add(now() - captured);
+        dropped_by_device_.store(source_->dropped());
         published_.fetch_add(1);
         if (source_->is_live() || period == Steady::duration::zero()) continue;
         // Keep to the rate's grid; after a stall, start a new grid rather than catch up in
@@ -157,6 +179,9 @@ class CameraSource final : public Component {
   bool wait_for_subscriber_ = true;
   Publisher<sensor_msgs::msg::Image> publisher_;
   std::atomic<uint64_t> published_{0};
+  std::atomic<uint64_t> dropped_by_device_{0};
+  uint64_t reported_drops_ = 0;  // as of the last status
+  LatencyFigures latency_;       // added by the capture worker
 };
 
 }  // namespace

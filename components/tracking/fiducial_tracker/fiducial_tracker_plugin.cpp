@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <mocap/component.hpp>
+#include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <sensor_msgs/msg/image.hpp>
 
@@ -119,6 +120,17 @@ class FiducialTracker final : public Component {
                drops_total_);
   }
 
+  void report_health(HealthReport& report) override {
+    latency_.report(report, "capture -> fiducials sent");
+    report.add("unreadable images", std::to_string(drops_total_));
+    if (drops_total_ > reported_drops_) {
+      report.flag(HealthLevel::warn,
+                  fmt::format("{} unreadable image(s) since the last status: see the log",
+                              drops_total_ - reported_drops_));
+    }
+    reported_drops_ = drops_total_;
+  }
+
  private:
   void on_image(const sensor_msgs::msg::Image& image) {
     Mono8View view = view_mono8(image);
@@ -150,6 +162,7 @@ class FiducialTracker final : public Component {
       fiducial.uncertainty(static_cast<float>(found.uncertainty_px));
     }
     publisher_.publish(std::move(array));
+    latency_.add(now() - from_time_msg(image.header().stamp()));
     ++images_total_;
     ++images_since_report_;
     fiducials_total_ += detected.size();
@@ -183,6 +196,8 @@ class FiducialTracker final : public Component {
   uint64_t images_total_ = 0, images_since_report_ = 0;
   uint64_t fiducials_total_ = 0, fiducials_since_report_ = 0;
   uint64_t drops_total_ = 0, drops_since_report_ = 0, drops_unlogged_ = 0;
+  uint64_t reported_drops_ = 0;  // drops_total_ at the last status
+  LatencyFigures latency_;
   std::chrono::steady_clock::time_point last_drop_log_;
   bool reported_silence_ = false;
 };

@@ -115,8 +115,9 @@ class PoseEvaluatorComponent final : public Component {
     create_subscription<mocap_msgs::msg::ConstellationPoseArray>(
         topics::kPoses, [this](const mocap_msgs::msg::ConstellationPoseArray& poses) {
           if (stopping_ || skipped(to_nanoseconds(poses.header().stamp()))) return;
-          latencies_s_.push_back(
-              std::chrono::duration<double>(now() - from_time_msg(poses.header().stamp())).count());
+          const auto latency = now() - from_time_msg(poses.header().stamp());
+          latencies_s_.push_back(std::chrono::duration<double>(latency).count());
+          latency_.add(latency);
           evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses, false));
           check_done();
         });
@@ -126,6 +127,21 @@ class PoseEvaluatorComponent final : public Component {
   }
 
   ~PoseEvaluatorComponent() override { finish(); }
+
+  void report_health(HealthReport& report) override {
+    latency_.report(report, "capture -> poses received");
+    const EvaluationSummary& total = evaluator_.total();
+    report.add("frames evaluated", std::to_string(total.frames));
+    report.add("tracked (%)",
+               total.frames > 0 ? fmt::format("{:.2f}", total.tracked_percent()) : "-");
+    report.add("false identifications", std::to_string(total.false_identifications));
+    report.add("identity swaps", std::to_string(total.identity_swaps));
+    if (total.false_identifications > 0 || total.identity_swaps > 0) {
+      report.flag(HealthLevel::warn,
+                  fmt::format("{} false identification(s), {} identity swap(s) against the truth",
+                              total.false_identifications, total.identity_swaps));
+    }
+  }
 
  private:
   // In the first skip_first_s, or before the first truth array.
@@ -221,6 +237,7 @@ class PoseEvaluatorComponent final : public Component {
   uint64_t truth_arrays_ = 0;
   std::optional<int64_t> first_truth_ns_;  // the first truth array's stamp
   std::vector<double> latencies_s_, window_latencies_s_, all_latencies_s_;
+  LatencyFigures latency_;
 };
 
 }  // namespace

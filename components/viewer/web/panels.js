@@ -1,6 +1,7 @@
 // The page's text, from the viewer's state (state.js): the connection's status and the rates
 // in the header, which panels the graph fills and the topics they show, the poses' table, the
-// alerts, the turret's angles and every topic with its rate and bandwidth.
+// alerts, the processes' and components' health (/diagnostics), the turret's angles and every
+// topic with its rate and bandwidth.
 import { rollPitchYaw } from "./geometry.js";
 import { graph, report, stampSeconds } from "./state.js";
 import { TYPES } from "./topics.js";
@@ -74,6 +75,31 @@ export function alerts() {
   $("alerts").innerHTML = graph.alerts
     .map((a) => `<li class="${level(a.level)}">${new Date(stampSeconds(a.header) * 1000).toLocaleTimeString()} ${a.source}: ${a.text}</li>`)
     .join("");
+}
+
+// A status not renewed for this long is shown STALE: its process stopped publishing.
+const HEALTH_STALE_MS = 3000;
+const LEVELS = ["OK", "WARN", "ERROR", "STALE"];
+const escape = (text) => text.replace(/[&<>"]/g, (c) => `&#${c.charCodeAt(0)};`);
+
+// One row per status, the worst first, with the stage's latency where the component gives one
+// (the first "capture -> ..." median) and its host.
+export function health() {
+  const now = Date.now();
+  const rows = [...graph.health.entries()].map(([name, { status, receivedAt }]) => {
+    const stale = now - receivedAt > HEALTH_STALE_MS;
+    const level = stale ? 3 : Math.min(status.level, 3);
+    const message = stale ? `no status for ${((now - receivedAt) / 1000).toFixed(0)} s: is its process running?` : status.message;
+    const latency = status.values.find((v) => v.key.startsWith("capture -> ") && v.key.endsWith("median (ms)"));
+    return { name, level, message, host: status.hardware_id, latency };
+  });
+  rows.sort((a, b) => b.level - a.level || a.name.localeCompare(b.name));
+  report.healthRows = Object.fromEntries(rows.map((r) => [r.name, LEVELS[r.level]]));
+  $("health").tBodies[0].innerHTML = rows.length
+    ? rows.map((r) => `<tr class="level-${LEVELS[r.level].toLowerCase()}"><td>${escape(r.name)}</td><td>${LEVELS[r.level]}</td>
+      <td>${escape(r.message)}</td><td>${r.latency ? `${escape(r.latency.key.slice(11, -12))}: ${escape(r.latency.value)} ms` : ""}</td>
+      <td>${escape(r.host)}</td></tr>`).join("")
+    : `<tr><td colspan="5" class="note">no /diagnostics in this graph</td></tr>`;
 }
 
 export function turret() {

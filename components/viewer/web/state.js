@@ -39,10 +39,11 @@ export const report = {
   volumeCamerasDrawn: 0,  // cameras drawn from above, with their view or (no images) from /tf
   volumeBodiesDrawn: 0,  // bodies and robots drawn from above
   volumeMarkersDrawn: 0,  // points of the marker cloud drawn from above
+  healthRows: {},  // status name -> its level as shown ("OK", "WARN", "ERROR", "STALE")
 };
 
 // The panels with news since the last animation frame.
-export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false };
+export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false, health: false };
 
 export const graph = {
   cameras: new Map(),  // image topic -> {name, image, frameStamp, dirty}, in topic order
@@ -57,6 +58,7 @@ export const graph = {
   footprints: new Map(),  // topic -> its latest cameras' footprints
   turret: null,  // {pan, tilt} in radians
   alerts: [],  // the newest first
+  health: new Map(),  // /diagnostics status name -> {status, receivedAt (page clock, ms)}
   topics: new Map(),  // every advertised topic -> {type, count, bytes, rate, bandwidth}
 };
 
@@ -198,6 +200,11 @@ const handlers = {
     if (message.header.frame_id !== WORLD) return;
     graph.markers = message;
     dirty.volume = true;
+  },
+  // Every process's statuses, once a second each (diagnostic_msgs, as ROS 2 publishes them).
+  [TYPES.diagnostics](message) {
+    for (const status of message.status) graph.health.set(status.name, { status, receivedAt: Date.now() });
+    dirty.health = true;
   },
   [TYPES.alert](alert) {
     graph.alerts.unshift(alert);

@@ -19,6 +19,7 @@ export const TYPES = {
   footprints: "mocap_msgs/msg/CameraFootprintArray",
   alert: "mocap_msgs/msg/Alert",
   markers: "sensor_msgs/msg/PointCloud2",
+  diagnostics: "diagnostic_msgs/msg/DiagnosticArray",
 };
 
 const namespace = (topic) => topic.slice(0, topic.lastIndexOf("/"));

@@ -49,6 +49,7 @@ setInterval(() => {
   rollRates();
   panels.topics();
   panels.rates();
+  panels.health();  // statuses that stopped coming turn STALE
 }, 1000);
 
 function frame() {
@@ -61,6 +62,7 @@ function frame() {
   if (dirty.volume) drawVolumeTop();
   if (dirty.poses) panels.poses();
   if (dirty.alerts) panels.alerts();
+  if (dirty.health) panels.health();
   for (const panel of Object.keys(dirty)) dirty[panel] = false;
   requestAnimationFrame(frame);
 }

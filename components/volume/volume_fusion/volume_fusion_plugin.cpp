@@ -16,6 +16,12 @@
 // by their tracks, and robots of one marker: swarm_tracker.hpp) are tracked in the cloud's
 // markers no body took, and posed on /mocap/poses after the bodies; /mocap/reseed tells where a
 // robot carried away by hand now is.
+//
+// The cameras' hosts' clocks are measured against this one's (clock probes, answered by each
+// process's diagnostics component: clock_offset.hpp): a camera whose clock is unknown or off by
+// more than `clock_limit_ms` is refused, by name, until its clock is back within it; one off by
+// more than `clock_warning_ms` is fused with a warning. Stamps of different clocks pair wrongly
+// in the frames, and a camera stamping 5 ms off at 1 m/s puts its markers 5 mm away.
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -30,6 +36,8 @@
 #include <mocap/config_files.hpp>
 #include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/alert.hpp>
+#include <mocap_msgs/msg/clock_probe.hpp>
+#include <mocap_msgs/msg/clock_probe_reply.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 #include <mocap_msgs/msg/fiducial_array.hpp>
 #include <motion_capture_tracking_interfaces/msg/named_pose_array.hpp>
@@ -39,6 +47,7 @@
 #include "common/marker_cloud_message/marker_cloud_message.hpp"
 #include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
+#include "health/clock_offset/clock_offset.hpp"
 #include "volume/frame_assembly/frame_assembler.hpp"
 #include "volume/marker_cloud/marker_cloud.hpp"
 #include "volume/rigid_bodies/rigid_body_database.hpp"
@@ -50,6 +59,8 @@ namespace mocap::volume {
 namespace {
 
 using mocap_msgs::msg::Alert;
+using mocap_msgs::msg::ClockProbe;
+using mocap_msgs::msg::ClockProbeReply;
 using mocap_msgs::msg::ConstellationPoseArray;
 using mocap_msgs::msg::FiducialArray;
 using motion_capture_tracking_interfaces::msg::NamedPoseArray;
@@ -63,6 +74,13 @@ constexpr size_t kMaxBacklog = 2;  // the newest frames fused at once when behin
 constexpr int kGapFramesLogged = 3;
 // A cloud marker this close to where a posed body puts one of its markers is that marker.
 constexpr double kOwnMarkerRadius_m = 0.005;
+// A process that has not answered a clock probe for this long has ended.
+constexpr std::chrono::seconds kClockSilence{3};
+// Exchanges with a camera's host before its clock is judged: of five, one quick enough to tell
+// the offset to a tenth of a millisecond (half a second at the default probe rate).
+constexpr int kClockSamplesForVerdict = 5;
+// A camera whose clock stays unknown this long after its first message is said to be refused.
+constexpr std::chrono::seconds kUnknownClockAlert{1};
 
 std::chrono::nanoseconds seconds(double s) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(s));
@@ -82,6 +100,10 @@ struct Settings : VolumeTrackerOptions {
   double wait_s = 0.005;
   double silent_after_s = 0.5;
   double behind_max_gap_s = 0.02;
+  bool check_clocks = true;
+  double clock_probe_hz = 10;
+  double clock_warning_ms = 0.2;
+  double clock_limit_ms = 1.0;
 
   // The shipped bodies are told apart by 5 markers (config/volume/bodies.yaml).
   Settings() { identification.min_markers = 5; }
@@ -171,7 +193,22 @@ const ParameterList<Settings> kParameters =
              "a fusion that is behind skips frames, but fuses frames at most this far apart (or "
              "two frame periods): the tracks bridge the gap",
              &Settings::behind_max_gap_s)
-        .range(0.001, 10);
+        .range(0.001, 10)
+        .add("check_clocks",
+             "measure each camera's host's clock against this one's and refuse a camera whose "
+             "clock is unknown or off by more than clock_limit_ms (false: for cameras in this "
+             "process only, or a graph without diagnostics components)",
+             &Settings::check_clocks)
+        .add("clock_probe_hz", "clock probes a second", &Settings::clock_probe_hz)
+        .range(0.5, 100)
+        .add("clock_warning_ms", "a camera's clock off by more than this is fused with a warning",
+             &Settings::clock_warning_ms)
+        .range(0, 1000)
+        .add("clock_limit_ms",
+             "a camera's clock off by more than this is refused: its stamps would pair with other "
+             "capture times (same_capture_s) and move its markers",
+             &Settings::clock_limit_ms)
+        .range(0, 10000);
 
 std::vector<VolumeCamera> load_cameras(const std::vector<std::string>& files) {
   if (files.empty()) throw std::invalid_argument("cameras: no camera files");
@@ -264,6 +301,10 @@ class VolumeFusion final : public Component {
     spec.publishes<TFMessage>(
         topics::kTfStatic, Qos::latched(),
         "once: each camera's optical frame (its images' frame id) in 'world'");
+    spec.publishes<ClockProbe>(topics::kClockProbe, Qos::sensor_data(),
+                               "clock probes, clock_probe_hz a second (check_clocks)");
+    spec.subscribes<ClockProbeReply>(topics::kClockReply, Qos::sensor_data(),
+                                     "the processes' answers: the cameras' hosts' clocks");
   }
 
   explicit VolumeFusion(Context& context)
@@ -283,7 +324,8 @@ class VolumeFusion final : public Component {
         heard_(tracker_.cameras().size(), false),
         silent_(tracker_.cameras().size(), false),
         gaps_(tracker_.cameras().size()),
-        drifted_(tracker_.cameras().size(), false) {
+        drifted_(tracker_.cameras().size(), false),
+        clock_states_(tracker_.cameras().size()) {
     poses_ = create_publisher<ConstellationPoseArray>(topics::kPoses);
     markers_ = create_publisher<PointCloud2>(topics::kMarkers);
     alerts_ = create_publisher<Alert>(topics::kAlerts);
@@ -294,10 +336,19 @@ class VolumeFusion final : public Component {
       create_subscription<FiducialArray>(
           topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name),
           [this, c](const FiducialArray& array) {
+            const auto arrival = std::chrono::steady_clock::now();
+            if (!clock_accepts(c, arrival)) return;
             frames_.add(static_cast<int>(c), to_nanoseconds(array.header().stamp()), array,
-                        std::chrono::steady_clock::now());
+                        arrival);
+            arrival_latency_.add(now() - from_time_msg(array.header().stamp()));
             fuse_ready();
           });
+    }
+    if (settings_.check_clocks) {
+      probes_ = create_publisher<ClockProbe>(topics::kClockProbe);
+      create_subscription<ClockProbeReply>(
+          topics::kClockReply, [this](const ClockProbeReply& reply) { take_clock_reply(reply); });
+      create_timer(seconds(1.0 / settings_.clock_probe_hz), [this] { probe_clocks(); });
     }
     // Frames whose wait runs out while no message arrives: a camera that stopped.
     create_timer(std::chrono::milliseconds(1), [this] { fuse_ready(); });
@@ -330,7 +381,143 @@ class VolumeFusion final : public Component {
         cloud_.totals().started, cloud_.totals().merged, cloud_.totals().unexplained, health);
   }
 
+  void report_health(HealthReport& report) override {
+    const double period_s = std::chrono::duration<double>(frames_.frame_period()).count();
+    report.add("fused frames", std::to_string(fused_frames_));
+    report.add("camera frame rate (Hz)", period_s > 0 ? fmt::format("{:.1f}", 1 / period_s) : "-");
+    report.add("incomplete frames", std::to_string(incomplete_frames_));
+    report.add("skipped while behind", std::to_string(skipped_frames_));
+    report.add("late messages dropped", std::to_string(frames_.late_drops()));
+    arrival_latency_.report(report, "capture -> fiducials received");
+    poses_latency_.report(report, "capture -> poses sent");
+    for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
+      const std::string& camera = tracker_.cameras()[c].name;
+      const ClockState& clock = clock_states_[c];
+      if (settings_.check_clocks) {
+        report.add(
+            camera + " clock offset (ms)",
+            clock.offset ? fmt::format("{:+.3f}", clock.offset->offset_ns * 1e-6) : "unknown");
+        report.add(camera + " clock round trip (ms)",
+                   clock.offset ? fmt::format("{:.3f}", clock.offset->round_trip_ns * 1e-6) : "-");
+        report.add(camera + " refused messages", std::to_string(clock.refused));
+        if (clock.verdict == ClockVerdict::refused ||
+            (clock.verdict == ClockVerdict::unknown && clock.unknown_alerted)) {
+          report.flag(HealthLevel::error, clock_problem(c));
+        } else if (clock.verdict == ClockVerdict::warned) {
+          report.flag(HealthLevel::warn, clock_problem(c));
+        }
+      }
+      if (tracker_.camera_health()[c].drifted) {
+        report.flag(HealthLevel::error, fmt::format("camera {} has moved since calibration: "
+                                                    "calibrate it again",
+                                                    camera));
+      } else if (heard_[c] && silent_[c]) {
+        report.flag(HealthLevel::warn,
+                    fmt::format("camera {} is silent: is its process running?", camera));
+      }
+    }
+  }
+
  private:
+  enum class ClockVerdict { unknown, accepted, warned, refused };
+  struct ClockState {
+    ClockVerdict verdict = ClockVerdict::unknown;
+    std::optional<health::ClockOffset> offset;
+    std::string publisher;  // "<process> on <host>"
+    std::optional<std::chrono::steady_clock::time_point> first_message;
+    bool unknown_alerted = false;
+    uint64_t refused = 0;
+  };
+
+  void probe_clocks() {
+    ClockProbe probe;
+    probe.requester(name());
+    probe.number(++probe_number_);
+    probe.sent(to_time_msg(now()));
+    probes_.publish(std::move(probe));
+    clocks_.forget_silent(std::chrono::steady_clock::now(), kClockSilence);
+  }
+
+  void take_clock_reply(const ClockProbeReply& reply) {
+    const int64_t received_ns = to_nanoseconds(to_time_msg(now()));
+    if (reply.requester() != name()) return;
+    clocks_.add(reply.instance(), reply.host(), reply.process(), reply.topics(),
+                {to_nanoseconds(reply.probe_sent()), to_nanoseconds(reply.received()),
+                 to_nanoseconds(reply.sent()), received_ns},
+                std::chrono::steady_clock::now());
+  }
+
+  // Whether camera `c`'s message may be fused, as its host's clock is now; a change of verdict
+  // is said once.
+  bool clock_accepts(size_t c, std::chrono::steady_clock::time_point arrival) {
+    if (!settings_.check_clocks) return true;
+    ClockState& clock = clock_states_[c];
+    if (!clock.first_message) clock.first_message = arrival;
+    const std::string topic =
+        topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name);
+    const health::PeerClocks::Peer* peer = clocks_.publisher_of(topic);
+    clock.offset = peer ? peer->filter.offset() : std::nullopt;
+    ClockVerdict verdict = ClockVerdict::unknown;
+    if (clock.offset && clock.offset->samples >= kClockSamplesForVerdict) {
+      clock.publisher = fmt::format("{} on {}", peer->process, peer->host);
+      // Off by at least this much: a camera is not refused for the network's queues.
+      const double off_ms = static_cast<double>(clock.offset->least_offset_ns()) * 1e-6;
+      verdict = off_ms > settings_.clock_limit_ms     ? ClockVerdict::refused
+                : off_ms > settings_.clock_warning_ms ? ClockVerdict::warned
+                                                      : ClockVerdict::accepted;
+    }
+    if (verdict != clock.verdict) {
+      const ClockVerdict was = clock.verdict;
+      clock.verdict = verdict;
+      if (was == ClockVerdict::unknown) {
+        log().info(
+            "camera {}: the clock of {} is {:+.3f} ms against this host's (round trip {:.3f} ms), "
+            "known {:.2f} s after its first message",
+            tracker_.cameras()[c].name, clock.publisher, clock.offset->offset_ns * 1e-6,
+            clock.offset->round_trip_ns * 1e-6,
+            std::chrono::duration<double>(arrival - *clock.first_message).count());
+      }
+      if (verdict == ClockVerdict::refused) {
+        alert(2, clock_problem(c));
+      } else if (verdict == ClockVerdict::warned) {
+        alert(1, clock_problem(c));
+      } else if (verdict == ClockVerdict::accepted &&
+                 (was != ClockVerdict::unknown || clock.unknown_alerted)) {
+        alert(1, fmt::format("camera {}: its clock agrees with this host's again ({:+.3f} ms): "
+                             "fused",
+                             tracker_.cameras()[c].name, clock.offset->offset_ns * 1e-6));
+      }
+    }
+    if (verdict == ClockVerdict::unknown && !clock.unknown_alerted &&
+        arrival - *clock.first_message > kUnknownClockAlert) {
+      clock.unknown_alerted = true;
+      alert(2, clock_problem(c));
+    }
+    const bool accepted = verdict == ClockVerdict::accepted || verdict == ClockVerdict::warned;
+    if (!accepted) ++clock.refused;
+    return accepted;
+  }
+
+  std::string clock_problem(size_t c) const {
+    const std::string& camera = tracker_.cameras()[c].name;
+    const ClockState& clock = clock_states_[c];
+    if (clock.verdict == ClockVerdict::unknown) {
+      return fmt::format(
+          "camera {} refused: its clock is unknown (no process that publishes {} answers clock "
+          "probes: is its group run by mocap_launch, with its diagnostics?)",
+          camera, topics::member_of(topics::kVolumeFiducials, camera));
+    }
+    const double off_ms = static_cast<double>(clock.offset->offset_ns) * 1e-6;
+    return fmt::format(
+        "camera {}{}: the clock of {} is {:.3f} ms {} this host's, give or take {:.3f} ms "
+        "(warning above {} ms, refused above {} ms): synchronise the hosts' clocks (README: "
+        "Clocks)",
+        camera, clock.verdict == ClockVerdict::refused ? " refused" : "", clock.publisher,
+        std::abs(off_ms), off_ms > 0 ? "ahead of" : "behind",
+        static_cast<double>(clock.offset->round_trip_ns) * 0.5e-6, settings_.clock_warning_ms,
+        settings_.clock_limit_ms);
+  }
+
   // Latched, for tf2 and viewers: where the cameras are.
   void publish_camera_frames() {
     TFMessage frames;
@@ -403,6 +590,7 @@ class VolumeFusion final : public Component {
     const std_msgs::msg::Header header = message->header();
     body_poses_ += poses.size();
     poses_.publish(std::move(message));
+    poses_latency_.add(now() - Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns)));
     markers_.publish(std::make_shared<PointCloud2>(to_point_cloud(header, markers)));
     report_unposed(poses, assembled.stamp_ns);
     report_drift();
@@ -621,6 +809,12 @@ class VolumeFusion final : public Component {
   std::optional<int64_t> last_fused_ns_;
   uint64_t body_poses_ = 0;
   uint64_t robot_poses_ = 0;
+  std::vector<ClockState> clock_states_;  // per camera
+  health::PeerClocks clocks_;
+  Publisher<ClockProbe> probes_;
+  uint32_t probe_number_ = 0;
+  LatencyFigures arrival_latency_;
+  LatencyFigures poses_latency_;
 };
 
 }  // namespace

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include <mocap/component_spec.hpp>
+#include <mocap/health.hpp>
 #include <mocap/logger.hpp>
 #include <mocap/message_type.hpp>
 #include <mocap/parameter.hpp>
@@ -135,6 +136,11 @@ class Context {
   // Ends the process's run once the current callbacks return; the process exits with
   // `exit_code` (the largest requested, if several components ask).
   virtual void request_shutdown(int exit_code) = 0;
+  // The name of this process: its launch-file group, or the host's name given by hand.
+  virtual const std::string& process_name() const = 0;
+  // Every component of this process: what the runtime counts and its last report_health(), for
+  // a component that publishes them (diagnostics).
+  virtual std::vector<ComponentHealth> process_health() const = 0;
 };
 
 class Component {
@@ -145,6 +151,13 @@ class Component {
   Component& operator=(const Component&) = delete;
 
   const std::string& name() const { return context_.name(); }
+
+  // Called once a second on the component's strand (never beside its callbacks), from the
+  // moment the process runs: how the component is doing, for /diagnostics (mocap/health.hpp).
+  // The runtime adds its own counts of messages, drops and callback errors; a component adds
+  // what only it knows (rates against what it expects, its stage's latency, causes) and flags
+  // problems with a sentence that says what to do.
+  virtual void report_health(HealthReport& report) { (void)report; }
 
  protected:
   template <class Message>
@@ -213,7 +226,7 @@ bool wait_for_stop(const std::stop_token& stop, std::chrono::nanoseconds duratio
 // What a plugin library exports, through MOCAP_REGISTER_COMPONENT.
 struct ComponentFactory {
   // Raised whenever Component, Context or this struct change layout.
-  static constexpr uint32_t kAbiVersion = 5;
+  static constexpr uint32_t kAbiVersion = 6;
   static constexpr const char* kSymbol = "mocap_component_factory";
 
   uint32_t abi_version;

@@ -14,6 +14,10 @@
 namespace mocap {
 
 inline constexpr const char* kLaunchStartVariable = "MOCAP_LAUNCH_START_NS";
+// Set by mocap_launch for a group it starts again after the group's process died: how many
+// times it did, and how the last one ended ("was killed by signal 9"), for its diagnostics.
+inline constexpr const char* kGroupRestartsVariable = "MOCAP_GROUP_RESTARTS";
+inline constexpr const char* kGroupLastEndVariable = "MOCAP_GROUP_LAST_END";
 
 // nullopt when this process was not started by mocap_launch (or the variable is not a count
 // of nanoseconds since the epoch).
@@ -27,6 +31,16 @@ inline std::optional<std::chrono::system_clock::time_point> launch_start() {
   return std::chrono::system_clock::time_point(
       std::chrono::duration_cast<std::chrono::system_clock::duration>(
           std::chrono::nanoseconds(ns)));
+}
+
+// 0 when this process is its group's first (or was not started by mocap_launch).
+inline int group_restarts() {
+  const char* text = std::getenv(kGroupRestartsVariable);
+  if (text == nullptr) return 0;
+  const std::string_view view(text);
+  int restarts = 0;
+  auto [end, error] = std::from_chars(view.data(), view.data() + view.size(), restarts);
+  return error == std::errc() && end == view.data() + view.size() && restarts > 0 ? restarts : 0;
 }
 
 }  // namespace mocap

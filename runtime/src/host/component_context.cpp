@@ -85,6 +85,7 @@ class HostSubscription final : public Waitable {
         callback_(std::move(callback)) {}
 
   const std::string& topic() const { return topic_; }
+  uint64_t received() const { return received_.load(std::memory_order_relaxed); }
 
   bool execute_one() override {
     ReceivedMessage received;
@@ -93,6 +94,7 @@ class HostSubscription final : public Waitable {
       size_t index = (next_ + i) % sources_.size();
       if (sources_[index]->take(received)) {
         next_ = index + 1;
+        received_.fetch_add(1, std::memory_order_relaxed);
         run_callback([&] { callback_(received.message); });
         return true;
       }
@@ -107,13 +109,15 @@ class HostSubscription final : public Waitable {
   std::string topic_;  // after remaps
   MessageCallback callback_;
   size_t next_ = 0;
+  std::atomic<uint64_t> received_{0};
 };
 
 }  // namespace
 
-ComponentContext::ComponentContext(HostServices& host, ComponentSpec spec, ComponentConfig config,
-                                   Parameters parameters)
+ComponentContext::ComponentContext(HostServices& host, std::string plugin, ComponentSpec spec,
+                                   ComponentConfig config, Parameters parameters)
     : host_(host),
+      plugin_(std::move(plugin)),
       spec_(std::move(spec)),
       config_(std::move(config)),
       parameters_(std::move(parameters)),
@@ -131,6 +135,7 @@ ComponentContext::~ComponentContext() {
   for (const auto& timer : timers_) host_.timers.remove(timer.get());
   // Transport endpoints go first, so that nothing notifies the strand once it is gone.
   strand_.clear();
+  std::lock_guard lock(endpoints_mutex_);
   publishers_.clear();
   waitables_.clear();
 }
@@ -158,6 +163,7 @@ void ComponentContext::subscribe_any(std::string_view topic, const MessageType& 
 
 void ComponentContext::unsubscribe_any(std::string_view topic) {
   const std::string name = remapped(std::string(topic));
+  std::lock_guard lock(endpoints_mutex_);
   std::erase_if(waitables_, [&](const std::shared_ptr<Waitable>& waitable) {
     auto* subscription = dynamic_cast<HostSubscription*>(waitable.get());
     if (subscription == nullptr || subscription->topic() != name) return false;
@@ -165,6 +171,49 @@ void ComponentContext::unsubscribe_any(std::string_view topic) {
     strand_.remove(subscription);
     return true;
   });
+}
+
+void ComponentContext::close_subscriptions() {
+  std::lock_guard lock(endpoints_mutex_);
+  for (const auto& waitable : waitables_) {
+    if (auto* subscription = dynamic_cast<HostSubscription*>(waitable.get())) {
+      subscription->sources_.clear();
+    }
+  }
+}
+
+void ComponentContext::start_health_reports(Component& component) {
+  add_timer(std::make_shared<Timer>(
+      "health report", std::chrono::seconds(1),
+      [this, &component] {
+        HealthReport report;
+        component.report_health(report);
+        std::lock_guard lock(report_mutex_);
+        report_ = std::move(report);
+        reported_at_ = std::chrono::steady_clock::now();
+      },
+      strand_));
+}
+
+ComponentHealth ComponentContext::health() const {
+  ComponentHealth health;
+  health.name = config_.name;
+  health.plugin = plugin_;
+  std::lock_guard endpoints_lock(endpoints_mutex_);
+  for (const auto& publisher : publishers_) {
+    PublisherStats stats = publisher->stats();
+    health.published.push_back({publisher->topic(), stats.published, stats.dropped});
+  }
+  for (const auto& waitable : waitables_) {
+    if (const auto* subscription = dynamic_cast<const HostSubscription*>(waitable.get())) {
+      health.received.push_back({subscription->topic(), subscription->received(), 0});
+    }
+  }
+  health.callback_errors = strand_.callback_errors() + worker_errors_.load();
+  std::lock_guard report_lock(report_mutex_);
+  health.report = report_;
+  health.reported_at = reported_at_;
+  return health;
 }
 
 void ComponentContext::add_declared_topics(std::map<std::string, KnownTopic>& known) const {
@@ -207,6 +256,7 @@ std::shared_ptr<PublisherPort> ComponentContext::advertise_endpoint(const Endpoi
   for (auto& transport : host_.transports) {
     publisher->ports_.push_back(transport->advertise(endpoint));
   }
+  std::lock_guard lock(endpoints_mutex_);
   publishers_.push_back(publisher);
   return publisher;
 }
@@ -220,7 +270,10 @@ void ComponentContext::subscribe_endpoint(const Endpoint& endpoint, MessageCallb
           may_run_callbacks ? strand->dispatch() : strand->notify();
         }));
   }
-  waitables_.push_back(subscription);
+  {
+    std::lock_guard lock(endpoints_mutex_);
+    waitables_.push_back(subscription);
+  }
   strand_.add(subscription);
 }
 
@@ -268,7 +321,10 @@ void ComponentContext::join_workers() {
 
 void ComponentContext::add_timer(std::shared_ptr<Timer> timer) {
   timers_.push_back(timer);
-  waitables_.push_back(timer);
+  {
+    std::lock_guard lock(endpoints_mutex_);
+    waitables_.push_back(timer);
+  }
   strand_.add(timer);
   host_.timers.add(timer);
 }

@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <stop_token>
 #include <string>
 #include <string_view>
@@ -33,12 +34,14 @@ struct HostServices {
   std::function<void(int exit_code)> request_shutdown;
   std::function<std::vector<KnownTopic>()> known_topics;
   std::function<std::vector<KnownTopic>()> discovered_topics;
+  const std::string& process_name;
+  std::function<std::vector<ComponentHealth>()> process_health;
 };
 
 class ComponentContext final : public Context {
  public:
-  ComponentContext(HostServices& host, ComponentSpec spec, ComponentConfig config,
-                   Parameters parameters);
+  ComponentContext(HostServices& host, std::string plugin, ComponentSpec spec,
+                   ComponentConfig config, Parameters parameters);
   // Stops and joins the workers, removes the timers, then the endpoints.
   ~ComponentContext() override;
 
@@ -62,6 +65,18 @@ class ComponentContext final : public Context {
   // Started by the host once the component exists (ComponentHost::start, or add()).
   void add_worker(std::string name, std::function<void(std::stop_token)> body) override;
   void request_shutdown(int exit_code) override { host_.request_shutdown(exit_code); }
+  const std::string& process_name() const override { return host_.process_name; }
+  std::vector<ComponentHealth> process_health() const override { return host_.process_health(); }
+
+  // Lets go of the transports' readers of every subscription: for a host that has stopped, so
+  // that no reader of this process holds its DDS implementation's delivery up while writers go
+  // (Cyclone DDS delivers into a full keep-all reader on the thread a writer's deletion waits
+  // for).
+  void close_subscriptions();
+  // Asks `component` (this context's) for its report once a second, on its strand, from now.
+  void start_health_reports(Component& component);
+  // The runtime's counts and the component's last report. Thread-safe.
+  ComponentHealth health() const;
 
   // This component's declared topics as the launch file sets them (remaps, QoS), for
   // known_topics().
@@ -90,16 +105,22 @@ class ComponentContext final : public Context {
                        TopicDirection direction);
 
   HostServices& host_;
+  std::string plugin_;
   ComponentSpec spec_;
   ComponentConfig config_;
   Parameters parameters_;
   Logger logger_;
   Strand strand_;
+  // Changed by the component's callbacks (subscribe_any and the like), read by health().
+  mutable std::mutex endpoints_mutex_;
   std::vector<std::shared_ptr<PublisherPort>> publishers_;
   std::vector<std::shared_ptr<Waitable>> waitables_;
   std::vector<std::shared_ptr<Timer>> timers_;
   std::vector<std::unique_ptr<Worker>> workers_;
   std::atomic<uint64_t> worker_errors_{0};
+  mutable std::mutex report_mutex_;
+  HealthReport report_;  // the last one, under report_mutex_
+  std::chrono::steady_clock::time_point reported_at_{};
 };
 
 }  // namespace mocap

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -110,9 +111,12 @@ struct ComponentHost::Impl {
                         transports,
                         [this](int code) { request_shutdown(code); },
                         [this] { return known_topics(); },
-                        [this] { return discovered_topics(); }};
+                        [this] { return discovered_topics(); },
+                        options.name,
+                        [this] { return process_health(); }};
   // Declared after the transports: destroyed before them.
   std::vector<std::unique_ptr<ComponentContext>> contexts;
+  mutable std::mutex contexts_mutex;  // add() against process_health() on a strand
   std::vector<std::unique_ptr<Component>> components;
   std::atomic<bool> shutdown_requested{false};
   std::atomic<int> exit_code{0};
@@ -127,7 +131,15 @@ struct ComponentHost::Impl {
 
   std::vector<KnownTopic> known_topics() const;
   std::vector<KnownTopic> discovered_topics() const;
+  std::vector<ComponentHealth> process_health() const;
 };
+
+std::vector<ComponentHealth> ComponentHost::Impl::process_health() const {
+  std::vector<ComponentHealth> health;
+  std::lock_guard lock(contexts_mutex);
+  for (const auto& context : contexts) health.push_back(context->health());
+  return health;
+}
 
 // ---------------------------------------------------------------------------------------
 
@@ -178,6 +190,8 @@ ComponentHost::ComponentHost(HostOptions options)
 
 ComponentHost::~ComponentHost() {
   stop();
+  // Every reader before any writer (component_context.hpp, close_subscriptions).
+  for (const auto& context : impl_->contexts) context->close_subscriptions();
   while (!impl_->components.empty()) {
     impl_->components.pop_back();
     impl_->contexts.pop_back();
@@ -206,17 +220,22 @@ Component& ComponentHost::add(const ComponentFactory& factory, ComponentConfig c
                                                               : parameter.coerce(given->second);
   }
 
-  auto context = std::make_unique<ComponentContext>(
-      impl_->services, std::move(spec), std::move(config), Parameters(std::move(values)));
+  auto context =
+      std::make_unique<ComponentContext>(impl_->services, factory.name, std::move(spec),
+                                         std::move(config), Parameters(std::move(values)));
   std::unique_ptr<Component> component;
   try {
     component = factory.create(*context);
   } catch (const std::exception& e) {
     throw ComponentError(fmt::format("{} failed to start: {}", label, e.what()));
   }
+  context->start_health_reports(*component);
   context->strand().enable();
   if (impl_->started) context->start_workers();
-  impl_->contexts.push_back(std::move(context));
+  {
+    std::lock_guard lock(impl_->contexts_mutex);
+    impl_->contexts.push_back(std::move(context));
+  }
   impl_->components.push_back(std::move(component));
   return *impl_->components.back();
 }

@@ -14,6 +14,8 @@
 
 #include <fmt/format.h>
 
+#include <mocap/launch_start.hpp>
+
 #include "core/shutdown_signal.hpp"
 
 extern char** environ;
@@ -64,6 +66,7 @@ struct Child {
   Stream out, err;
   int ready_fd = -1;  // read end of its ready pipe, while Starting
   int starts = 0;
+  std::string last_end;  // how its last process ended, told to the next (its diagnostics)
   Time started_at{}, restart_at{};
   bool alive() const { return state == State::Starting || state == State::Running; }
 };
@@ -116,13 +119,22 @@ bool start(Child& child, const std::vector<std::string>& extra) {
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
-  const std::string ready_variable = fmt::format("{}={}", kReadyFdVariable, kReadyFd);
-  const std::string_view ready_name(ready_variable.data(), ready_variable.find('=') + 1);
+  // The variables this supervisor sets replace inherited ones of the same name.
+  std::vector<std::string> own_variables = {fmt::format("{}={}", kReadyFdVariable, kReadyFd)};
+  if (child.starts > 0) {
+    own_variables.push_back(fmt::format("{}={}", kGroupRestartsVariable, child.starts));
+    own_variables.push_back(fmt::format("{}={}", kGroupLastEndVariable, child.last_end));
+  }
+  auto own = [&](std::string_view variable) {
+    return std::any_of(own_variables.begin(), own_variables.end(), [&](const std::string& set) {
+      return variable.starts_with(std::string_view(set.data(), set.find('=') + 1));
+    });
+  };
   std::vector<char*> envp;
   for (char** variable = environ; *variable; ++variable) {
-    if (!std::string_view(*variable).starts_with(ready_name)) envp.push_back(*variable);
+    if (!own(*variable)) envp.push_back(*variable);
   }
-  envp.push_back(const_cast<char*>(ready_variable.c_str()));
+  for (std::string& variable : own_variables) envp.push_back(variable.data());
   envp.push_back(nullptr);
   std::string exec_failed = fmt::format("cannot run {}\n", args.front());
   pid_t parent = getpid();
@@ -304,6 +316,7 @@ class Supervisor {
 
   void ended(Child& child, int status, int code, bool had_started) {
     const std::string& name = child.spec->name;
+    child.last_end = how_it_ended(status);
     if (code == 0) {
       stop_all(fmt::format("group '{}' finished; stopping the others", name));
       return;

@@ -1,0 +1,138 @@
+// One process's statuses (process_diagnostics.hpp): the runtime's counts as rates, the levels
+// its counts raise, the process's restarts, and each level change said once.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "health/diagnostics/process_diagnostics.hpp"
+
+namespace mocap::health {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using SteadyTime = ProcessDiagnostics::SteadyTime;
+
+const SteadyTime kStart{seconds(1000)};
+
+std::string value_of(const DiagnosticStatus& status, const std::string& key) {
+  for (const auto& [k, v] : status.values) {
+    if (k == key) return v;
+  }
+  return "(none)";
+}
+
+// cam_0 as the runtime counts it, having reported at `reported_at`.
+ComponentHealth camera(SteadyTime reported_at, uint64_t images, uint64_t dropped = 0,
+                       uint64_t errors = 0) {
+  ComponentHealth health;
+  health.name = "cam_0";
+  health.plugin = "synthetic_ir_camera";
+  health.published = {{"/volume/cam_0/image_raw", images, dropped}};
+  health.received = {{"/sim/camera_pose", 1, 0}};
+  health.callback_errors = errors;
+  health.reported_at = reported_at;
+  health.report.add("capture -> image sent median (ms)", "0.4");
+  return health;
+}
+
+TEST(ProcessDiagnostics, RatesAreOverThePeriodSinceTheLastStatus) {
+  ProcessDiagnostics diagnostics({.process = "cam_0", .host = "host-a"}, kStart);
+  std::vector<DiagnosticStatus> statuses =
+      diagnostics.update({camera(kStart + seconds(1), 30)}, kStart + seconds(1));
+  ASSERT_EQ(statuses.size(), 2u);
+  EXPECT_EQ(statuses[0].name, "cam_0");
+  EXPECT_EQ(value_of(statuses[0], "restarts"), "0");
+  const DiagnosticStatus& status = statuses[1];
+  EXPECT_EQ(status.name, "cam_0/cam_0");
+  EXPECT_EQ(status.hardware_id, "host-a");
+  EXPECT_EQ(status.level, HealthLevel::ok);
+  EXPECT_EQ(status.message, "OK");
+  EXPECT_EQ(value_of(status, "plugin"), "synthetic_ir_camera");
+  EXPECT_EQ(value_of(status, "out /volume/cam_0/image_raw (msg/s)"), "30.0");
+  EXPECT_EQ(value_of(status, "in /sim/camera_pose (msg/s)"), "1.0");
+  EXPECT_EQ(value_of(status, "capture -> image sent median (ms)"), "0.4");
+  statuses =
+      diagnostics.update({camera(kStart + milliseconds(3000), 90)}, kStart + milliseconds(3000));
+  EXPECT_EQ(value_of(statuses[1], "out /volume/cam_0/image_raw (msg/s)"), "30.0");
+  EXPECT_EQ(value_of(statuses[1], "in /sim/camera_pose (msg/s)"), "0.0");
+}
+
+TEST(ProcessDiagnostics, NewDropsWarnAndNewCallbackErrorsAreErrors) {
+  ProcessDiagnostics diagnostics({.process = "p", .host = "h"}, kStart);
+  diagnostics.update({camera(kStart + seconds(1), 30)}, kStart + seconds(1));
+  std::vector<DiagnosticStatus> statuses =
+      diagnostics.update({camera(kStart + seconds(2), 60, 4)}, kStart + seconds(2));
+  EXPECT_EQ(statuses[1].level, HealthLevel::warn);
+  EXPECT_NE(statuses[1].message.find("4 message(s) on /volume/cam_0/image_raw dropped"),
+            std::string::npos)
+      << statuses[1].message;
+  EXPECT_EQ(value_of(statuses[1], "out /volume/cam_0/image_raw dropped"), "4");
+  // No new drop: OK again, the total kept.
+  statuses = diagnostics.update({camera(kStart + seconds(3), 90, 4)}, kStart + seconds(3));
+  EXPECT_EQ(statuses[1].level, HealthLevel::ok);
+  EXPECT_EQ(value_of(statuses[1], "out /volume/cam_0/image_raw dropped"), "4");
+  statuses = diagnostics.update({camera(kStart + seconds(4), 120, 4, 2)}, kStart + seconds(4));
+  EXPECT_EQ(statuses[1].level, HealthLevel::error);
+  EXPECT_NE(statuses[1].message.find("2 callback(s) threw"), std::string::npos);
+}
+
+TEST(ProcessDiagnostics, AComponentWhoseReportIsOldIsStale) {
+  ProcessDiagnostics diagnostics({.process = "p", .host = "h", .stale_after = seconds(3)}, kStart);
+  ComponentHealth stuck = camera(kStart + seconds(1), 30);
+  EXPECT_EQ(diagnostics.update({stuck}, kStart + seconds(3))[1].level, HealthLevel::ok);
+  const DiagnosticStatus status = diagnostics.update({stuck}, kStart + seconds(5))[1];
+  EXPECT_EQ(status.level, HealthLevel::stale);
+  EXPECT_NE(status.message.find("no report for 4 s"), std::string::npos) << status.message;
+  // One whose callbacks never ran at all: as old as the process.
+  ComponentHealth never = camera(SteadyTime{}, 0);
+  ProcessDiagnostics fresh({.process = "p", .host = "h", .stale_after = seconds(3)}, kStart);
+  EXPECT_EQ(fresh.update({never}, kStart + seconds(2))[1].level, HealthLevel::ok);
+  EXPECT_EQ(fresh.update({never}, kStart + seconds(4))[1].level, HealthLevel::stale);
+}
+
+TEST(ProcessDiagnostics, AComponentsOwnProblemsKeepTheirLevelAndSentence) {
+  ProcessDiagnostics diagnostics({.process = "compute", .host = "h"}, kStart);
+  ComponentHealth fusion = camera(kStart + seconds(1), 30);
+  fusion.name = "fusion";
+  fusion.report.flag(HealthLevel::error, "camera cam_3 refused: its clock is 5 ms ahead");
+  fusion.report.flag(HealthLevel::warn, "camera cam_1 is silent");
+  const DiagnosticStatus status = diagnostics.update({fusion}, kStart + seconds(1))[1];
+  EXPECT_EQ(status.level, HealthLevel::error);
+  EXPECT_EQ(status.message,
+            "camera cam_3 refused: its clock is 5 ms ahead; camera cam_1 is silent");
+}
+
+TEST(ProcessDiagnostics, ARestartedProcessWarnsForAMinuteAndKeepsItsCount) {
+  ProcessDiagnostics diagnostics(
+      {.process = "cam_1", .host = "h", .restarts = 2, .last_end = "was killed by signal 9"},
+      kStart);
+  DiagnosticStatus process = diagnostics.update({}, kStart + seconds(1))[0];
+  EXPECT_EQ(process.level, HealthLevel::warn);
+  EXPECT_EQ(value_of(process, "restarts"), "2");
+  EXPECT_EQ(value_of(process, "last process"), "was killed by signal 9");
+  EXPECT_NE(process.message.find("started again by mocap_launch (2 time(s)); the last process "
+                                 "was killed by signal 9"),
+            std::string::npos)
+      << process.message;
+  process = diagnostics.update({}, kStart + seconds(61))[0];
+  EXPECT_EQ(process.level, HealthLevel::ok);
+  EXPECT_EQ(value_of(process, "restarts"), "2");
+}
+
+TEST(ProcessDiagnostics, ALevelChangeIsSaidOnce) {
+  ProcessDiagnostics diagnostics({.process = "p", .host = "h"}, kStart);
+  diagnostics.update({camera(kStart + seconds(1), 30)}, kStart + seconds(1));
+  EXPECT_TRUE(diagnostics.level_changes().empty());
+  diagnostics.update({camera(kStart + seconds(2), 60, 1)}, kStart + seconds(2));
+  ASSERT_EQ(diagnostics.level_changes().size(), 1u);
+  EXPECT_EQ(diagnostics.level_changes()[0].substr(0, 23), "p/cam_0: OK -> WARN: 1 ");
+  diagnostics.update({camera(kStart + seconds(3), 90, 2)}, kStart + seconds(3));
+  EXPECT_TRUE(diagnostics.level_changes().empty());
+  diagnostics.update({camera(kStart + seconds(4), 120, 2)}, kStart + seconds(4));
+  ASSERT_EQ(diagnostics.level_changes().size(), 1u);
+  EXPECT_EQ(diagnostics.level_changes()[0], "p/cam_0: WARN -> OK: OK");
+}
+
+}  // namespace
+}  // namespace mocap::health
