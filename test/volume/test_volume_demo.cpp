@@ -307,9 +307,13 @@ void expect_a_shifted_camera_refused(double shift_s, int slot) {
   shifted["LD_PRELOAD"] = faketime.string();
   shifted["FAKETIME"] = fmt::format("{:+.3f}", shift_s);
   shifted["FAKETIME_DONT_FAKE_MONOTONIC"] = "1";
+  // Counted from the fifth second: with three cameras a board is found only once two of them
+  // see five of its markers, later than with four (with another demo beside: 90 to 97 % of
+  // the first two seconds' board-frames, and in one run 75 % and 83 % of the fourth and fifth
+  // seconds', every one after).
   auto compute = group("compute",
                        {"--set", "evaluator.summary_file=" + summary.string(), "--set",
-                        "viewer.port=0", "--set", "evaluator.skip_first_s=1"},
+                        "viewer.port=0", "--set", "evaluator.skip_first_s=5"},
                        environment(slot));
   std::vector<std::unique_ptr<test::ChildProcess>> cameras;
   for (int c = 0; c < 3; ++c)
@@ -317,7 +321,7 @@ void expect_a_shifted_camera_refused(double shift_s, int slot) {
   cameras.push_back(group("cam_3", {}, shifted));
   ASSERT_TRUE(compute->wait_for_output("camera cam_3 refused", std::chrono::seconds(30)))
       << compute->output() << cameras[3]->output();
-  std::this_thread::sleep_for(std::chrono::seconds(12));
+  std::this_thread::sleep_for(std::chrono::seconds(15));
   compute->signal(SIGTERM);
   ASSERT_EQ(compute->wait(std::chrono::seconds(20)), 0) << compute->output();
   const std::string output = compute->output();

@@ -45,7 +45,7 @@ struct ClockOffset {
 
 class ClockOffsetFilter {
  public:
-  // NTP keeps 8, polling every 64 s and more; probes ten times a second on a busy host meet
+  // NTP keeps 8, polling every 64 s and more; probes twenty times a second on a busy host meet
   // queues more often, and a clock drifts a few microseconds in the seconds 32 of them span.
   static constexpr size_t kSamples = 32;
 

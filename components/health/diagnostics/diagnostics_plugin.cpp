@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <mutex>
 #include <random>
 #include <set>
 #include <string>
@@ -84,9 +85,16 @@ class Diagnostics final : public Component {
                      std::chrono::steady_clock::now()) {
     statuses_ = create_publisher<DiagnosticArray>(topics::kDiagnostics);
     replies_ = create_publisher<ClockProbeReply>(topics::kClockReply);
+    note_topics(context.process_health());
     create_subscription<ClockProbe>(topics::kClockProbe,
                                     [this](const ClockProbe& probe) { answer(probe); });
-    create_timer(seconds(settings_.period_s), [this] { publish(); });
+    // The statuses on a thread of their own: gathering and sending them takes a fraction of a
+    // millisecond, which on the component's strand would delay the answers to clock probes
+    // (their arrival times are what the asker measures) and keep them off the DDS thread that
+    // runs quick callbacks at once.
+    create_worker("statuses", [this, period = seconds(settings_.period_s)](std::stop_token stop) {
+      while (wait_for_stop(stop, period)) publish();
+    });
   }
 
  private:
@@ -98,14 +106,20 @@ class Diagnostics final : public Component {
     return text ? text : "";
   }
 
-  void answer(const ClockProbe& probe) {
-    const auto received = now();
-    // The topics as they are now: a component may have advertised one since the last status,
-    // and a fusion refuses a camera until it knows whose clock stamps its topic.
+  // The topics this process's components publish: those of their constructors (this component
+  // is the last made), then as each status finds them. An answer only copies them: the less it
+  // does, the sooner it runs after the probe arrived, and the truer the clock it tells.
+  void note_topics(const std::vector<ComponentHealth>& components) {
     std::set<std::string> topics;
-    for (const ComponentHealth& component : context().process_health()) {
+    for (const ComponentHealth& component : components) {
       for (const TopicCounts& topic : component.published) topics.insert(topic.topic);
     }
+    std::lock_guard lock(topics_mutex_);
+    published_topics_.assign(topics.begin(), topics.end());
+  }
+
+  void answer(const ClockProbe& probe) {
+    const auto received = now();
     ClockProbeReply reply;
     reply.requester(probe.requester());
     reply.number(probe.number());
@@ -114,13 +128,17 @@ class Diagnostics final : public Component {
     reply.instance(instance_);
     reply.host(host_);
     reply.process(context().process_name());
-    reply.topics({topics.begin(), topics.end()});
+    {
+      std::lock_guard lock(topics_mutex_);
+      reply.topics(published_topics_);
+    }
     reply.sent(to_time_msg(now()));
     replies_.publish(std::move(reply));
   }
 
   void publish() {
     const std::vector<ComponentHealth> components = context().process_health();
+    note_topics(components);
     DiagnosticArray array;
     array.header().stamp(to_time_msg(now()));
     for (const DiagnosticStatus& status :
@@ -148,7 +166,9 @@ class Diagnostics final : public Component {
 
   const std::string host_;
   const uint64_t instance_;
-  ProcessDiagnostics diagnostics_;
+  ProcessDiagnostics diagnostics_;  // the statuses worker's alone
+  std::mutex topics_mutex_;         // the worker writes the topics, the answers read them
+  std::vector<std::string> published_topics_;
   Publisher<DiagnosticArray> statuses_;
   Publisher<ClockProbeReply> replies_;
 };

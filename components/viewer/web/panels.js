@@ -83,14 +83,15 @@ const LEVELS = ["OK", "WARN", "ERROR", "STALE"];
 const escape = (text) => text.replace(/[&<>"]/g, (c) => `&#${c.charCodeAt(0)};`);
 
 // One row per status, the worst first, with the stage's latency where the component gives one
-// (the first "capture -> ..." median) and its host.
+// (its last "capture -> ..." median) and its host.
 export function health() {
   const now = Date.now();
   const rows = [...graph.health.entries()].map(([name, { status, receivedAt }]) => {
     const stale = now - receivedAt > HEALTH_STALE_MS;
     const level = stale ? 3 : Math.min(status.level, 3);
     const message = stale ? `no status for ${((now - receivedAt) / 1000).toFixed(0)} s: is its process running?` : status.message;
-    const latency = status.values.find((v) => v.key.startsWith("capture -> ") && v.key.endsWith("median (ms)"));
+    // The stage's last figure: a fusion gives its inputs' arrival, then its poses sent.
+    const latency = status.values.filter((v) => v.key.startsWith("capture -> ") && v.key.endsWith("median (ms)")).pop();
     return { name, level, message, host: status.hardware_id, latency };
   });
   rows.sort((a, b) => b.level - a.level || a.name.localeCompare(b.name));

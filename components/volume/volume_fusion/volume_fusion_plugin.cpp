@@ -76,9 +76,11 @@ constexpr int kGapFramesLogged = 3;
 constexpr double kOwnMarkerRadius_m = 0.005;
 // A process that has not answered a clock probe for this long has ended.
 constexpr std::chrono::seconds kClockSilence{3};
-// Exchanges with a camera's host before its clock is judged: of five, one quick enough to tell
-// the offset to a tenth of a millisecond (half a second at the default probe rate).
-constexpr int kClockSamplesForVerdict = 5;
+// Exchanges with a camera's host after which its clock is judged on the best of them even where
+// none proves it within or beyond the limit, and its offset logged: of ten, one is quick enough
+// to tell it to a tenth of a millisecond on a busy host (half a second at the default probe
+// rate).
+constexpr int kClockSamplesForVerdict = 10;
 // A camera whose clock stays unknown this long after its first message is said to be refused.
 constexpr std::chrono::seconds kUnknownClockAlert{1};
 
@@ -101,7 +103,7 @@ struct Settings : VolumeTrackerOptions {
   double silent_after_s = 0.5;
   double behind_max_gap_s = 0.02;
   bool check_clocks = true;
-  double clock_probe_hz = 10;
+  double clock_probe_hz = 20;
   double clock_warning_ms = 0.2;
   double clock_limit_ms = 1.0;
 
@@ -426,6 +428,7 @@ class VolumeFusion final : public Component {
     std::string publisher;  // "<process> on <host>"
     std::optional<std::chrono::steady_clock::time_point> first_message;
     bool unknown_alerted = false;
+    bool measured_logged = false;  // said once the filter holds kClockSamplesForVerdict
     uint64_t refused = 0;
   };
 
@@ -457,19 +460,25 @@ class VolumeFusion final : public Component {
         topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name);
     const health::PeerClocks::Peer* peer = clocks_.publisher_of(topic);
     clock.offset = peer ? peer->filter.offset() : std::nullopt;
+    // Judged on what the exchanges prove: refused once the clock is surely more than the limit
+    // off, fused once it is surely within it (a camera is not refused for the network's
+    // queues); in between, until an exchange quick enough to tell comes, or enough have.
     ClockVerdict verdict = ClockVerdict::unknown;
-    if (clock.offset && clock.offset->samples >= kClockSamplesForVerdict) {
+    if (clock.offset) {
       clock.publisher = fmt::format("{} on {}", peer->process, peer->host);
-      // Off by at least this much: a camera is not refused for the network's queues.
-      const double off_ms = static_cast<double>(clock.offset->least_offset_ns()) * 1e-6;
-      verdict = off_ms > settings_.clock_limit_ms     ? ClockVerdict::refused
-                : off_ms > settings_.clock_warning_ms ? ClockVerdict::warned
-                                                      : ClockVerdict::accepted;
-    }
-    if (verdict != clock.verdict) {
-      const ClockVerdict was = clock.verdict;
-      clock.verdict = verdict;
-      if (was == ClockVerdict::unknown) {
+      const double least_ms = static_cast<double>(clock.offset->least_offset_ns()) * 1e-6;
+      const double most_ms =
+          static_cast<double>(std::abs(clock.offset->offset_ns) + clock.offset->round_trip_ns / 2) *
+          1e-6;
+      if (least_ms > settings_.clock_limit_ms) {
+        verdict = ClockVerdict::refused;
+      } else if (most_ms <= settings_.clock_limit_ms ||
+                 clock.offset->samples >= kClockSamplesForVerdict) {
+        verdict =
+            least_ms > settings_.clock_warning_ms ? ClockVerdict::warned : ClockVerdict::accepted;
+      }
+      if (!clock.measured_logged && clock.offset->samples >= kClockSamplesForVerdict) {
+        clock.measured_logged = true;
         log().info(
             "camera {}: the clock of {} is {:+.3f} ms against this host's (round trip {:.3f} ms), "
             "known {:.2f} s after its first message",
@@ -477,6 +486,10 @@ class VolumeFusion final : public Component {
             clock.offset->round_trip_ns * 1e-6,
             std::chrono::duration<double>(arrival - *clock.first_message).count());
       }
+    }
+    if (verdict != clock.verdict) {
+      const ClockVerdict was = clock.verdict;
+      clock.verdict = verdict;
       if (verdict == ClockVerdict::refused) {
         alert(2, clock_problem(c));
       } else if (verdict == ClockVerdict::warned) {
