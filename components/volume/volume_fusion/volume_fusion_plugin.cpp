@@ -76,11 +76,18 @@ constexpr int kGapFramesLogged = 3;
 constexpr double kOwnMarkerRadius_m = 0.005;
 // A process that has not answered a clock probe for this long has ended.
 constexpr std::chrono::seconds kClockSilence{3};
-// Exchanges with a camera's host after which its clock is judged on the best of them even where
-// none proves it within or beyond the limit, and its offset logged: of ten, one is quick enough
-// to tell it to a tenth of a millisecond on a busy host (half a second at the default probe
-// rate).
-constexpr int kClockSamplesForVerdict = 10;
+// A camera's clock is settled once an exchange with its host was this quick (it tells the
+// offset to half of it, a tenth of a millisecond) or the filter is full: its offset is logged,
+// and where no exchange proved it within or beyond the limit, it is judged on the best.
+constexpr std::chrono::nanoseconds kSettledRoundTrip{200'000};
+// Probes come this often while a camera's clock is not settled: on a busy host a quick exchange
+// is rare, and the sooner one comes the sooner the clock is known.
+constexpr std::chrono::milliseconds kSettlingProbePeriod{10};
+
+bool settled(const health::ClockOffset& offset) {
+  return offset.round_trip_ns <= kSettledRoundTrip.count() ||
+         offset.samples >= static_cast<int>(health::ClockOffsetFilter::kSamples);
+}
 // A camera whose clock stays unknown this long after its first message is said to be refused.
 constexpr std::chrono::seconds kUnknownClockAlert{1};
 
@@ -201,7 +208,9 @@ const ParameterList<Settings> kParameters =
              "clock is unknown or off by more than clock_limit_ms (false: for cameras in this "
              "process only, or a graph without diagnostics components)",
              &Settings::check_clocks)
-        .add("clock_probe_hz", "clock probes a second", &Settings::clock_probe_hz)
+        .add("clock_probe_hz",
+             "clock probes a second once every camera's clock is settled (a hundred before)",
+             &Settings::clock_probe_hz)
         .range(0.5, 100)
         .add("clock_warning_ms", "a camera's clock off by more than this is fused with a warning",
              &Settings::clock_warning_ms)
@@ -350,7 +359,7 @@ class VolumeFusion final : public Component {
       probes_ = create_publisher<ClockProbe>(topics::kClockProbe);
       create_subscription<ClockProbeReply>(
           topics::kClockReply, [this](const ClockProbeReply& reply) { take_clock_reply(reply); });
-      create_timer(seconds(1.0 / settings_.clock_probe_hz), [this] { probe_clocks(); });
+      create_timer(kSettlingProbePeriod, [this] { probe_clocks(); });
     }
     // Frames whose wait runs out while no message arrives: a camera that stopped.
     create_timer(std::chrono::milliseconds(1), [this] { fuse_ready(); });
@@ -428,17 +437,28 @@ class VolumeFusion final : public Component {
     std::string publisher;  // "<process> on <host>"
     std::optional<std::chrono::steady_clock::time_point> first_message;
     bool unknown_alerted = false;
-    bool measured_logged = false;  // said once the filter holds kClockSamplesForVerdict
+    bool measured_logged = false;  // said once settled
     uint64_t refused = 0;
   };
 
+  // clock_probe_hz a second, and every kSettlingProbePeriod while a camera's host answers but
+  // its clock is not settled.
   void probe_clocks() {
+    const auto steady_now = std::chrono::steady_clock::now();
+    const bool settling = std::any_of(
+        tracker_.cameras().begin(), tracker_.cameras().end(), [this](const VolumeCamera& camera) {
+          const health::PeerClocks::Peer* peer =
+              clocks_.publisher_of(topics::member_of(topics::kVolumeFiducials, camera.name));
+          return peer != nullptr && peer->filter.offset() && !settled(*peer->filter.offset());
+        });
+    if (!settling && steady_now - last_probe_ < seconds(1.0 / settings_.clock_probe_hz)) return;
+    last_probe_ = steady_now;
     ClockProbe probe;
     probe.requester(name());
     probe.number(++probe_number_);
     probe.sent(to_time_msg(now()));
     probes_.publish(std::move(probe));
-    clocks_.forget_silent(std::chrono::steady_clock::now(), kClockSilence);
+    clocks_.forget_silent(steady_now, kClockSilence);
   }
 
   void take_clock_reply(const ClockProbeReply& reply) {
@@ -472,12 +492,11 @@ class VolumeFusion final : public Component {
           1e-6;
       if (least_ms > settings_.clock_limit_ms) {
         verdict = ClockVerdict::refused;
-      } else if (most_ms <= settings_.clock_limit_ms ||
-                 clock.offset->samples >= kClockSamplesForVerdict) {
+      } else if (most_ms <= settings_.clock_limit_ms || settled(*clock.offset)) {
         verdict =
             least_ms > settings_.clock_warning_ms ? ClockVerdict::warned : ClockVerdict::accepted;
       }
-      if (!clock.measured_logged && clock.offset->samples >= kClockSamplesForVerdict) {
+      if (!clock.measured_logged && settled(*clock.offset)) {
         clock.measured_logged = true;
         log().info(
             "camera {}: the clock of {} is {:+.3f} ms against this host's (round trip {:.3f} ms), "
@@ -826,6 +845,7 @@ class VolumeFusion final : public Component {
   health::PeerClocks clocks_;
   Publisher<ClockProbe> probes_;
   uint32_t probe_number_ = 0;
+  std::chrono::steady_clock::time_point last_probe_{};
   LatencyFigures arrival_latency_;
   LatencyFigures poses_latency_;
 };
