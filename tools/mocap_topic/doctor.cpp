@@ -133,7 +133,9 @@ void report_expectations(const Observations& seen, const Expectations& expected,
       (endpoint->publisher ? writers : readers)
           .insert(fmt::format("{} ({})", endpoint->component, endpoint->group));
     }
-    if (!readers.empty() && !published.count(topic)) {
+    // A component may declare a topic it takes only with some parameters (a camera's pose for
+    // a moving camera): what is declared but not read or written now is no problem.
+    if (!readers.empty() && !published.count(topic) && subscribed.count(topic)) {
       std::set<std::string> expected_writers;
       for (const ExpectedEndpoint* endpoint : endpoints) {
         if (endpoint->publisher) expected_writers.insert(endpoint->component);
@@ -145,28 +147,25 @@ void report_expectations(const Observations& seen, const Expectations& expected,
             "correct the remap",
             topic, joined(readers), *meant, *meant));
       } else if (!expected_writers.empty()) {
-        report.problem(
-            fmt::format("nobody publishes {}, which {} read(s). Do: check {} (its log, "
-                        "its remaps)",
-                        topic, joined(readers), joined(expected_writers)));
+        report.problem(fmt::format("nobody publishes {}, which {} read(s). Do: check {} (its log, "
+                                   "its remaps)",
+                                   topic, joined(readers), joined(expected_writers)));
       } else {
-        // An input from outside the file (a re-seed, a simulator's pose): there may be none.
-        report.note(
-            fmt::format("{} read(s) {}, which no component of the file publishes and "
-                        "nobody publishes now",
-                        joined(readers), topic));
+        // An input from outside the file (a re-seed): there may be none.
+        report.note(fmt::format("{} read(s) {}, which no component of the file publishes and "
+                                "nobody publishes now",
+                                joined(readers), topic));
       }
     }
-    if (!writers.empty() && !subscribed.count(topic)) {
+    if (!writers.empty() && published.count(topic) && !subscribed.count(topic)) {
       std::set<std::string> expected_readers;
       for (const ExpectedEndpoint* endpoint : endpoints) {
         if (!endpoint->publisher) expected_readers.insert(endpoint->component);
       }
       if (!expected_readers.empty()) {
-        report.problem(
-            fmt::format("nobody reads {}, which {} publish(es) for {}. Do: check "
-                        "their processes and remaps",
-                        topic, joined(writers), joined(expected_readers)));
+        report.note(fmt::format("nobody reads {} now, which {} publish(es) for {} (down, or not "
+                                "reading it with its parameters)",
+                                topic, joined(writers), joined(expected_readers)));
       }
     }
   }
