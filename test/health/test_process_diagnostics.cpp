@@ -24,12 +24,12 @@ std::string value_of(const DiagnosticStatus& status, const std::string& key) {
 
 // cam_0 as the runtime counts it, having reported at `reported_at`.
 ComponentHealth camera(SteadyTime reported_at, uint64_t images, uint64_t dropped = 0,
-                       uint64_t errors = 0) {
+                       uint64_t errors = 0, uint64_t dropped_in = 0) {
   ComponentHealth health;
   health.name = "cam_0";
   health.plugin = "synthetic_ir_camera";
   health.published = {{"/volume/cam_0/image_raw", images, dropped}};
-  health.received = {{"/sim/camera_pose", 1, 0}};
+  health.received = {{"/sim/camera_pose", 1, dropped_in, 3}};
   health.callback_errors = errors;
   health.reported_at = reported_at;
   health.report.add("capture -> image sent median (ms)", "0.4");
@@ -51,6 +51,8 @@ TEST(ProcessDiagnostics, RatesAreOverThePeriodSinceTheLastStatus) {
   EXPECT_EQ(value_of(status, "plugin"), "synthetic_ir_camera");
   EXPECT_EQ(value_of(status, "out /volume/cam_0/image_raw (msg/s)"), "30.0");
   EXPECT_EQ(value_of(status, "in /sim/camera_pose (msg/s)"), "1.0");
+  EXPECT_EQ(value_of(status, "in /sim/camera_pose waiting"), "3");
+  EXPECT_EQ(value_of(status, "in /sim/camera_pose dropped"), "(none)");
   EXPECT_EQ(value_of(status, "capture -> image sent median (ms)"), "0.4");
   statuses =
       diagnostics.update({camera(kStart + milliseconds(3000), 90)}, kStart + milliseconds(3000));
@@ -75,6 +77,14 @@ TEST(ProcessDiagnostics, NewDropsWarnAndNewCallbackErrorsAreErrors) {
   statuses = diagnostics.update({camera(kStart + seconds(4), 120, 4, 2)}, kStart + seconds(4));
   EXPECT_EQ(statuses[1].level, HealthLevel::error);
   EXPECT_NE(statuses[1].message.find("2 callback(s) threw"), std::string::npos);
+  // A subscriber's own drops: its queue overflowed.
+  statuses = diagnostics.update({camera(kStart + seconds(5), 150, 4, 2, 7)}, kStart + seconds(5));
+  EXPECT_EQ(statuses[1].level, HealthLevel::warn);
+  EXPECT_NE(statuses[1].message.find("7 message(s) on /sim/camera_pose dropped before it read "
+                                     "them"),
+            std::string::npos)
+      << statuses[1].message;
+  EXPECT_EQ(value_of(statuses[1], "in /sim/camera_pose dropped"), "7");
 }
 
 TEST(ProcessDiagnostics, AComponentWhoseReportIsOldIsStale) {
@@ -132,6 +142,31 @@ TEST(ProcessDiagnostics, ALevelChangeIsSaidOnce) {
   diagnostics.update({camera(kStart + seconds(4), 120, 2)}, kStart + seconds(4));
   ASSERT_EQ(diagnostics.level_changes().size(), 1u);
   EXPECT_EQ(diagnostics.level_changes()[0], "p/cam_0: WARN -> OK: OK");
+}
+
+// A stream's rate against what it should be (mocap/health.hpp), judged from the second report:
+// below 90 % a warning with its cause; a stopped stream is not judged.
+TEST(RateFigures, WarnsBelowTheExpectedRateFromTheSecondReportOn) {
+  RateFigures rate;
+  HealthReport first;
+  rate.add();
+  rate.report(first, "frames", 1e12, "the host is too busy");
+  EXPECT_EQ(first.level, HealthLevel::ok);  // the start's period
+  HealthReport slow;
+  rate.add();
+  rate.report(slow, "frames", 1e12, "the host is too busy");  // one frame in microseconds at most
+  EXPECT_EQ(slow.level, HealthLevel::warn);
+  EXPECT_NE(slow.message.find("of 1000000000000.0: the host is too busy"), std::string::npos)
+      << slow.message;
+  HealthReport stopped;
+  rate.report(stopped, "frames", 1e12, "the host is too busy");
+  EXPECT_EQ(stopped.level, HealthLevel::ok);
+  EXPECT_EQ(stopped.values[1].second, "0.0");
+  HealthReport fast;
+  rate.add();
+  rate.report(fast, "frames", 1e-3, "the host is too busy");  // one frame in less than 1000 s
+  EXPECT_EQ(fast.level, HealthLevel::ok);
+  EXPECT_EQ(fast.values[0], (std::pair<std::string, std::string>("frames expected (Hz)", "0.0")));
 }
 
 }  // namespace

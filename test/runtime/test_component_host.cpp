@@ -904,6 +904,8 @@ TEST_F(ComponentHostTest, EachComponentReportsItsHealthOnItsStrandWithTheRuntime
   const ComponentHealth& sink = health_record.seen[1];
   ASSERT_EQ(sink.received.size(), 1u);
   EXPECT_EQ(sink.received[0].messages, 50u);
+  EXPECT_EQ(sink.received[0].dropped, 0u);
+  EXPECT_EQ(sink.received[0].waiting, std::optional<size_t>(0));  // all taken
   const ComponentHealth& reporter = health_record.seen[2];
   EXPECT_EQ(reporter.report.level, HealthLevel::warn);
   EXPECT_EQ(reporter.report.message, "a test's warning");

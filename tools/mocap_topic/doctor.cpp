@@ -147,14 +147,16 @@ void report_expectations(const Observations& seen, const Expectations& expected,
             "correct the remap",
             topic, joined(readers), *meant, *meant));
       } else if (!expected_writers.empty()) {
-        report.problem(fmt::format("nobody publishes {}, which {} read(s). Do: check {} (its log, "
-                                   "its remaps)",
-                                   topic, joined(readers), joined(expected_writers)));
+        report.problem(
+            fmt::format("nobody publishes {}, which {} read(s). Do: check {} (its log, "
+                        "its remaps)",
+                        topic, joined(readers), joined(expected_writers)));
       } else {
         // An input from outside the file (a re-seed): there may be none.
-        report.note(fmt::format("{} read(s) {}, which no component of the file publishes and "
-                                "nobody publishes now",
-                                joined(readers), topic));
+        report.note(
+            fmt::format("{} read(s) {}, which no component of the file publishes and "
+                        "nobody publishes now",
+                        joined(readers), topic));
       }
     }
     if (!writers.empty() && published.count(topic) && !subscribed.count(topic)) {
@@ -163,9 +165,10 @@ void report_expectations(const Observations& seen, const Expectations& expected,
         if (!endpoint->publisher) expected_readers.insert(endpoint->component);
       }
       if (!expected_readers.empty()) {
-        report.note(fmt::format("nobody reads {} now, which {} publish(es) for {} (down, or not "
-                                "reading it with its parameters)",
-                                topic, joined(writers), joined(expected_readers)));
+        report.note(
+            fmt::format("nobody reads {} now, which {} publish(es) for {} (down, or not "
+                        "reading it with its parameters)",
+                        topic, joined(writers), joined(expected_readers)));
       }
     }
   }

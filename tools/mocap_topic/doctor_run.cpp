@@ -134,7 +134,8 @@ int run_doctor(const DoctorCommand& command) {
                       {Reliability::Reliable, Durability::Volatile, History::KeepLast, 10},
                       doorbell);
     Inbox replies(*transport, "/mocap/clock/reply", message_type<ClockProbeReply>(),
-                  Qos::sensor_data(), doorbell);
+                  {Reliability::BestEffort, Durability::Volatile, History::KeepLast, 100},
+                  doorbell);
     auto probes = transport->advertise(
         {"/mocap/clock/probe", &message_type<ClockProbe>(), Qos::sensor_data(), kParticipant});
     std::map<std::string, std::pair<DiagnosticArray, std::chrono::steady_clock::time_point>> last;

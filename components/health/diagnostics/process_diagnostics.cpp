@@ -30,8 +30,10 @@ std::vector<DiagnosticStatus> ProcessDiagnostics::update(
       counts.published[topic.topic] = topic.messages;
       counts.dropped[topic.topic] = topic.dropped;
     }
-    for (const TopicCounts& topic : component.received)
+    for (const TopicCounts& topic : component.received) {
       counts.received[topic.topic] = topic.messages;
+      counts.dropped_in[topic.topic] = topic.dropped;
+    }
     counts.callback_errors = component.callback_errors;
   }
   last_update_ = now;
@@ -66,6 +68,21 @@ DiagnosticStatus ProcessDiagnostics::component_status(const ComponentHealth& com
     auto it = before.received.find(topic.topic);
     runtime.add(fmt::format("in {} (msg/s)", topic.topic),
                 rate(topic.messages, it == before.received.end() ? 0 : it->second, seconds));
+    if (topic.waiting) {
+      runtime.add(fmt::format("in {} waiting", topic.topic), std::to_string(*topic.waiting));
+    }
+    if (topic.dropped == 0) continue;
+    runtime.add(fmt::format("in {} dropped", topic.topic), std::to_string(topic.dropped));
+    auto dropped_before = before.dropped_in.find(topic.topic);
+    const uint64_t new_drops =
+        topic.dropped - (dropped_before == before.dropped_in.end() ? 0 : dropped_before->second);
+    if (new_drops > 0) {
+      report.flag(HealthLevel::warn,
+                  fmt::format("{} message(s) on {} dropped before it read them: it reads slower "
+                              "than they come (its queue overflowed) or they were lost on the "
+                              "way (see its log)",
+                              new_drops, topic.topic));
+    }
   }
   for (const TopicCounts& topic : component.published) {
     auto it = before.published.find(topic.topic);

@@ -115,6 +115,8 @@ class CentroidCameraComponent final : public Component {
   }
 
   void report_health(HealthReport& report) override {
+    rate_.report(report, "frames", settings_.rate_hz,
+                 "the capture thread misses its times: the host is too busy");
     latency_.report(report, "capture -> fiducials sent");
   }
 
@@ -158,6 +160,7 @@ class CentroidCameraComponent final : public Component {
     }
     fiducials_.publish(std::move(fiducials));
     latency_.add(now() - stamp);
+    rate_.add();
     // The truth after the centroids, which it would otherwise delay, and only while someone
     // reads it (in the demos, the one camera whose truth the evaluator takes): it costs as
     // much as the centroids.
@@ -181,7 +184,8 @@ class CentroidCameraComponent final : public Component {
   }
 
   SwarmScene scene_;
-  LatencyFigures latency_;                  // added by the capture thread
+  LatencyFigures latency_;  // added by the capture thread
+  RateFigures rate_;
   std::unique_ptr<CentroidCamera> camera_;  // only the capture thread uses it
   std::string frame_id_;
   std::chrono::system_clock::time_point scene_start_;

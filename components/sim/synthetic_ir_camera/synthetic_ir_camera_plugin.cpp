@@ -192,6 +192,10 @@ class SyntheticIrCamera final : public Component {
   }
 
   void report_health(HealthReport& report) override {
+    if (settings_.rate_hz > 0) {
+      rate_.report(report, "frames", settings_.rate_hz,
+                   "rendering takes longer than a frame period: the host is too busy");
+    }
     latency_.report(report, "capture -> image sent");
   }
 
@@ -258,6 +262,7 @@ class SyntheticIrCamera final : public Component {
     }
     images_.publish(std::move(image));
     latency_.add(now() - stamp);
+    rate_.add();
     truths_.publish(std::move(truth));
     if (infos_) {
       auto info = std::make_shared<sensor_msgs::msg::CameraInfo>(camera_info_);
@@ -283,6 +288,7 @@ class SyntheticIrCamera final : public Component {
   Publisher<mocap_msgs::msg::ConstellationPoseArray> truths_;
   Publisher<sensor_msgs::msg::CameraInfo> infos_;  // none for a lens camera_info cannot describe
   LatencyFigures latency_;                         // added by the capture thread when synchronized
+  RateFigures rate_;
 };
 
 }  // namespace

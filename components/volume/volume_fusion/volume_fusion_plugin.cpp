@@ -314,8 +314,12 @@ class VolumeFusion final : public Component {
         "once: each camera's optical frame (its images' frame id) in 'world'");
     spec.publishes<ClockProbe>(topics::kClockProbe, Qos::sensor_data(),
                                "clock probes, clock_probe_hz a second (check_clocks)");
-    spec.subscribes<ClockProbeReply>(topics::kClockReply, Qos::sensor_data(),
-                                     "the processes' answers: the cameras' hosts' clocks");
+    // Best effort, as the answers are sent, but a queue for every process's answers to the
+    // probes of a settling burst (a hundred a second).
+    spec.subscribes<ClockProbeReply>(
+        topics::kClockReply,
+        {Reliability::BestEffort, Durability::Volatile, History::KeepLast, 100},
+        "the processes' answers: the cameras' hosts' clocks");
   }
 
   explicit VolumeFusion(Context& context)
@@ -396,6 +400,11 @@ class VolumeFusion final : public Component {
     const double period_s = std::chrono::duration<double>(frames_.frame_period()).count();
     report.add("fused frames", std::to_string(fused_frames_));
     report.add("camera frame rate (Hz)", period_s > 0 ? fmt::format("{:.1f}", 1 / period_s) : "-");
+    if (period_s > 0) {
+      fused_rate_.report(report, "fused frames", 1 / period_s,
+                         "the fusion is behind its cameras and skips frames: the host is too "
+                         "busy, or the scene too large for it");
+    }
     report.add("incomplete frames", std::to_string(incomplete_frames_));
     report.add("skipped while behind", std::to_string(skipped_frames_));
     report.add("late messages dropped", std::to_string(frames_.late_drops()));
@@ -623,6 +632,7 @@ class VolumeFusion final : public Component {
     body_poses_ += poses.size();
     poses_.publish(std::move(message));
     poses_latency_.add(now() - Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns)));
+    fused_rate_.add();
     markers_.publish(std::make_shared<PointCloud2>(to_point_cloud(header, markers)));
     report_unposed(poses, assembled.stamp_ns);
     report_drift();
@@ -848,6 +858,7 @@ class VolumeFusion final : public Component {
   std::chrono::steady_clock::time_point last_probe_{};
   LatencyFigures arrival_latency_;
   LatencyFigures poses_latency_;
+  RateFigures fused_rate_;
 };
 
 }  // namespace

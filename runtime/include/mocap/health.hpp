@@ -6,9 +6,11 @@
 // /diagnostics).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -54,11 +56,32 @@ class LatencyFigures {
   std::vector<int64_t> samples_;
 };
 
+// A stream's rate over each report's period against the rate it should have (a camera's
+// frames against its rate_hz): report() adds "<what> (Hz)" and "<what> expected (Hz)", and
+// flags WARN with `why_low` when it ran below 90 % of it. A stream that stopped (0 Hz: a camera
+// waiting for its first subscriber) is left to who reads it. The first period, which holds the
+// start, is not judged. Thread-safe.
+class RateFigures {
+ public:
+  void add() { count_.fetch_add(1, std::memory_order_relaxed); }
+  void report(HealthReport& report, std::string_view what, double expected_hz,
+              std::string_view why_low);
+
+ private:
+  std::atomic<uint64_t> count_{0};
+  std::optional<std::chrono::steady_clock::time_point> since_;
+};
+
 // What the runtime counts for one topic of a component, since the component started.
 struct TopicCounts {
   std::string topic;      // after remaps
   uint64_t messages = 0;  // published, or received (callbacks run)
-  uint64_t dropped = 0;   // publisher side: given up (Qos::max_blocking, a failed write)
+  // Published: given up for some subscriber (Qos::max_blocking, a failed write). Received:
+  // given up for this one (its keep-last queue overflowed, lost or rejected in transit).
+  uint64_t dropped = 0;
+  // Received: samples waiting to be taken now (its queue's depth); nullopt where the DDS
+  // implementation does not tell.
+  std::optional<size_t> waiting = std::nullopt;
 };
 
 // One component of this process, as Context::process_health() gives it.

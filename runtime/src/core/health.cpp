@@ -49,4 +49,24 @@ void LatencyFigures::report(HealthReport& report, std::string_view stage) {
   report.add(fmt::format("{} p99 (ms)", stage), fmt::format("{:.3f}", at(0.99)));
 }
 
+void RateFigures::report(HealthReport& report, std::string_view what, double expected_hz,
+                         std::string_view why_low) {
+  const auto now = std::chrono::steady_clock::now();
+  const uint64_t count = count_.exchange(0, std::memory_order_relaxed);
+  const std::optional<std::chrono::steady_clock::time_point> since = since_;
+  since_ = now;
+  report.add(fmt::format("{} expected (Hz)", what), fmt::format("{:.1f}", expected_hz));
+  if (!since) {
+    report.add(fmt::format("{} (Hz)", what), "-");
+    return;
+  }
+  const double hz =
+      static_cast<double>(count) / std::chrono::duration<double>(now - *since).count();
+  report.add(fmt::format("{} (Hz)", what), fmt::format("{:.1f}", hz));
+  if (hz > 0 && hz < 0.9 * expected_hz) {
+    report.flag(HealthLevel::warn,
+                fmt::format("{} at {:.1f} Hz of {:.1f}: {}", what, hz, expected_hz, why_low));
+  }
+}
+
 }  // namespace mocap

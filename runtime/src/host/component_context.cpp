@@ -86,6 +86,16 @@ class HostSubscription final : public Waitable {
 
   const std::string& topic() const { return topic_; }
   uint64_t received() const { return received_.load(std::memory_order_relaxed); }
+  // Over every transport; call with the context's endpoints_mutex_ held (sources_ changes under
+  // it).
+  TopicCounts counts() const {
+    TopicCounts counts{topic_, received(), 0, std::nullopt};
+    for (const auto& source : sources_) {
+      counts.dropped += source->dropped();
+      if (auto waiting = source->waiting()) counts.waiting = counts.waiting.value_or(0) + *waiting;
+    }
+    return counts;
+  }
 
   bool execute_one() override {
     ReceivedMessage received;
@@ -206,7 +216,7 @@ ComponentHealth ComponentContext::health() const {
   }
   for (const auto& waitable : waitables_) {
     if (const auto* subscription = dynamic_cast<const HostSubscription*>(waitable.get())) {
-      health.received.push_back({subscription->topic(), subscription->received(), 0});
+      health.received.push_back(subscription->counts());
     }
   }
   health.callback_errors = strand_.callback_errors() + worker_errors_.load();

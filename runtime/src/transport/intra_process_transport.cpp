@@ -22,6 +22,11 @@ class IntraProcessTransport::Queue {
         drops_(endpoint, "in-process subscriber") {}
 
   const Endpoint& endpoint() const { return endpoint_; }
+  uint64_t dropped() const { return drops_.total(); }
+  size_t waiting() const {
+    std::lock_guard lock(mutex_);
+    return messages_.size();
+  }
 
   bool take(ReceivedMessage& out) {
     {
@@ -129,7 +134,7 @@ class IntraProcessTransport::Queue {
   IntraProcessTransport& transport_;
   Endpoint endpoint_;
   DataNotification on_data_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable room_;
   std::deque<ReceivedMessage> messages_;
   bool closed_ = false;
@@ -146,6 +151,8 @@ class IntraProcessTransport::Subscription final : public TransportSubscription {
     transport_.remove(queue_);
   }
   bool take(ReceivedMessage& out) override { return queue_->take(out); }
+  uint64_t dropped() const override { return queue_->dropped(); }
+  std::optional<size_t> waiting() const override { return queue_->waiting(); }
 
  private:
   IntraProcessTransport& transport_;

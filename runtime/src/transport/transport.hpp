@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include <mocap/component.hpp>
@@ -49,6 +50,12 @@ class TransportSubscription {
   virtual ~TransportSubscription() = default;
   // Moves the next waiting message into `out`; false when none waits.
   virtual bool take(ReceivedMessage& out) = 0;
+  // Samples given up for this subscriber: a keep-last queue that overflowed, lost or rejected
+  // in transit, malformed. Thread-safe.
+  virtual uint64_t dropped() const = 0;
+  // Samples waiting to be taken now; nullopt where the implementation does not tell (Cyclone
+  // DDS). Thread-safe.
+  virtual std::optional<size_t> waiting() const = 0;
 };
 
 // Called, from any thread, when a message may be ready to take. `may_run_callbacks` is true

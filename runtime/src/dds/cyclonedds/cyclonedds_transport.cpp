@@ -246,6 +246,10 @@ class CycloneDdsTransport::Reader final : public TransportSubscription {
     }
   }
 
+  uint64_t dropped() const override { return drops_.total(); }
+  // Cyclone DDS has no count of a reader's unread samples short of reading them.
+  std::optional<size_t> waiting() const override { return std::nullopt; }
+
  private:
   static void on_data_available(dds_entity_t, void* self) {
     static_cast<Reader*>(self)->on_data_(!writing);

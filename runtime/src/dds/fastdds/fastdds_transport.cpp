@@ -330,6 +330,11 @@ class FastDdsTransport::Reader final : public TransportSubscription,
     }
   }
 
+  uint64_t dropped() const override { return drops_.total(); }
+  std::optional<size_t> waiting() const override {
+    return static_cast<size_t>(reader_->get_unread_count());
+  }
+
   void on_data_available(dds::DataReader*) override { on_data_(!writing); }
 
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override {
