@@ -450,16 +450,17 @@ class VolumeFusion final : public Component {
     uint64_t refused = 0;
   };
 
-  // clock_probe_hz a second, and every kSettlingProbePeriod while a camera's host answers but
-  // its clock is not settled.
+  // clock_probe_hz a second, and every kSettlingProbePeriod while a camera's clock is not
+  // settled: its host answers, or its messages come and are refused until it does.
   void probe_clocks() {
     const auto steady_now = std::chrono::steady_clock::now();
-    const bool settling = std::any_of(
-        tracker_.cameras().begin(), tracker_.cameras().end(), [this](const VolumeCamera& camera) {
-          const health::PeerClocks::Peer* peer =
-              clocks_.publisher_of(topics::member_of(topics::kVolumeFiducials, camera.name));
-          return peer != nullptr && peer->filter.offset() && !settled(*peer->filter.offset());
-        });
+    bool settling = false;
+    for (size_t c = 0; c < tracker_.cameras().size() && !settling; ++c) {
+      const health::PeerClocks::Peer* peer = clocks_.publisher_of(
+          topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name));
+      settling = peer != nullptr ? peer->filter.offset() && !settled(*peer->filter.offset())
+                                 : clock_states_[c].first_message.has_value();
+    }
     if (!settling && steady_now - last_probe_ < seconds(1.0 / settings_.clock_probe_hz)) return;
     last_probe_ = steady_now;
     ClockProbe probe;
