@@ -52,7 +52,7 @@ options for all: --domain ID (default: MOCAP_DOMAIN_ID, else the launch file's, 
          graph's; --domains 0-20,42 for others; a Cyclone DDS participant announces itself
          every 30 s once started, Fast DDS every 3 s); participants that use DDS Security
          (--security and --identity: credentials from scripts/make_security.sh, to see their
-         topics); publishers and subscribers that cannot connect (type, QoS); each process's
+         topics; authenticating with each takes a second or more: give it --seconds 10); publishers and subscribers that cannot connect (type, QoS); each process's
          clock against this host's; every /diagnostics status that is not OK, and processes
          whose diagnostics stopped. With LAUNCH_FILE, also its groups that do not run and its
          topics without a writer or a reader. ("all well" when nothing is wrong; mocap-graph
