@@ -26,14 +26,8 @@ std::vector<DiagnosticStatus> ProcessDiagnostics::update(
     statuses.push_back(component_status(component, counts, seconds, now));
     note_level(statuses.back());
     counts = {};
-    for (const TopicCounts& topic : component.published) {
-      counts.published[topic.topic] = topic.messages;
-      counts.dropped[topic.topic] = topic.dropped;
-    }
-    for (const TopicCounts& topic : component.received) {
-      counts.received[topic.topic] = topic.messages;
-      counts.dropped_in[topic.topic] = topic.dropped;
-    }
+    for (const TopicCounts& topic : component.published) counts.published[topic.topic] = topic;
+    for (const TopicCounts& topic : component.received) counts.received[topic.topic] = topic;
     counts.callback_errors = component.callback_errors;
   }
   last_update_ = now;
@@ -64,41 +58,35 @@ DiagnosticStatus ProcessDiagnostics::component_status(const ComponentHealth& com
                                                       SteadyTime now) const {
   HealthReport report = component.report;
   HealthReport runtime;
-  for (const TopicCounts& topic : component.received) {
-    auto it = before.received.find(topic.topic);
-    runtime.add(fmt::format("in {} (msg/s)", topic.topic),
-                rate(topic.messages, it == before.received.end() ? 0 : it->second, seconds));
+  // One topic's figures, in or out; new drops since the last status warn with their cause.
+  auto topic_figures = [&](std::string_view direction, const TopicCounts& topic,
+                           const std::map<std::string, TopicCounts>& previous,
+                           std::string_view drop_cause) {
+    auto last = previous.find(topic.topic);
+    const TopicCounts& was = last == previous.end() ? TopicCounts{} : last->second;
+    runtime.add(fmt::format("{} {} (msg/s)", direction, topic.topic),
+                rate(topic.messages, was.messages, seconds));
     if (topic.waiting) {
-      runtime.add(fmt::format("in {} waiting", topic.topic), std::to_string(*topic.waiting));
+      runtime.add(fmt::format("{} {} waiting", direction, topic.topic),
+                  std::to_string(*topic.waiting));
     }
-    if (topic.dropped == 0) continue;
-    runtime.add(fmt::format("in {} dropped", topic.topic), std::to_string(topic.dropped));
-    auto dropped_before = before.dropped_in.find(topic.topic);
-    const uint64_t new_drops =
-        topic.dropped - (dropped_before == before.dropped_in.end() ? 0 : dropped_before->second);
-    if (new_drops > 0) {
+    if (topic.dropped == 0) return;
+    runtime.add(fmt::format("{} {} dropped", direction, topic.topic),
+                std::to_string(topic.dropped));
+    if (topic.dropped > was.dropped) {
       report.flag(HealthLevel::warn,
-                  fmt::format("{} message(s) on {} dropped before it read them: it reads slower "
-                              "than they come (its queue overflowed) or they were lost on the "
-                              "way (see its log)",
-                              new_drops, topic.topic));
+                  fmt::format("{} message(s) on {} dropped{}", topic.dropped - was.dropped,
+                              topic.topic, drop_cause));
     }
+  };
+  for (const TopicCounts& topic : component.received) {
+    topic_figures("in", topic, before.received,
+                  " before it read them: it reads slower than they come (its queue overflowed) "
+                  "or they were lost on the way (see its log)");
   }
   for (const TopicCounts& topic : component.published) {
-    auto it = before.published.find(topic.topic);
-    runtime.add(fmt::format("out {} (msg/s)", topic.topic),
-                rate(topic.messages, it == before.published.end() ? 0 : it->second, seconds));
-    if (topic.dropped == 0) continue;
-    runtime.add(fmt::format("out {} dropped", topic.topic), std::to_string(topic.dropped));
-    auto dropped_before = before.dropped.find(topic.topic);
-    const uint64_t new_drops =
-        topic.dropped - (dropped_before == before.dropped.end() ? 0 : dropped_before->second);
-    if (new_drops > 0) {
-      report.flag(HealthLevel::warn,
-                  fmt::format("{} message(s) on {} dropped: a subscriber had no room (slow, or "
-                              "its host is busy)",
-                              new_drops, topic.topic));
-    }
+    topic_figures("out", topic, before.published,
+                  ": a subscriber had no room (slow, or its host is busy)");
   }
   runtime.add("callback errors", std::to_string(component.callback_errors));
   if (component.callback_errors > before.callback_errors) {

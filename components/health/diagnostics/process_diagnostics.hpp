@@ -59,7 +59,7 @@ class ProcessDiagnostics {
 
  private:
   struct Counts {
-    std::map<std::string, uint64_t> published, received, dropped, dropped_in;
+    std::map<std::string, TopicCounts> published, received;  // by topic
     uint64_t callback_errors = 0;
   };
 

@@ -456,8 +456,7 @@ class VolumeFusion final : public Component {
     const auto steady_now = std::chrono::steady_clock::now();
     bool settling = false;
     for (size_t c = 0; c < tracker_.cameras().size() && !settling; ++c) {
-      const health::PeerClocks::Peer* peer = clocks_.publisher_of(
-          topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name));
+      const health::PeerClocks::Peer* peer = host_clock(c);
       settling = peer != nullptr ? peer->filter.offset() && !settled(*peer->filter.offset())
                                  : clock_states_[c].first_message.has_value();
     }
@@ -469,6 +468,12 @@ class VolumeFusion final : public Component {
     probe.sent(to_time_msg(now()));
     probes_.publish(std::move(probe));
     clocks_.forget_silent(steady_now, kClockSilence);
+  }
+
+  // The clock of the process that publishes camera `c`'s fiducials; none answered: nullptr.
+  const health::PeerClocks::Peer* host_clock(size_t c) const {
+    return clocks_.publisher_of(
+        topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name));
   }
 
   void take_clock_reply(const ClockProbeReply& reply) {
@@ -486,9 +491,7 @@ class VolumeFusion final : public Component {
     if (!settings_.check_clocks) return true;
     ClockState& clock = clock_states_[c];
     if (!clock.first_message) clock.first_message = arrival;
-    const std::string topic =
-        topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name);
-    const health::PeerClocks::Peer* peer = clocks_.publisher_of(topic);
+    const health::PeerClocks::Peer* peer = host_clock(c);
     clock.offset = peer ? peer->filter.offset() : std::nullopt;
     // Judged on what the exchanges prove: refused once the clock is surely more than the limit
     // off, fused once it is surely within it (a camera is not refused for the network's
