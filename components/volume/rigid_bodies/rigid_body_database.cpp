@@ -18,12 +18,20 @@ using Reader = YamlReader<RigidBodyError>;
 
 RigidBody read_body(const Reader& reader, const YAML::Node& node,
                     const std::vector<RigidBody>& earlier) {
-  reader.check_keys(node, {"name", "markers"}, "a body");
+  reader.check_keys(node, {"name", "markers", "streaming_id"}, "a body");
   RigidBody body;
   body.name = reader.text(reader.required(node, "name", "a body"), "name");
+  if (node["streaming_id"]) {
+    body.streaming_id = static_cast<int32_t>(
+        reader.to_integer(node["streaming_id"], "streaming_id", 1, kMaxStreamingId));
+  }
   for (const RigidBody& other : earlier) {
     if (other.name == body.name) {
       reader.fail(node["name"], fmt::format("body '{}' is declared twice", body.name));
+    }
+    if (body.streaming_id && other.streaming_id == body.streaming_id) {
+      reader.fail(node["streaming_id"], fmt::format("bodies '{}' and '{}' have streaming_id {}",
+                                                    other.name, body.name, *body.streaming_id));
     }
   }
   const YAML::Node markers = reader.required(node, "markers", fmt::format("body '{}'", body.name));

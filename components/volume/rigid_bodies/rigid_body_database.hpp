@@ -7,12 +7,14 @@
 //       markers: [[0, 0, 0], [0.10, 0, 0], [0.25, 0.03, 0]]   # metres, the body's frame
 //     - name: drone
 //       markers: [[0.1, 0, 0], [0, 0.12, 0], [-0.1, 0, 0.02], [0, -0.07, 0.04]]
+//       streaming_id: 7     # optional: its id to NatNet clients (Motive's "Streaming ID")
 //
 // Two bodies that the distances cannot tell apart within the identification's tolerance (the
 // same shape, or one the shape of part of the other) are an error when the file is read, with
 // both names: in a volume they would be taken for each other.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -23,9 +25,14 @@
 
 namespace mocap::volume {
 
+// Streaming ids (NatNet's rigid body ids) are 1 to this: a labeled marker's id holds its
+// body's in 16 bits.
+inline constexpr int32_t kMaxStreamingId = 32767;
+
 struct RigidBody {
   std::string name;
-  std::vector<Eigen::Vector3d> markers;  // metres, in the body's frame
+  std::vector<Eigen::Vector3d> markers;                // metres, in the body's frame
+  std::optional<int32_t> streaming_id = std::nullopt;  // none: by its place (natnet_server)
 };
 
 class RigidBodyError : public std::runtime_error {
@@ -41,7 +48,8 @@ struct RigidBodyDatabase {
 inline constexpr double kMinMarkerSeparation = 0.01;  // metres
 
 // The bodies of `text` (`source` names it in messages: "bodies.yaml:7: ..."). Throws
-// RigidBodyError for a malformed file, a body of fewer than three markers or with markers
+// RigidBodyError for a malformed file, a streaming_id outside 1..kMaxStreamingId or given
+// twice, a body of fewer than three markers or with markers
 // closer than kMinMarkerSeparation, a name given twice, and two bodies that identification
 // with `tolerance` (metres) and `min_markers` (rigid_body_identification.hpp) cannot tell
 // apart: one whose markers, measured with errors up to the tolerance, could be taken for

@@ -63,7 +63,7 @@ SwarmDatabase read_swarm(const Reader& reader, const YAML::Node& root, double to
   }
   const YAML::Node robots = reader.list(root, "robots");
   for (const YAML::Node& node : robots) {
-    reader.check_keys(node, {"name", "layout", "initial_position"}, "a robot");
+    reader.check_keys(node, {"name", "layout", "initial_position", "streaming_id"}, "a robot");
     SwarmRobot robot;
     robot.name = reader.text(reader.required(node, "name", "a robot"), "name");
     const std::string what = fmt::format("robot '{}'", robot.name);
@@ -77,10 +77,19 @@ SwarmDatabase read_swarm(const Reader& reader, const YAML::Node& root, double to
     robot.layout = static_cast<size_t>(found - swarm.layouts.begin());
     robot.initial_position = reader.vector<3>(reader.required(node, "initial_position", what),
                                               "initial_position", -1000, 1000);
+    if (node["streaming_id"]) {
+      robot.streaming_id = static_cast<int32_t>(
+          reader.to_integer(node["streaming_id"], "streaming_id", 1, kMaxStreamingId));
+    }
     for (size_t other = 0; other < swarm.robots.size(); ++other) {
       const SwarmRobot& earlier = swarm.robots[other];
       if (earlier.name == robot.name) {
         reader.fail(node["name"], fmt::format("robot '{}' is declared twice", robot.name));
+      }
+      if (robot.streaming_id && earlier.streaming_id == robot.streaming_id) {
+        reader.fail(node["streaming_id"],
+                    fmt::format("robots '{}' and '{}' have streaming_id {}", earlier.name,
+                                robot.name, *robot.streaming_id));
       }
       const double apart = (earlier.initial_position - robot.initial_position).norm();
       if (earlier.layout == robot.layout && apart < found->size_m()) {

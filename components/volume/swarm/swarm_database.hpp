@@ -10,7 +10,9 @@
 //       markers: [[0, 0, 0]]              # one marker: a position, no orientation
 //   robots:
 //     - {name: cf01, layout: marker_deck, initial_position: [-1.0, -1.0, 0.02]}
-//     - {name: ground_1, layout: single, initial_position: [0.5, 0, 0.1]}
+//     - {name: ground_1, layout: single, initial_position: [0.5, 0, 0.1], streaming_id: 40}
+//
+// (streaming_id, optional: the robot's id to NatNet clients, as rigid_body_database.hpp's.)
 //
 // A layout has one marker, or three or more no rotation maps onto each other (its orientation
 // would be ambiguous); two robots of one layout start further apart than the layout's size
@@ -18,6 +20,7 @@
 // a guess from the first frame.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +43,7 @@ struct SwarmRobot {
   std::string name;
   size_t layout = 0;                                           // index in SwarmDatabase::layouts
   Eigen::Vector3d initial_position = Eigen::Vector3d::Zero();  // world frame, metres
+  std::optional<int32_t> streaming_id = std::nullopt;
 };
 
 struct SwarmDatabase {
@@ -50,8 +54,8 @@ struct SwarmDatabase {
 // The swarm of `text` (`source` names it in messages: "robots.yaml:7: ..."). Throws
 // RigidBodyError for a malformed file, a layout of two markers or with markers closer than
 // kMinMarkerSeparation or that a rotation maps onto itself within `tolerance` (metres), a name
-// given twice, a robot of an unknown layout, and two robots of one layout that start closer
-// than its size.
+// or a streaming_id given twice, a robot of an unknown layout, and two robots of one layout that
+// start closer than its size.
 SwarmDatabase parse_swarm(const std::string& text, const std::string& source, double tolerance);
 SwarmDatabase load_swarm(const std::string& path, double tolerance);
 

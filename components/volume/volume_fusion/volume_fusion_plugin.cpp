@@ -598,6 +598,7 @@ class VolumeFusion final : public Component {
   }
 
   void fuse(const AssembledFrame<FiducialArray>& assembled) {
+    const Clock::time_point assembled_at = now();
     report_coverage(assembled);
     std::vector<CameraFrame> frame(assembled.messages.size());
     for (size_t c = 0; c < frame.size(); ++c) {
@@ -618,6 +619,7 @@ class VolumeFusion final : public Component {
     message->header().stamp(
         to_time_msg(Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns))));
     message->header().frame_id("world");
+    message->data_received(to_time_msg(assembled_at));
     for (const TrackedBodyPose& body : poses) {
       mocap_msgs::msg::ConstellationPose pose =
           pose_message(message->header(), body.name, body.world_from_body, body.covariance);
