@@ -78,6 +78,9 @@ poses:
         z: 0
     velocity_covariance: [0, 0, 0, 0, ...] # 36 items
     cameras_used: 3
+data_received:
+  sec: 0
+  nanosec: 0
 )");
 }
 
