@@ -272,7 +272,7 @@ Eigen::Isometry3d pose_of(const Eigen::Vector3d& position, double angle) {
 TEST(NatNetFrames, MarkersAreLabeledByBodyAndBodiesKeepTheirLastPose) {
   const std::vector<StreamedBody> known = {{"board", 4, {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}}},
                                            {"robot", 9, {{0, 0, 0}}}};
-  FrameBuilder builder(known, {});
+  FrameBuilder builder(known, {.legacy_markers = LegacyMarkers::unlabeled});
   const Eigen::Isometry3d board = pose_of({1, 2, 0.5}, 0.3);
   FusedFrame fused;
   fused.capture_ns = 1'000'000'000;
@@ -338,6 +338,7 @@ TEST(NatNetFrames, YUpIsMotivesAxes) {
   // Up is y: our z goes to y, our y to -z.
   EXPECT_TRUE(frame.rigid_bodies[0].position.isApprox(Vector3f(1, 3, -2)));
   EXPECT_EQ(frame.labeled_markers[0].position, Vector3f(1, 3, -2));
+  EXPECT_TRUE(frame.other_markers.empty());  // the legacy list: none by default
   // The body's own axes in Motive's world: ours through the same change of axes.
   Eigen::Matrix3d y_up_from_ours;
   y_up_from_ours << 1, 0, 0, 0, 0, 1, 0, -1, 0;
@@ -785,7 +786,8 @@ TEST(NatNetServerPlugin, ServesTheFusionsPosesAndCloudFrameByFrame) {
   host.add(*loader.load("natnet_server").factory,
            {.name = "natnet",
             .parameters = {{"bodies", (dir / "bodies.yaml").string()},
-                           {"command_port", static_cast<int64_t>(port)}}});
+                           {"command_port", static_cast<int64_t>(port)},
+                           {"legacy_markers", std::string("all")}}});
   host.start();
   std::atomic<bool> stop{false};
   std::thread publisher([&] {
@@ -857,9 +859,29 @@ TEST(NatNetServerPlugin, ServesTheFusionsPosesAndCloudFrameByFrame) {
         EXPECT_TRUE(marker["unlabeled"].get<bool>());
       }
     }
-    ASSERT_EQ(frame["unlabeled_markers"].size(), 1u);
+    EXPECT_EQ(frame["unlabeled_markers"].size(), fed.markers.size());  // legacy_markers: all
   }
   host.stop();
+}
+
+TEST(NatNetServerPlugin, BadParametersAreNamed) {
+  PluginLoader loader;
+  for (const auto& [parameters, message] :
+       std::vector<std::pair<std::map<std::string, ParameterValue>, std::string>>{
+           {{{"up_axis", std::string("x_up")}}, "up_axis: 'x_up'; expected z_up or y_up"},
+           {{{"legacy_markers", std::string("some")}},
+            "legacy_markers: 'some'; expected none, unlabeled or all"},
+           {{{"natnet_version", std::string("2.9")}}, "natnet_version: '2.9'; expected 3.0 to 4.2"},
+           {{{"address", std::string("localhost")}}, "address: 'localhost' is not an IPv4 address"},
+           {{{"bodies", std::string("/nonexistent/bodies.yaml")}}, "/nonexistent/bodies.yaml"}}) {
+    ComponentHost host({.name = "test", .threads = 1, .dds = {.enabled = false}});
+    try {
+      host.add(*loader.load("natnet_server").factory, {.name = "natnet", .parameters = parameters});
+      ADD_FAILURE() << "accepted; expected: " << message;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ServerOptions, NameTheFieldThatCannotBeUsed) {

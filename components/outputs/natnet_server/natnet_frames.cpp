@@ -65,6 +65,13 @@ std::optional<UpAxis> parse_up_axis(const std::string& text) {
   return std::nullopt;
 }
 
+std::optional<LegacyMarkers> parse_legacy_markers(const std::string& text) {
+  if (text == "none") return LegacyMarkers::none;
+  if (text == "unlabeled") return LegacyMarkers::unlabeled;
+  if (text == "all") return LegacyMarkers::all;
+  return std::nullopt;
+}
+
 FrameBuilder::FrameBuilder(std::vector<StreamedBody> known, FrameBuilderOptions options)
     : bodies_(std::move(known)), last_pose_(bodies_.size()), options_(options) {
   for (size_t b = 0; b < bodies_.size(); ++b) index_of_[bodies_[b].name] = b;
@@ -149,7 +156,8 @@ FrameOfData FrameBuilder::build(const FusedFrame& fused, bool* new_bodies) {
       labeled.id = static_cast<int32_t>(marker.id & 0xFFFF);
       labeled.flags = kUnlabeled | kPointCloudSolved;
     }
-    if (!owned || options_.every_marker_in_legacy_list) {
+    if (options_.legacy_markers == LegacyMarkers::all ||
+        (options_.legacy_markers == LegacyMarkers::unlabeled && !owned)) {
       frame.other_markers.push_back(labeled.position);
     }
     frame.labeled_markers.push_back(labeled);

@@ -39,11 +39,21 @@ enum class UpAxis {
 // "z_up" or "y_up"; nullopt otherwise.
 std::optional<UpAxis> parse_up_axis(const std::string& text);
 
+// What the legacy unlabeled list ("other markers", before NatNet 2.3's labeled list) holds. Every
+// marker is in the labeled list, flagged unlabeled or not; libmotioncapture (crazyswarm2) makes
+// its point cloud of both lists, so anything here it counts twice.
+enum class LegacyMarkers {
+  none,       // nothing
+  unlabeled,  // the markers no body claims, as NatNet 2 servers sent them
+  all,        // every marker
+};
+
+// "none", "unlabeled" or "all"; nullopt otherwise.
+std::optional<LegacyMarkers> parse_legacy_markers(const std::string& text);
+
 struct FrameBuilderOptions {
   UpAxis up_axis = UpAxis::z_up;
-  // The legacy unlabeled list holds every marker, not only the unlabeled (for clients that track
-  // the cloud themselves, as crazyswarm2's motion_capture_tracking through libmotioncapture).
-  bool every_marker_in_legacy_list = false;
+  LegacyMarkers legacy_markers = LegacyMarkers::none;
   float marker_size_m = 0.014f;  // NatNet's marker size; ours are not measured
 };
 

@@ -36,7 +36,7 @@ struct Settings : ServerOptions {
   std::string up_axis = "z_up";
   std::string bodies = mocap::config_file("volume/bodies.yaml");
   std::string robots;
-  std::string legacy_markers = "unlabeled";
+  std::string legacy_markers = "none";
   double marker_size_m = 0.014;
 };
 
@@ -73,8 +73,8 @@ const ParameterList<Settings> kParameters =
         .add("robots", "the fusion's swarm file; empty: none", &Settings::robots)
         .path()
         .add("legacy_markers",
-             "the legacy unlabeled list: unlabeled (as Motive) or all (clients that track the "
-             "cloud themselves, as libmotioncapture's)",
+             "the legacy unlabeled list: none (every marker is in the labeled list; "
+             "libmotioncapture counts both), unlabeled (as NatNet 2 servers) or all",
              &Settings::legacy_markers)
         .add("marker_size_m", "the size sent with each marker", &Settings::marker_size_m)
         .range(0, 1)
@@ -93,11 +93,12 @@ FrameBuilderOptions builder_options(const Settings& settings) {
   if (!axis)
     throw std::invalid_argument("up_axis: '" + settings.up_axis + "'; expected z_up or y_up");
   options.up_axis = *axis;
-  if (settings.legacy_markers != "unlabeled" && settings.legacy_markers != "all") {
+  const std::optional<LegacyMarkers> legacy = parse_legacy_markers(settings.legacy_markers);
+  if (!legacy) {
     throw std::invalid_argument("legacy_markers: '" + settings.legacy_markers +
-                                "'; expected unlabeled or all");
+                                "'; expected none, unlabeled or all");
   }
-  options.every_marker_in_legacy_list = settings.legacy_markers == "all";
+  options.legacy_markers = *legacy;
   options.marker_size_m = static_cast<float>(settings.marker_size_m);
   return options;
 }
