@@ -83,6 +83,10 @@ constexpr std::chrono::nanoseconds kSettledRoundTrip{200'000};
 // Probes come this often while a camera's clock is not settled: on a busy host a quick exchange
 // is rare, and the sooner one comes the sooner the clock is known.
 constexpr std::chrono::milliseconds kSettlingProbePeriod{10};
+// Messages held while their camera's clock is not known (hold()): at most this many, and a
+// probe for them at most this often.
+constexpr size_t kMaxHeld = 64;
+constexpr std::chrono::milliseconds kHeldProbePeriod{1};
 
 bool settled(const health::ClockOffset& offset) {
   return offset.round_trip_ns <= kSettledRoundTrip.count() ||
@@ -352,11 +356,17 @@ class VolumeFusion final : public Component {
           topics::member_of(topics::kVolumeFiducials, tracker_.cameras()[c].name),
           [this, c](const FiducialArray& array) {
             const auto arrival = std::chrono::steady_clock::now();
-            if (!clock_accepts(c, arrival)) return;
-            frames_.add(static_cast<int>(c), to_nanoseconds(array.header().stamp()), array,
-                        arrival);
-            arrival_latency_.add(now() - from_time_msg(array.header().stamp()));
-            fuse_ready();
+            release_held(arrival);
+            switch (judge_clock(c, arrival)) {
+              case ClockVerdict::accepted:
+              case ClockVerdict::warned:
+                return take_fiducials(c, array, arrival);
+              case ClockVerdict::unknown:
+                if (hold(c, array, arrival)) return;
+                [[fallthrough]];
+              case ClockVerdict::refused:
+                ++clock_states_[c].refused;
+            }
           });
     }
     if (settings_.check_clocks) {
@@ -366,7 +376,10 @@ class VolumeFusion final : public Component {
       create_timer(kSettlingProbePeriod, [this] { probe_clocks(); });
     }
     // Frames whose wait runs out while no message arrives: a camera that stopped.
-    create_timer(std::chrono::milliseconds(1), [this] { fuse_ready(); });
+    create_timer(std::chrono::milliseconds(1), [this] {
+      release_held(std::chrono::steady_clock::now());
+      fuse_ready();
+    });
     std::string names;
     for (const VolumeCamera& camera : tracker_.cameras()) names += " " + camera.name;
     log().info("{} bodies ({}), {} robots ({}), {} cameras:{}", tracker_.bodies().bodies.size(),
@@ -380,9 +393,12 @@ class VolumeFusion final : public Component {
     std::string health;
     for (size_t c = 0; c < tracker_.cameras().size(); ++c) {
       const CameraHealth& h = tracker_.camera_health()[c];
-      health += fmt::format("; {}: residual {:.2f} px over {} views, left out {}{}",
-                            tracker_.cameras()[c].name, h.average_error_px, h.views, h.left_out,
-                            h.drifted ? ", DRIFTED" : "");
+      health += fmt::format(
+          "; {}: residual {:.2f} px over {} views, left out {}{}{}", tracker_.cameras()[c].name,
+          h.average_error_px, h.views, h.left_out, h.drifted ? ", DRIFTED" : "",
+          settings_.check_clocks
+              ? fmt::format(", {} refused for its clock", clock_states_[c].refused)
+              : "");
     }
     log().info(
         "{} frames fused ({} incomplete, {} skipped while behind), {} body poses ({} from one "
@@ -451,7 +467,7 @@ class VolumeFusion final : public Component {
   };
 
   // clock_probe_hz a second, and every kSettlingProbePeriod while a camera's clock is not
-  // settled: its host answers, or its messages come and are refused until it does.
+  // settled: its host answers, or its messages come and are held, then refused, until it does.
   void probe_clocks() {
     const auto steady_now = std::chrono::steady_clock::now();
     bool settling = false;
@@ -461,13 +477,17 @@ class VolumeFusion final : public Component {
                                  : clock_states_[c].first_message.has_value();
     }
     if (!settling && steady_now - last_probe_ < seconds(1.0 / settings_.clock_probe_hz)) return;
+    send_probe(steady_now);
+    clocks_.forget_silent(steady_now, kClockSilence);
+  }
+
+  void send_probe(std::chrono::steady_clock::time_point steady_now) {
     last_probe_ = steady_now;
     ClockProbe probe;
     probe.requester(name());
     probe.number(++probe_number_);
     probe.sent(to_time_msg(now()));
     probes_.publish(std::move(probe));
-    clocks_.forget_silent(steady_now, kClockSilence);
   }
 
   // The clock of the process that publishes camera `c`'s fiducials; none answered: nullptr.
@@ -483,12 +503,49 @@ class VolumeFusion final : public Component {
                 {to_nanoseconds(reply.probe_sent()), to_nanoseconds(reply.received()),
                  to_nanoseconds(reply.sent()), received_ns},
                 std::chrono::steady_clock::now());
+    release_held(std::chrono::steady_clock::now());
   }
 
-  // Whether camera `c`'s message may be fused, as its host's clock is now; a change of verdict
-  // is said once.
-  bool clock_accepts(size_t c, std::chrono::steady_clock::time_point arrival) {
-    if (!settings_.check_clocks) return true;
+  void take_fiducials(size_t c, const FiducialArray& array,
+                      std::chrono::steady_clock::time_point arrival) {
+    frames_.add(static_cast<int>(c), to_nanoseconds(array.header().stamp()), array, arrival);
+    arrival_latency_.add(now() - from_time_msg(array.header().stamp()));
+    fuse_ready();
+  }
+
+  // A message of a camera whose clock is not yet known waits for it as long as its frame would
+  // wait for a camera (wait_s): its host is probed at once, and an answer within a millisecond
+  // or two settles it, so that a camera's first messages (and a restarted one's) are fused
+  // rather than refused for the moment discovery takes. False when it cannot wait.
+  bool hold(size_t c, const FiducialArray& array, std::chrono::steady_clock::time_point arrival) {
+    if (held_.size() >= kMaxHeld) return false;
+    held_.push_back({c, array, arrival});
+    if (arrival - last_probe_ >= kHeldProbePeriod) send_probe(arrival);
+    return true;
+  }
+
+  // Held messages whose camera's clock is now known go on (in their order) or are refused;
+  // those that waited wait_s are refused.
+  void release_held(std::chrono::steady_clock::time_point now_steady) {
+    const auto wait = seconds(settings_.wait_s);
+    std::vector<HeldMessage> waiting;
+    for (HeldMessage& held : std::exchange(held_, {})) {
+      const ClockVerdict verdict = judge_clock(held.camera, now_steady);
+      if (verdict == ClockVerdict::accepted || verdict == ClockVerdict::warned) {
+        take_fiducials(held.camera, held.array, held.arrival);
+      } else if (verdict == ClockVerdict::unknown && now_steady - held.arrival < wait) {
+        waiting.push_back(std::move(held));
+      } else {
+        ++clock_states_[held.camera].refused;
+      }
+    }
+    held_ = std::move(waiting);
+  }
+
+  // Camera `c`'s host's clock as the exchanges now prove it (always accepted without
+  // check_clocks); a change of verdict is said once.
+  ClockVerdict judge_clock(size_t c, std::chrono::steady_clock::time_point arrival) {
+    if (!settings_.check_clocks) return ClockVerdict::accepted;
     ClockState& clock = clock_states_[c];
     if (!clock.first_message) clock.first_message = arrival;
     const health::PeerClocks::Peer* peer = host_clock(c);
@@ -538,9 +595,7 @@ class VolumeFusion final : public Component {
       clock.unknown_alerted = true;
       alert(2, clock_problem(c));
     }
-    const bool accepted = verdict == ClockVerdict::accepted || verdict == ClockVerdict::warned;
-    if (!accepted) ++clock.refused;
-    return accepted;
+    return verdict;
   }
 
   std::string clock_problem(size_t c) const {
@@ -862,6 +917,12 @@ class VolumeFusion final : public Component {
   Publisher<ClockProbe> probes_;
   uint32_t probe_number_ = 0;
   std::chrono::steady_clock::time_point last_probe_{};
+  struct HeldMessage {
+    size_t camera = 0;
+    FiducialArray array;
+    std::chrono::steady_clock::time_point arrival;
+  };
+  std::vector<HeldMessage> held_;
   LatencyFigures arrival_latency_;
   LatencyFigures poses_latency_;
   RateFigures fused_rate_;
