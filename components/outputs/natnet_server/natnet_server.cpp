@@ -261,7 +261,10 @@ struct Server::Impl {
     }
   }
 
+  // A client is added only when its answer may go: a forged NAT_CONNECT registers a stream to its
+  // source no more often than that source may be answered.
   void connect(const Endpoint& from, const Request& request, SteadyClock::time_point now) {
+    if (!may_reply(from, now)) return;
     Version version = options.version;
     if (const std::optional<Version> asked = requested_version(request);
         asked && asked->supported() && !options.multicast) {
@@ -272,18 +275,16 @@ struct Server::Impl {
       if (client == clients.end()) {
         if (clients.size() >= options.max_clients) {
           ++stats.clients_refused;
-          return reply(
-              from,
-              encode_message_string(fmt::format(
-                  "refused: this server serves {} unicast clients at most", options.max_clients)),
-              now);
+          return send_to(from, encode_message_string(fmt::format(
+                                   "refused: this server serves {} unicast clients at most",
+                                   options.max_clients)));
         }
         ++stats.clients_connected;
         client = clients.emplace(from, Client{version, now}).first;
       }
       client->second.version = version;
     }
-    reply(from, encode_server_info(description_for(version)), now);
+    send_to(from, encode_server_info(description_for(version)));
   }
 
   void command(const Endpoint& from, const std::string& text, SteadyClock::time_point now) {

@@ -17,9 +17,12 @@
 //
 // Nothing that arrives can make the server send to a third host or send much: it answers only the
 // address a request came from, at most replies_per_s a second per source address (burst
-// reply_burst) and 20 times that over all sources; it keeps a fixed record per client, at most
-// max_clients of them, and forgets a client that sends what is not NatNet. Frames never wait for a
-// client: a datagram the kernel cannot take at once is counted and dropped.
+// reply_burst) and 20 times that over all sources, and adds a unicast client only within that rate;
+// it keeps a fixed record per client, at most max_clients of them, and forgets a client that sends
+// what is not NatNet. Frames never wait for a client: a datagram the kernel cannot take at once is
+// counted and dropped. What NatNet itself allows stays: a forged NAT_CONNECT (UDP's source can be
+// forged, and NatNet has no handshake to prove it) draws up to client_timeout_s of frames to that
+// source, unless it is forged again.
 #pragma once
 
 #include <cstdint>
