@@ -629,6 +629,25 @@ TEST(NatNetServer, ClientsAreCappedAndForgottenWhenSilentOrForeign) {
   EXPECT_EQ(stats.clients_timed_out, 1u);
 }
 
+// NAT_CONNECTs from many ports of one address (as forged ones would come): clients are added only
+// within the address's answer rate, so they cannot draw streams at will.
+TEST(NatNetServer, ConnectsFromOneAddressAreAddedOnlyWithinItsRate) {
+  Server server({.command_port = 0, .max_clients = 1000, .replies_per_s = 20, .reply_burst = 40});
+  std::vector<std::unique_ptr<RawSocket>> sockets;
+  const auto started = std::chrono::steady_clock::now();
+  for (int i = 0; i < 300; ++i) {
+    sockets.push_back(std::make_unique<RawSocket>("127.0.0.4"));
+    sockets.back()->send(server.command_port(), packet(kConnect, ""));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  // The burst, and what the rate refilled meanwhile.
+  EXPECT_GE(server.clients(), 40u);
+  EXPECT_LE(static_cast<double>(server.clients()), 40 + 20 * seconds + 1);
+  EXPECT_EQ(server.clients() + server.stats().replies_limited, 300u);
+}
+
 // Whatever comes in at random, the server stays up and a proper client is served.
 TEST(NatNetServer, RandomDatagramsLeaveItServing) {
   Server server({.command_port = 0, .replies_per_s = 10000, .reply_burst = 10000});
