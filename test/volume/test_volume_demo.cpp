@@ -118,7 +118,7 @@ TEST(VolumeDemo, FourCameraProcessesFusedIntoAccuratePoses) {
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
   EXPECT_GT(figures.node["frames"].as<int>(), 450) << output;  // 30 Hz, less the start
-  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary) << output;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
   EXPECT_EQ(figures.false_identifications(), 0) << output;
@@ -186,7 +186,8 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
   std::printf("%s", test::read_file(summary).c_str());
   // A pose array for every frame of the truth camera (cam_0), through the kill and the return.
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << compute->output();
-  EXPECT_GE(figures.tracked_share(), tracked_bound) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), tracked_bound)
+      << test::read_file(summary) << compute->output();
   EXPECT_EQ(figures.false_identifications(), 0) << compute->output();
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 1e-3);
   EXPECT_EQ(compute->output().find("camera cam_0 is silent"), std::string::npos);
@@ -194,13 +195,18 @@ TEST(VolumeDemo, AKilledCameraIsReportedAndTakenBackWhenItReturns) {
 
 // The one-machine form as the README runs it: cam_1's process killed (SIGKILL), as a crash ends
 // it. The launcher starts it again while the compute process fuses the other three, a pose
-// array for every frame; the camera is fused again soon after its death.
+// array for every frame; the camera is fused again soon after its death. Tracked from the second
+// second, as in FourCameraProcessesFusedIntoAccuratePoses: before, the boards are found as the
+// camera processes come up, which under CI's load took a run under 99.5 % by itself (13
+// body-frames of 2287 missed). By hand under the same load (a compiler in the idle class on each
+// core), three runs lost 4, 5 and 0 body-frames, all in the first second, none across the kill.
 TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
   test::TempDir dir;
   const auto summary = dir / "summary.yaml";
   test::ChildProcess launch(
       {(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration", "20", "--set",
-       "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+       "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0", "--set",
+       "evaluator.skip_first_s=1"},
       environment(22), dir / "launch.log");
   ASSERT_TRUE(launch.wait_for_output("camera cam_1: first fiducials", std::chrono::seconds(30)))
       << launch.output();
@@ -247,7 +253,7 @@ TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
   const Figures figures = read_figures(summary);
   std::printf("%s", test::read_file(summary).c_str());
   EXPECT_EQ(figures.node["frames_lost"].as<int>(), 0) << output;
-  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary) << output;
   EXPECT_EQ(figures.false_identifications(), 0) << output;
 }
 
@@ -481,7 +487,7 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   // Tracked from the second second on: in the first, boards are identified as they come into
   // two cameras' views (90 % of that second's body-frames; every one after), which in a 12 s
   // run alone weighs 0.8 %. MultiHostFormSurvivesACrashAndALostLink counts it.
-  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.995) << test::read_file(summary) << demo;
   EXPECT_EQ(figures.false_identifications(), 0) << demo;
   EXPECT_LT(figures.node["position_error_median_m"].as<double>(), 0.15e-3);
   EXPECT_LT(figures.node["orientation_error_median_deg"].as<double>(), 0.1);
@@ -510,7 +516,7 @@ TEST(VolumeDemo, TheSwarmDemosHundredRobotsKeepTheirNames) {
   EXPECT_GT(figures.node["frames"].as<int>(), 4000) << output;  // 240 Hz, less the start
   EXPECT_EQ(figures.node["identity_swaps"].as<int>(), 0) << output;
   EXPECT_EQ(figures.false_identifications(), 0) << output;
-  EXPECT_GE(figures.tracked_share(), 0.99) << test::read_file(summary);
+  EXPECT_GE(figures.tracked_share(), 0.99) << test::read_file(summary) << output;
   EXPECT_LE(figures.node["position_error_median_m"].as<double>(), 1e-4);
   EXPECT_LE(figures.node["orientation_error_median_deg"].as<double>(), 0.2);
 }
