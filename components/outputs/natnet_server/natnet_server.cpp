@@ -103,7 +103,7 @@ unsigned interface_for(const std::string& name, in_addr address) {
 struct Server::Impl {
   ServerOptions options;
   int command_fd = -1, data_fd = -1, wake_fd = -1;
-  uint16_t command_port = 0;
+  uint16_t command_port = 0, data_port = 0;
   bool loopback = false;
   sockaddr_in group{};
 
@@ -148,14 +148,36 @@ struct Server::Impl {
     setsockopt(command_fd, SOL_SOCKET, SO_SNDBUF, &buffer, sizeof buffer);
     setsockopt(command_fd, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer);
     wake_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    open_data(requested, address.sin_addr);
     if (requested.multicast) open_multicast(requested, address.sin_addr);
+  }
+
+  // Frames leave from the data port, unicast as multicast, as a Motive host sends them: OptiTrack's
+  // NatNetLib takes what comes from the server's command port for answers and passes frames on
+  // only from its data port. Shared (SO_REUSEADDR), as multicast clients on this host bind it too.
+  void open_data(const ServerOptions& requested, in_addr local) {
+    data_fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    const int on = 1;
+    setsockopt(data_fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr = local;
+    address.sin_port = htons(requested.data_port);
+    if (::bind(data_fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+      throw std::runtime_error(fmt::format("address/data_port: cannot bind UDP {}:{}: {}",
+                                           requested.address, requested.data_port, errno_text()));
+    }
+    socklen_t size = sizeof address;
+    getsockname(data_fd, reinterpret_cast<sockaddr*>(&address), &size);
+    data_port = ntohs(address.sin_port);
+    const int buffer = 4 << 20;
+    setsockopt(data_fd, SOL_SOCKET, SO_SNDBUF, &buffer, sizeof buffer);
   }
 
   void open_multicast(const ServerOptions& requested, in_addr local) {
     group.sin_family = AF_INET;
-    group.sin_port = htons(requested.data_port);
+    group.sin_port = htons(data_port);
     inet_pton(AF_INET, requested.multicast_group.c_str(), &group.sin_addr);
-    data_fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     const unsigned index = interface_for(requested.multicast_interface, local);
     if (!requested.multicast_interface.empty() && index == 0) {
       throw std::runtime_error(fmt::format("multicast_interface: no interface '{}' on this host",
@@ -170,8 +192,6 @@ struct Server::Impl {
       throw std::runtime_error(fmt::format("multicast_interface: cannot send multicast on '{}': {}",
                                            requested.multicast_interface, errno_text()));
     }
-    const int buffer = 4 << 20;
-    setsockopt(data_fd, SOL_SOCKET, SO_SNDBUF, &buffer, sizeof buffer);
   }
 
   void wake() const {
@@ -220,7 +240,7 @@ struct Server::Impl {
     ServerDescription server;
     server.application = options.application;
     server.natnet = version;
-    server.data_port = options.data_port;
+    server.data_port = data_port;
     server.multicast = options.multicast;
     if (options.multicast) std::memcpy(server.multicast_group, &group.sin_addr, 4);
     return server;
@@ -441,6 +461,8 @@ Server::~Server() {
 
 uint16_t Server::command_port() const { return impl_->command_port; }
 
+uint16_t Server::data_port() const { return impl_->data_port; }
+
 bool Server::loopback_only() const { return impl_->loopback; }
 
 void Server::set_descriptions(Descriptions descriptions) {
@@ -474,7 +496,7 @@ void Server::send_frame(FrameOfData frame) {
       std::string& packet = packet_for(client.version);
       set_bitstream_changed(packet, std::exchange(client.bitstream_changed, false));
       set_transmit_stamp(packet, client.version, now_ticks());
-      s.send_datagram(packet, socket_address(endpoint), s.command_fd);
+      s.send_datagram(packet, socket_address(endpoint), s.data_fd);
     }
   }
   s.last_frame = std::move(frame);

@@ -2,12 +2,13 @@
 //
 // The command port (1510) answers NAT_CONNECT with the server's description, NAT_REQUEST_MODELDEF
 // with the bodies' descriptions, the requests below, keep-alives and echo requests; anything else
-// NatNet-shaped gets NAT_UNRECOGNIZED_REQUEST. Frames go, as Motive sends them:
+// NatNet-shaped gets NAT_UNRECOGNIZED_REQUEST. Frames leave from the data port (1511), as Motive
+// sends them:
 //   - unicast (the default): to the address and port each client's NAT_CONNECT came from (where
-//     OptiTrack's PacketClient and Python client read them), in the bitstream version that client
-//     asked for in its connection options or by "Bitstream,M.m"; a client that sends nothing for
-//     client_timeout_s (NatNet's clients send a keep-alive every second or two) is no longer sent
-//     to;
+//     OptiTrack's PacketClient, Python client and NatNetLib read them), in the bitstream version
+//     that client asked for in its connection options or by "Bitstream,M.m"; a client that sends
+//     nothing for client_timeout_s (NatNet's clients send a keep-alive every second or two) is no
+//     longer sent to;
 //   - multicast: to group:data_port on one interface, TTL 1, in `version`.
 //
 // Requests understood: "Bitstream" (the client's version, "Bitstream,4.1"), "Bitstream,M.m" (0:
@@ -37,7 +38,9 @@ namespace mocap::natnet {
 struct ServerOptions {
   std::string address = "127.0.0.1";  // IPv4 address to listen on; 0.0.0.0: every interface
   uint16_t command_port = kDefaultCommandPort;  // 0: any free port (command_port() tells which)
-  uint16_t data_port = kDefaultDataPort;        // multicast's destination port
+  // Frames leave from it (shared with multicast clients of this host), and multicast goes to it;
+  // 0: any free port (the server info tells clients which).
+  uint16_t data_port = kDefaultDataPort;
   bool multicast = false;
   std::string multicast_group = kDefaultMulticastGroup;
   // The interface multicast frames leave by, by name ("eth0"); empty: "lo" when `address` is a
@@ -82,6 +85,7 @@ class Server {
   Server& operator=(const Server&) = delete;
 
   uint16_t command_port() const;
+  uint16_t data_port() const;
   bool loopback_only() const;
 
   // Thread-safe. The bodies (and marker sets) described to clients from now on; the next frame

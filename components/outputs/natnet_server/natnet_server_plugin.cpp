@@ -49,7 +49,7 @@ const ParameterList<Settings> kParameters =
         .add("command_port", "UDP port of NatNet's commands (0: any free port, logged)",
              &Settings::command_port)
         .range(0, 65535)
-        .add("data_port", "UDP port multicast frames go to", &Settings::data_port)
+        .add("data_port", "UDP port frames leave from, and multicast goes to", &Settings::data_port)
         .range(1, 65535)
         .add("multicast",
              "frames to multicast_group on multicast_interface (TTL 1) instead of to each "
