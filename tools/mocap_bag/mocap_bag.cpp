@@ -21,6 +21,7 @@
 #include "dds/dds_transport.hpp"
 #include "host/dds_implementations.hpp"
 #include "host/plugin_loader.hpp"
+#include "mocap_bag/bag_export.hpp"
 
 namespace {
 
@@ -30,6 +31,7 @@ constexpr const char* kUsage = R"(usage:
   mocap_bag record [-o DIR] TOPIC... | --all   [--duration SECONDS] [--storage mcap|sqlite3]
   mocap_bag play DIR [--rate R] [--loop] [--topics TOPIC...] [--delay SECONDS]
   mocap_bag info DIR
+  mocap_bag export DIR --format tum [-o PATH] [--bodies BODY...]
 
   record  subscribes to the topics (or to every topic published, as publishers appear) and
           writes what arrives to a new bag directory DIR (default bag_YYYY_MM_DD-HH_MM_SS),
@@ -40,6 +42,9 @@ constexpr const char* kUsage = R"(usage:
           pace times R (default 1; 0: as fast as possible, in order), after waiting --delay
           seconds (default 1) for subscribers to be discovered
   info    what a bag holds: files, duration, topics with types and counts, and what is damaged
+  export  the bodies of /mocap/poses in a format analysis tools read: tum (evo's and the TUM
+          benchmark's "timestamp tx ty tz qx qy qz qw", world frame; PATH a folder, one
+          <body>.tum per body, default DIR_tum); --bodies: only these
 
 options for record and play: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
 exit status: 0 done, 1 the bag cannot be written or read, 2 bad arguments
@@ -291,7 +296,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string command = args[0];
-  if (command != "record" && command != "play" && command != "info") {
+  if (command != "record" && command != "play" && command != "info" && command != "export") {
     usage_error(fmt::format("unknown command {}", command));
   }
   std::optional<std::string> output, bag;
@@ -302,13 +307,15 @@ int main(int argc, char** argv) {
   double delay = 1.0;
   mocap::bag::PlaybackOptions playback;
   bool in_topics = false;  // play's --topics takes the arguments after it
+  mocap::bag_export::ExportOptions exporting;
+  bool in_bodies = false;  // export's --bodies takes the arguments after it
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& arg = args[i];
     auto value = [&]() -> const std::string& {
       if (i + 1 >= args.size()) usage_error(fmt::format("{} needs a value", arg));
       return args[++i];
     };
-    if (arg.starts_with("-")) in_topics = false;
+    if (arg.starts_with("-")) in_topics = in_bodies = false;
     if (arg == "-o" || arg == "--output") {
       output = value();
     } else if (arg == "--all") {
@@ -328,6 +335,10 @@ int main(int argc, char** argv) {
       delay = parse_seconds(arg, value());
     } else if (arg == "--topics") {
       in_topics = true;
+    } else if (arg == "--bodies") {
+      in_bodies = true;
+    } else if (arg == "--format") {
+      exporting.format = value();
     } else if (arg == "--domain") {
       const std::string& text = value();
       int domain = -1;
@@ -343,6 +354,8 @@ int main(int argc, char** argv) {
       topics.insert(arg);
     } else if (in_topics) {
       playback.topics.push_back(arg);
+    } else if (in_bodies) {
+      exporting.bodies.push_back(arg);
     } else if (!bag) {
       bag = arg;
     } else {
@@ -364,6 +377,11 @@ int main(int argc, char** argv) {
       return record(output.value_or(mocap::bag::default_bag_directory()), topics, all, duration,
                     storage);
     if (command == "play") return play(*bag, playback, delay);
+    if (command == "export") {
+      if (exporting.format.empty()) usage_error("export needs --format tum");
+      exporting.output = output;
+      return mocap::bag_export::export_bag(*bag, exporting);
+    }
     return info(*bag);
   } catch (const std::exception& e) {
     fmt::print(stderr, "mocap_bag: {}\n", e.what());
