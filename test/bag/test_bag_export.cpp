@@ -1,6 +1,6 @@
 // `mocap_bag export`: a bag of known poses written out and read back by a reader of each format
-// written from its description (test/bag/tum_read.mjs), values equal to the micrometre; a bag
-// without poses and a body not in it are named.
+// written from its description (test/bag/tum_read.mjs, trc_read.mjs), values equal to the
+// micrometre; a bag without poses and a body not in it are named.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -119,6 +119,54 @@ TEST(BagExport, TumFilesReadBackAsTheBagsPosesToTheMicrometre) {
   }
   EXPECT_EQ(wand_poses, 100);
   EXPECT_EQ(drone_poses, 80);
+}
+
+// OpenSim's Y up: our (x, y, z) as (x, z, -y).
+Eigen::Vector3d y_up(const Eigen::Vector3d& p) { return {p.x(), p.z(), -p.y()}; }
+
+TEST(BagExport, TrcReadsBackAsEachBodysOriginAndAxesToTheMicrometre) {
+  test::TempDir dir;
+  write_bag(dir / "bag", 100, true);
+  const auto [code, output] = mocap_bag(
+      {"export", (dir / "bag").string(), "--format", "trc", "-o", (dir / "bag.trc").string()});
+  ASSERT_EQ(code, 0) << output;
+  const auto [read_code, read] =
+      test::run_command({"node", (test::source_dir() / "test" / "bag" / "trc_read.mjs").string(),
+                         (dir / "bag.trc").string()},
+                        {}, std::chrono::seconds(30));
+  ASSERT_EQ(read_code, 0) << read;
+  const json trc = json::parse(read);
+  EXPECT_EQ(trc["header"]["Units"], "m");
+  EXPECT_EQ(trc["header"]["NumFrames"], "100");
+  EXPECT_NEAR(std::stod(trc["header"]["DataRate"].get<std::string>()), 1e9 / kPeriod, 1e-5);
+  EXPECT_EQ(trc["markers"], (json{"drone_origin", "drone_x", "drone_y", "drone_z", "wand_origin",
+                                  "wand_x", "wand_y", "wand_z"}));
+  ASSERT_EQ(trc["rows"].size(), 100u);
+  for (int k = 0; k < 100; ++k) {
+    const json& row = trc["rows"][static_cast<size_t>(k)];
+    EXPECT_EQ(row["frame"], k + 1);
+    EXPECT_NEAR(std::stod(row["time"].get<std::string>()), k * kPeriod * 1e-9, 1e-9);
+    for (const auto& [name, truth] : {std::pair{"wand", wand(k)}, {"drone", drone(k)}}) {
+      const std::string body = name;
+      if (body == "drone" && !drone_seen(k)) {
+        EXPECT_TRUE(row["points"][body + "_origin"].is_null()) << row;  // a gap where it was lost
+        continue;
+      }
+      const Eigen::Isometry3d pose =
+          Eigen::Translation3d(truth.position) * truth.orientation.normalized();
+      const std::pair<const char*, Eigen::Vector3d> points[] = {
+          {"_origin", Eigen::Vector3d::Zero()},
+          {"_x", Eigen::Vector3d(0.1, 0, 0)},
+          {"_y", Eigen::Vector3d(0, 0.1, 0)},
+          {"_z", Eigen::Vector3d(0, 0, 0.1)}};
+      for (const auto& [suffix, in_body] : points) {
+        const Eigen::Vector3d expected = y_up(pose * in_body);
+        const json& got = row["points"][body + suffix];
+        ASSERT_FALSE(got.is_null()) << body << suffix << " at frame " << k;
+        for (int i = 0; i < 3; ++i) EXPECT_NEAR(got[i].get<double>(), expected[i], 1e-6) << row;
+      }
+    }
+  }
 }
 
 TEST(BagExport, ABagWithoutPosesOrABodyNotInItIsNamed) {

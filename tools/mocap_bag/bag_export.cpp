@@ -13,6 +13,7 @@
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
 #include "recording/motion_export/body_trajectories.hpp"
+#include "recording/motion_export/trc_writer.hpp"
 #include "recording/motion_export/tum_writer.hpp"
 
 namespace mocap::bag_export {
@@ -71,6 +72,7 @@ BodyTrajectories read_poses(const std::string& path, const ExportOptions& option
       ++undecodable;
       continue;
     }
+    trajectories.add_frame(to_nanoseconds(array.header().stamp()));
     for (const auto& pose : array.poses()) {
       const auto& p = pose.pose().pose().position();
       const auto& q = pose.pose().pose().orientation();
@@ -87,11 +89,51 @@ BodyTrajectories read_poses(const std::string& path, const ExportOptions& option
   return trajectories;
 }
 
+// One <body>.tum per body in the output folder.
+int write_tum_files(const std::string& path, const ExportOptions& options,
+                    const BodyTrajectories& trajectories, const std::vector<std::string>& bodies) {
+  const std::filesystem::path folder =
+      options.output.value_or(std::filesystem::path(path).filename().string() + "_tum");
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) {
+    fmt::print(stderr, "mocap_bag: -o {}: {}\n", folder.string(), error.message());
+    return 1;
+  }
+  for (const std::string& body : bodies) {
+    const std::filesystem::path file = folder / (body + ".tum");
+    std::ofstream out(file);
+    motion_export::write_tum(out, body, trajectories.bodies().at(body));
+    if (!out.flush()) {
+      fmt::print(stderr, "mocap_bag: cannot write {}\n", file.string());
+      return 1;
+    }
+    fmt::print("{}: {} poses\n", file.string(), trajectories.bodies().at(body).size());
+  }
+  return 0;
+}
+
+// One .trc file of every body's virtual points.
+int write_trc_file(const std::string& path, const ExportOptions& options,
+                   const BodyTrajectories& trajectories, const std::vector<std::string>& bodies) {
+  const std::filesystem::path file =
+      options.output.value_or(std::filesystem::path(path).filename().string() + ".trc");
+  std::ofstream out(file);
+  motion_export::write_trc(out, file.filename().string(), trajectories, bodies);
+  if (!out.flush()) {
+    fmt::print(stderr, "mocap_bag: cannot write {}\n", file.string());
+    return 1;
+  }
+  fmt::print("{}: {} frames, {} bodies as {} points\n", file.string(), trajectories.frames().size(),
+             bodies.size(), 4 * bodies.size());
+  return 0;
+}
+
 }  // namespace
 
 int export_bag(const std::string& path, const ExportOptions& options) {
-  if (options.format != "tum") {
-    fmt::print(stderr, "mocap_bag: --format {}: expected tum (c3d, trc and csv are to come)\n",
+  if (options.format != "tum" && options.format != "trc") {
+    fmt::print(stderr, "mocap_bag: --format {}: expected tum or trc (c3d and csv are to come)\n",
                options.format);
     return 2;
   }
@@ -112,24 +154,9 @@ int export_bag(const std::string& path, const ExportOptions& options) {
       return 1;
     }
   }
-  const std::filesystem::path folder =
-      options.output.value_or(std::filesystem::path(path).filename().string() + "_tum");
-  std::error_code error;
-  std::filesystem::create_directories(folder, error);
-  if (error) {
-    fmt::print(stderr, "mocap_bag: -o {}: {}\n", folder.string(), error.message());
-    return 1;
-  }
-  for (const std::string& body : bodies) {
-    const std::filesystem::path file = folder / (body + ".tum");
-    std::ofstream out(file);
-    motion_export::write_tum(out, body, trajectories.bodies().at(body));
-    if (!out.flush()) {
-      fmt::print(stderr, "mocap_bag: cannot write {}\n", file.string());
-      return 1;
-    }
-    fmt::print("{}: {} poses\n", file.string(), trajectories.bodies().at(body).size());
-  }
+  const int written = options.format == "tum" ? write_tum_files(path, options, trajectories, bodies)
+                                              : write_trc_file(path, options, trajectories, bodies);
+  if (written != 0) return written;
   if (trajectories.invalid_poses() > 0) {
     fmt::print(stderr, "mocap_bag: {} poses that were no pose left out\n",
                trajectories.invalid_poses());

@@ -8,8 +8,8 @@
 namespace mocap::bag_export {
 
 struct ExportOptions {
-  std::string format;                 // tum (c3d, trc, csv: to come)
-  std::optional<std::string> output;  // tum: a folder, one <body>.tum per body
+  std::string format;                 // tum or trc (c3d, csv: to come)
+  std::optional<std::string> output;  // tum: a folder, one <body>.tum per body; trc: the file
   std::vector<std::string> bodies;    // empty: every body in the bag
   std::string poses_topic = "/mocap/poses";
 };

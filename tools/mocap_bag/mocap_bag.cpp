@@ -31,7 +31,7 @@ constexpr const char* kUsage = R"(usage:
   mocap_bag record [-o DIR] TOPIC... | --all   [--duration SECONDS] [--storage mcap|sqlite3]
   mocap_bag play DIR [--rate R] [--loop] [--topics TOPIC...] [--delay SECONDS]
   mocap_bag info DIR
-  mocap_bag export DIR --format tum [-o PATH] [--bodies BODY...]
+  mocap_bag export DIR --format tum|trc [-o PATH] [--bodies BODY...]
 
   record  subscribes to the topics (or to every topic published, as publishers appear) and
           writes what arrives to a new bag directory DIR (default bag_YYYY_MM_DD-HH_MM_SS),
@@ -44,7 +44,9 @@ constexpr const char* kUsage = R"(usage:
   info    what a bag holds: files, duration, topics with types and counts, and what is damaged
   export  the bodies of /mocap/poses in a format analysis tools read: tum (evo's and the TUM
           benchmark's "timestamp tx ty tz qx qy qz qw", world frame; PATH a folder, one
-          <body>.tum per body, default DIR_tum); --bodies: only these
+          <body>.tum per body, default DIR_tum) or trc (OpenSim's, Y up: each body as four
+          points, its origin and axis ends 0.1 m out; PATH the file, default DIR.trc);
+          --bodies: only these
 
 options for record and play: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
 exit status: 0 done, 1 the bag cannot be written or read, 2 bad arguments
@@ -378,7 +380,7 @@ int main(int argc, char** argv) {
                     storage);
     if (command == "play") return play(*bag, playback, delay);
     if (command == "export") {
-      if (exporting.format.empty()) usage_error("export needs --format tum");
+      if (exporting.format.empty()) usage_error("export needs --format tum or trc");
       exporting.output = output;
       return mocap::bag_export::export_bag(*bag, exporting);
     }
