@@ -210,8 +210,8 @@ Row run(int clients, bool plain, double seconds, double rate, int bodies, int ma
   const int plain_fd = ::socket(AF_INET, SOCK_DGRAM, 0);
   std::vector<double> send_us;
   const auto period = std::chrono::duration<double>(1.0 / rate);
+  const size_t bytes = encode_frame(frame_of(0, bodies, markers), kDefaultVersion).size();
   const auto start = std::chrono::steady_clock::now();
-  size_t bytes = 0;
   for (size_t k = 0; k < frames; ++k) {
     std::this_thread::sleep_until(start + k * period);
     FrameOfData frame = frame_of(static_cast<int>(k), bodies, markers);
@@ -228,7 +228,6 @@ Row run(int clients, bool plain, double seconds, double rate, int bodies, int ma
       }
     }
     send_us.push_back(static_cast<double>(wall_ns() - before) * 1e-3);
-    if (k == 0) bytes = encode_frame(frame_of(0, bodies, markers), kDefaultVersion).size();
   }
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -12,6 +12,7 @@
 #include <mocap/message_type.hpp>
 #include <mocap_msgs/msg/constellation_pose_array.hpp>
 
+#include "common/pose_message/pose_message.hpp"
 #include "recording/motion_export/body_trajectories.hpp"
 #include "recording/motion_export/trc_writer.hpp"
 #include "recording/motion_export/tum_writer.hpp"
@@ -74,10 +75,8 @@ BodyTrajectories read_poses(const std::string& path, const ExportOptions& option
     }
     trajectories.add_frame(to_nanoseconds(array.header().stamp()));
     for (const auto& pose : array.poses()) {
-      const auto& p = pose.pose().pose().position();
-      const auto& q = pose.pose().pose().orientation();
-      trajectories.add(pose.name(), to_nanoseconds(array.header().stamp()), {p.x(), p.y(), p.z()},
-                       Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()));
+      trajectories.add(pose.name(), to_nanoseconds(array.header().stamp()),
+                       to_isometry(pose.pose().pose()));
     }
   }
   for (const std::string& problem : reader.problems())

@@ -3,7 +3,6 @@
 // OptiTrack's samples), as a Motive host streams them. Each /mocap/poses array and the
 // /mocap/markers cloud of the same capture time make one frame; until a cloud has come (a graph
 // without one), poses go out alone.
-#include <cmath>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -19,6 +18,7 @@
 #include <sensor_msgs/msg/point_cloud2.hpp>
 
 #include "common/marker_cloud_message/marker_cloud_message.hpp"
+#include "common/pose_message/pose_message.hpp"
 #include "common/topics/graph_topics.hpp"
 #include "outputs/natnet_server/natnet_frames.hpp"
 #include "outputs/natnet_server/natnet_server.hpp"
@@ -215,15 +215,9 @@ class NatNetServer final : public Component {
           std::chrono::duration_cast<std::chrono::nanoseconds>(now().time_since_epoch()).count();
     }
     for (const ConstellationPose& pose : array.poses()) {
-      const auto& p = pose.pose().pose().position();
-      const auto& q = pose.pose().pose().orientation();
-      const Eigen::Quaterniond orientation(q.w(), q.x(), q.y(), q.z());
-      if (!std::isfinite(p.x() + p.y() + p.z()) || !(orientation.norm() > 0.5)) continue;
-      PosedBody body;
-      body.name = pose.name();
-      body.world_from_body.translation() = Eigen::Vector3d(p.x(), p.y(), p.z());
-      body.world_from_body.linear() = orientation.normalized().toRotationMatrix();
-      frame.bodies.push_back(std::move(body));
+      if (const std::optional<Eigen::Isometry3d> placed = to_isometry(pose.pose().pose())) {
+        frame.bodies.push_back({pose.name(), *placed});
+      }
     }
     if (pending_poses_) send(*std::exchange(pending_poses_, std::nullopt), true);
     if (pending_cloud_ && pending_cloud_->first == frame.capture_ns) {

@@ -1,20 +1,14 @@
 #include "recording/motion_export/body_trajectories.hpp"
 
-#include <cmath>
-
 namespace mocap::motion_export {
 
 void BodyTrajectories::add(const std::string& body, int64_t stamp_ns,
-                           const Eigen::Vector3d& position, const Eigen::Quaterniond& orientation) {
-  if (!position.allFinite() || !orientation.coeffs().allFinite() || orientation.norm() < 0.5) {
+                           const std::optional<Eigen::Isometry3d>& world_from_body) {
+  if (!world_from_body) {
     ++invalid_;
     return;
   }
-  StampedPose pose;
-  pose.stamp_ns = stamp_ns;
-  pose.world_from_body.translation() = position;
-  pose.world_from_body.linear() = orientation.normalized().toRotationMatrix();
-  bodies_[body].push_back(pose);
+  bodies_[body].push_back({stamp_ns, *world_from_body});
 }
 
 }  // namespace mocap::motion_export

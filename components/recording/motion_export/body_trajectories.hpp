@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,10 +19,10 @@ struct StampedPose {
 
 class BodyTrajectories {
  public:
-  // One body's pose at `stamp_ns`; a pose that is no pose (not finite, or a quaternion of nearly
-  // zero length) is counted and left out.
-  void add(const std::string& body, int64_t stamp_ns, const Eigen::Vector3d& position,
-           const Eigen::Quaterniond& orientation);
+  // One body's pose at `stamp_ns`; none (a pose message that is no pose) is counted and left
+  // out.
+  void add(const std::string& body, int64_t stamp_ns,
+           const std::optional<Eigen::Isometry3d>& world_from_body);
 
   // A frame of the recording (a pose array, whichever bodies it holds): the frames a format of
   // fixed rows writes, with gaps where a body was not posed.
