@@ -31,7 +31,8 @@ constexpr const char* kUsage = R"(usage:
   mocap_bag record [-o DIR] TOPIC... | --all   [--duration SECONDS] [--storage mcap|sqlite3]
   mocap_bag play DIR [--rate R] [--loop] [--topics TOPIC...] [--delay SECONDS]
   mocap_bag info DIR
-  mocap_bag export DIR --format tum|trc [-o PATH] [--bodies BODY...]
+  mocap_bag export DIR --format c3d|trc|csv|tum [-o PATH] [--bodies BODY...]
+                   [--markers [--bodies-file FILE] [--robots-file FILE]]
 
   record  subscribes to the topics (or to every topic published, as publishers appear) and
           writes what arrives to a new bag directory DIR (default bag_YYYY_MM_DD-HH_MM_SS),
@@ -42,11 +43,15 @@ constexpr const char* kUsage = R"(usage:
           pace times R (default 1; 0: as fast as possible, in order), after waiting --delay
           seconds (default 1) for subscribers to be discovered
   info    what a bag holds: files, duration, topics with types and counts, and what is damaged
-  export  the bodies of /mocap/poses in a format analysis tools read: tum (evo's and the TUM
-          benchmark's "timestamp tx ty tz qx qy qz qw", world frame; PATH a folder, one
-          <body>.tum per body, default DIR_tum) or trc (OpenSim's, Y up: each body as four
-          points, its origin and axis ends 0.1 m out; PATH the file, default DIR.trc);
-          --bodies: only these
+  export  the bodies of /mocap/poses, at the bag's rate, in a format analysis tools read:
+          c3d (Z up, mm; each body as four points: its origin and axis ends 0.1 m out), trc
+          (OpenSim's, Y up, m; bodies as in c3d), csv (Motive's CSV export: rigid bodies'
+          quaternion and position, Y up, m) or tum (evo's and the TUM benchmark's "timestamp
+          tx ty tz qx qy qz qw", world frame; PATH a folder, one <body>.tum per body, default
+          DIR_tum); PATH the file, default DIR.c3d, DIR.trc, DIR.csv. --bodies: only these.
+          --markers: /mocap/markers too, a labeled marker as <body>_<n>, the others as
+          unlabeled_<track>; its body named from the fusion's --bodies-file and --robots-file
+          (a cloud gives the index in their list)
 
 options for record and play: --domain ID (default: MOCAP_DOMAIN_ID, else 0)
 exit status: 0 done, 1 the bag cannot be written or read, 2 bad arguments
@@ -341,6 +346,12 @@ int main(int argc, char** argv) {
       in_bodies = true;
     } else if (arg == "--format") {
       exporting.format = value();
+    } else if (arg == "--markers") {
+      exporting.markers = true;
+    } else if (arg == "--bodies-file") {
+      exporting.bodies_file = value();
+    } else if (arg == "--robots-file") {
+      exporting.robots_file = value();
     } else if (arg == "--domain") {
       const std::string& text = value();
       int domain = -1;
@@ -380,7 +391,7 @@ int main(int argc, char** argv) {
                     storage);
     if (command == "play") return play(*bag, playback, delay);
     if (command == "export") {
-      if (exporting.format.empty()) usage_error("export needs --format tum or trc");
+      if (exporting.format.empty()) usage_error("export needs --format c3d, trc, csv or tum");
       exporting.output = output;
       return mocap::bag_export::export_bag(*bag, exporting);
     }

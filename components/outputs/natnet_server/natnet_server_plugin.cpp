@@ -116,12 +116,10 @@ ServerOptions server_options(const Settings& settings) {
 }
 
 std::vector<StreamedBody> known_bodies(const Settings& settings) {
-  // Which bodies could be taken for each other is the fusion's check, with its own tolerance and
-  // min_markers: counting more markers than any body has, no confusion is looked for here.
-  constexpr int kNoConfusionCheck = 1 << 20;
   const volume::RigidBodyDatabase bodies =
-      settings.bodies.empty() ? volume::RigidBodyDatabase{}
-                              : volume::load_rigid_bodies(settings.bodies, 0, kNoConfusionCheck);
+      settings.bodies.empty()
+          ? volume::RigidBodyDatabase{}
+          : volume::load_rigid_bodies(settings.bodies, 0, volume::kNoConfusionCheck);
   const volume::SwarmDatabase robots =
       settings.robots.empty() ? volume::SwarmDatabase{} : volume::load_swarm(settings.robots, 0);
   return streamed_bodies(bodies, robots);

@@ -6,21 +6,14 @@
 
 #include <ostream>
 #include <string>
-#include <vector>
 
-#include "recording/motion_export/body_trajectories.hpp"
+#include "recording/motion_export/point_table.hpp"
 
 namespace mocap::motion_export {
 
-// A body as TRC's markers: its origin and the ends of its three axes, kAxisLength along them
-// ("<body>_origin", "<body>_x", "<body>_y", "<body>_z"), a common way analysis tools read a
-// rigid body from marker trajectories.
-inline constexpr double kAxisLength = 0.1;  // metres
-
-// `trajectories`' frames and the bodies named in `bodies` (each a key of bodies()): rows at the
-// frames' times (s since the first), the data rate their median interval's. `file_name` goes in
-// the first line, as OpenSim writes it. Positions in metres to the nanometre.
-void write_trc(std::ostream& out, const std::string& file_name,
-               const BodyTrajectories& trajectories, const std::vector<std::string>& bodies);
+// `table`'s points as TRC markers, a row per frame at its time (s since the first frame), the
+// data rate the table's. `file_name` goes in the first line, as OpenSim writes it. Metres to
+// the nanometre.
+void write_trc(std::ostream& out, const std::string& file_name, const PointTable& table);
 
 }  // namespace mocap::motion_export

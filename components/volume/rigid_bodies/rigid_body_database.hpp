@@ -58,6 +58,10 @@ RigidBodyDatabase parse_rigid_bodies(const std::string& text, const std::string&
                                      double tolerance, int min_markers);
 RigidBodyDatabase load_rigid_bodies(const std::string& path, double tolerance, int min_markers);
 
+// A min_markers that looks for no confusion (more markers than any body has): for readers of a
+// file whose bodies they only name, the fusion having checked it with its own tolerance.
+inline constexpr int kNoConfusionCheck = 1 << 20;
+
 // A way `count` markers of `seen` could be taken for `count` of `taken_for`'s: their distances
 // differ by up to twice `tolerance` and a rotation maps one set onto the other (a mirror image
 // does not confuse). With `same` (one body against itself), the markers taken for themselves
