@@ -259,10 +259,11 @@ TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
 
 // cam_1 knocked by half a degree after calibration: the simulator renders it from where it now
 // points, the fusion still has its calibrated pose. It is named as moved, and poses stay right.
-// Tracked: 98 %, the figure of a camera away, which cam_1 is once named; before, for the first
-// two or three seconds, a board only cam_1 and one other camera see is not posed (their views
-// disagree by 4 px and each agrees with itself) until cam_1's residuals mark it out (93 % to
-// 96 % tracked in those seconds; 97.8 % to 99.7 % over the run, six runs measured).
+// Tracked: 98 %, the figure of a camera away, which cam_1 is once named; before, a board only
+// cam_1 and one other camera see is not posed (their views disagree by 4 px and each agrees with
+// itself) until cam_1's residuals mark it out (91 % to 96 % tracked in the second second). Counted
+// from the second second, as the other volume tests are: the first is the camera processes coming
+// up (81 % in a CI run that then missed the bound with 97.7 % over the run, 99.1 % without it).
 TEST(VolumeDemo, ABumpedCameraIsNamed) {
   test::TempDir dir;
   calibration::CameraFile bumped = calibration::load_camera_file(
@@ -275,7 +276,8 @@ TEST(VolumeDemo, ABumpedCameraIsNamed) {
   auto [code, output] =
       test::run_command({(test::bin_dir() / "mocap_launch").string(), launch_file(), "--duration",
                          "12", "--set", "cam_1.camera=" + bumped_file.string(), "--set",
-                         "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0"},
+                         "evaluator.summary_file=" + summary.string(), "--set", "viewer.port=0",
+                         "--set", "evaluator.skip_first_s=1"},
                         environment(78), std::chrono::seconds(90));
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("camera cam_1 has moved since calibration"), std::string::npos) << output;
@@ -519,6 +521,58 @@ TEST(VolumeDemo, TheSwarmDemosHundredRobotsKeepTheirNames) {
   EXPECT_GE(figures.tracked_share(), 0.99) << test::read_file(summary) << output;
   EXPECT_LE(figures.node["position_error_median_m"].as<double>(), 1e-4);
   EXPECT_LE(figures.node["orientation_error_median_deg"].as<double>(), 0.2);
+}
+
+// Eight seconds of the demo recorded as a user would (mocap_bag record /mocap/poses
+// /mocap/markers) and exported in every format: each export read back by a reader written from
+// its format's description holds every pose and marker of the bag, read by MCAP's and Foxglove's
+// own readers, at its frame, to 1 µm or the float, and gaps exactly where the bag has nothing
+// (test/bag/export_compare.mjs).
+TEST(VolumeDemo, ARecordingsExportsHoldEveryPoseAndMarkerOfIt) {
+  test::TempDir dir;
+  test::ChildProcess graph({(test::bin_dir() / "mocap_launch").string(), launch_file(),
+                            "--duration", "14", "--set", "viewer.port=0"},
+                           environment(63), dir / "graph.log");
+  ASSERT_TRUE(graph.wait_for_output("[evaluator]", std::chrono::seconds(60))) << graph.output();
+  const std::string mocap_bag = (test::bin_dir() / "mocap_bag").string();
+  const auto bag = dir / "demo";
+  auto [code, output] = test::run_command({mocap_bag, "record", "-o", bag.string(), "/mocap/poses",
+                                           "/mocap/markers", "--duration", "8"},
+                                          environment(63), std::chrono::seconds(60));
+  ASSERT_EQ(code, 0) << output;
+  const std::string bodies = (test::source_dir() / "config" / "volume" / "bodies.yaml").string();
+  for (const std::string format : {"c3d", "trc", "csv", "tum"}) {
+    const bool tum = format == "tum";
+    std::vector<std::string> arguments = {mocap_bag,
+                                          "export",
+                                          bag.string(),
+                                          "--format",
+                                          format,
+                                          "-o",
+                                          (dir / (tum ? "demo_tum" : "demo." + format)).string()};
+    if (!tum) arguments.insert(arguments.end(), {"--markers", "--bodies-file", bodies});
+    std::tie(code, output) = test::run_command(arguments, {}, std::chrono::seconds(60));
+    ASSERT_EQ(code, 0) << format << ": " << output;
+  }
+  std::filesystem::path mcap;
+  for (const auto& entry : std::filesystem::directory_iterator(bag)) {
+    if (entry.path().extension() == ".mcap") mcap = entry.path();
+  }
+  std::tie(code, output) = test::run_command(
+      {"node", (test::source_dir() / "test" / "bag" / "export_compare.mjs").string(), mcap.string(),
+       "board_1,board_2,board_3,board_4", (dir / "demo").string()},
+      {}, std::chrono::seconds(120));
+  ASSERT_EQ(code, 0) << output;
+  std::printf("%s", output.c_str());
+  // A row per format, each of the recording's 8 s at 30 frames/s.
+  const std::regex row(R"(\| (c3d|trc|csv|tum) \| (\d+) \| (\d+) \|)");
+  int rows = 0;
+  for (auto it = std::sregex_iterator(output.begin(), output.end(), row);
+       it != std::sregex_iterator(); ++it, ++rows) {
+    EXPECT_GE(std::stoi((*it)[2]), 200) << output;
+    EXPECT_GE(std::stoi((*it)[3]), 200 * 4) << output;
+  }
+  EXPECT_EQ(rows, 4) << output;
 }
 
 }  // namespace
