@@ -25,13 +25,19 @@
 // with the last dimension outermost. Bytes and the counts POINT:USED, FRAMES, DATA_START,
 // ANALOG:USED and the TRIAL words read unsigned, other int16 signed. Fails, naming what is wrong,
 // when the header and parameters disagree or the data does not fit the file.
-//   node c3d_read.mjs FILE
+// With --frames I,J,... (0-based) every frame is read and checked, and only those are printed
+// (frames and residuals hold them in that order).
+//   node c3d_read.mjs FILE [--frames I,J,...]
 import { readFileSync } from "node:fs";
 
 const fail = (message) => { console.error(`c3d_read: ${message}`); process.exit(1); };
-if (process.argv.length !== 3) fail("usage: node c3d_read.mjs FILE");
+const [, , fileName, option, list] = process.argv;
+if (!fileName || (option !== undefined && (option !== "--frames" || !list)) || process.argv.length > 5) {
+  fail("usage: node c3d_read.mjs FILE [--frames I,J,...]");
+}
+const printed = list?.split(",").map(Number);
 let file;
-try { file = readFileSync(process.argv[2]); } catch (e) { fail(`cannot read ${process.argv[2]}: ${e.message}`); }
+try { file = readFileSync(fileName); } catch (e) { fail(`cannot read ${fileName}: ${e.message}`); }
 const view = new DataView(file.buffer, file.byteOffset, file.byteLength);
 const BLOCK = 512;
 const blockOffset = (block) => (block - 1) * BLOCK;
@@ -306,5 +312,7 @@ for (let f = 0; f < frameCount; f++) {
 
 console.log(JSON.stringify({
   header, processor, parameters, group_descriptions, labels, descriptions, units, rate,
-  frame_count: frameCount, frames, residuals,
+  frame_count: frameCount,
+  frames: printed ? printed.map((i) => frames[i] ?? fail(`--frames: no frame ${i}`)) : frames,
+  residuals: printed ? printed.map((i) => residuals[i]) : residuals,
 }));
