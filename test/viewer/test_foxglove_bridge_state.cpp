@@ -145,6 +145,46 @@ TEST_F(BridgeTest, ATopicThatIsNotLatchedIsReadOnlyWhileAClientWatchesIt) {
   EXPECT_TRUE(graph.subscribed.contains("/alerts")) << "a latched topic is kept";
 }
 
+// max_rate_hz: a topic at 240 Hz reaches a client at about that rate (after a second's worth
+// at once); a slower one loses nothing, however its messages bunch: ten processes' statuses
+// coming together once a second.
+TEST_F(BridgeTest, MaxRateThinsAFastTopicAndPassesASlowOneWhole) {
+  FoxgloveBridge bridge = make({.topics = ".*", .max_rate_hz = 30});
+  bridge.opened(1);
+  std::map<std::string, uint32_t> ids;
+  for (const json& channel : links.texts[1][1]["channels"]) ids[channel["topic"]] = channel["id"];
+  bridge.received(1, json{{"op", "subscribe"},
+                          {"subscriptions",
+                           {{{"id", 1}, {"channelId", ids.at("/hidden/alerts")}},
+                            {{"id", 2}, {"channelId", ids.at("/alerts")}}}}}
+                         .dump());
+  bridge.run_once();
+  auto alert = std::make_shared<mocap_msgs::msg::Alert>();
+  std::map<uint32_t, int> sent;  // subscription -> messages
+  auto count = [&] {
+    for (const std::string& frame : links.binaries[1]) {
+      uint32_t subscription = 0;
+      std::memcpy(&subscription, frame.data() + 1, 4);
+      ++sent[subscription];
+    }
+    links.binaries[1].clear();
+  };
+  const Clock::time_point start(std::chrono::seconds(100));
+  for (int i = 0; i < 480; ++i) {
+    bridge.forward("/hidden/alerts", alert, start + std::chrono::microseconds(i * 1'000'000 / 240));
+  }
+  count();
+  EXPECT_GE(sent[1], 30 + 55) << "a second's worth at once, then 30 a second";
+  EXPECT_LE(sent[1], 30 + 61);
+  for (int second = 0; second < 3; ++second) {
+    for (int process = 0; process < 10; ++process) {
+      bridge.forward("/alerts", alert, start + std::chrono::seconds(second));
+    }
+  }
+  count();
+  EXPECT_EQ(sent[2], 30);
+}
+
 TEST_F(BridgeTest, AClientPublishingWhileItIsOffIsClosed) {
   FoxgloveBridge bridge = make();
   bridge.opened(3);
@@ -162,6 +202,8 @@ TEST(FoxgloveBridgeOptions, NameTheFieldThatCannotBeUsed) {
             0u);
   EXPECT_EQ(FoxgloveBridgeOptions{.max_image_rate_hz = -1}.problem(),
             "max_image_rate_hz: -1 is not a rate (0: every image)");
+  EXPECT_EQ(FoxgloveBridgeOptions{.max_rate_hz = -1}.problem(),
+            "max_rate_hz: -1 is not a rate (0: every message)");
   FoxgloveBridgeOptions no_room;
   no_room.queue.limit_bytes = 0;
   EXPECT_EQ(no_room.problem(), "queue.limit_bytes: 0 leaves no room for a message");

@@ -43,6 +43,9 @@ std::optional<std::string> FoxgloveBridgeOptions::problem() const {
   if (!(max_image_rate_hz >= 0)) {
     return fmt::format("max_image_rate_hz: {} is not a rate (0: every image)", max_image_rate_hz);
   }
+  if (!(max_rate_hz >= 0)) {
+    return fmt::format("max_rate_hz: {} is not a rate (0: every message)", max_rate_hz);
+  }
   if (auto problem = queue.problem()) return "queue." + *problem;
   return std::nullopt;
 }
@@ -63,6 +66,7 @@ FoxgloveBridge::FoxgloveBridge(FoxgloveBridgeOptions options,
     image_period_ = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(1.0 / options_.max_image_rate_hz));
   }
+  rate_burst_ = std::max(1.0, options_.max_rate_hz);
   for (const KnownTopic& topic : declared) {
     if (offered(topic)) declared_.insert(topic.topic);
   }
@@ -156,6 +160,7 @@ void FoxgloveBridge::update(const std::vector<KnownTopic>& present, bool announc
       for (auto& [client, state] : clients_) {
         state.subscription_of_channel.erase(topic.channel_id);
         state.last_image.erase(topic.channel_id);
+        state.budget.erase(topic.channel_id);
       }
       topic.channel_id = 0;
     }
@@ -422,6 +427,17 @@ void FoxgloveBridge::forward(const std::string& topic, const std::shared_ptr<con
         continue;
       }
       state.last_image[id] = received;
+    } else if (!image && options_.max_rate_hz > 0) {
+      // A new subscriber starts with a full bucket: its first messages pass at once.
+      auto [budget, first] = state.budget.try_emplace(id, RateBudget{rate_burst_, received});
+      RateBudget& b = budget->second;
+      if (!first) {
+        const double elapsed = std::chrono::duration<double>(received - b.at).count();
+        b.tokens = std::min(rate_burst_, b.tokens + std::max(0.0, elapsed) * options_.max_rate_hz);
+        b.at = std::max(b.at, received);
+      }
+      if (b.tokens < 1) continue;
+      b.tokens -= 1;
     }
     if (frame.empty()) frame = message_data(channel, message.get(), received);
     queue_frame(state, frame, subscription->second);

@@ -39,6 +39,10 @@ struct FoxgloveBridgeOptions {
   std::string topics = ".*";
   // Most sensor_msgs/msg/Image messages a second per client and topic; 0: all.
   double max_image_rate_hz = 10;
+  // Most messages a second per client and topic of the other types, on average; a topic slower
+  // than that passes whole, however its messages bunch within a second (a second's worth pass
+  // at once): /diagnostics, of every process, and /alerts lose nothing. 0: all.
+  double max_rate_hz = 0;
   // Clients may publish (Foxglove's clientPublish) on offered topics, in CDR of a known type.
   bool client_publish = false;
   ClientQueueOptions queue = {};
@@ -131,11 +135,18 @@ class FoxgloveBridge {
     std::string topic;
     const MessageType* type;
   };
+  // max_rate_hz's token bucket: a message passes with a whole token; tokens come at the rate, up
+  // to a second's worth.
+  struct RateBudget {
+    double tokens = 0;
+    Clock::time_point at{};
+  };
   struct ClientState {
     explicit ClientState(ClientQueueOptions options) : queue(options) {}
     ClientQueue queue;
     std::map<uint32_t, uint32_t> subscription_of_channel;  // channel id -> subscription id
     std::map<uint32_t, Clock::time_point> last_image;      // channel id -> last image sent
+    std::map<uint32_t, RateBudget> budget;                 // channel id -> its max_rate_hz
     std::map<uint32_t, ClientChannelState> published;      // client channel id -> topic
   };
   struct ClientMessageToPublish {
@@ -167,6 +178,7 @@ class FoxgloveBridge {
   const Logger& log_;
   std::regex allowed_;
   Clock::duration image_period_{};
+  double rate_burst_ = 0;               // max_rate_hz's second of messages, at least one
   std::set<std::string> declared_;      // offered topics of the launch file: always present
   std::set<std::string> warned_types_;  // topics published with two types, warned about once
   mutable std::mutex mutex_;            // guards what follows

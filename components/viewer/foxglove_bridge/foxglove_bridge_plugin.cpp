@@ -65,6 +65,11 @@ const ParameterList<Settings> kParameters =
              "most sensor_msgs/msg/Image messages a second per client and topic (0: all)",
              &Settings::bridge, &FoxgloveBridgeOptions::max_image_rate_hz)
         .range(0.0, 1000.0)
+        .add("max_rate_hz",
+             "most messages a second per client and topic of the other types, on average: a "
+             "topic slower than that (/diagnostics, /alerts) passes whole (0: all)",
+             &Settings::bridge, &FoxgloveBridgeOptions::max_rate_hz)
+        .range(0.0, 10000.0)
         .add("send_buffer_limit_bytes",
              "bytes a client may have queued; beyond, its oldest messages are dropped, "
              "and after 5 s of dropping it is disconnected",

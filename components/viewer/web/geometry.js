@@ -38,3 +38,22 @@ export function project(info, p) {
 
 // Half the camera's horizontal field of view.
 export const halfView = (info) => Math.atan(info.width / 2 / info.k[0]);
+
+// The rotation a then b applied to a vector: a * b.
+export function multiply(a, b) {
+  return {
+    w: a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+    x: a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+    y: a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+    z: a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+  };
+}
+
+// tf's transform `outer` after `inner` ({translation, rotation}): parent_from_child chained.
+export function compose(outer, inner) {
+  const r = rotate(outer.rotation, inner.translation);
+  return {
+    translation: { x: outer.translation.x + r.x, y: outer.translation.y + r.y, z: outer.translation.z + r.z },
+    rotation: multiply(outer.rotation, inner.rotation),
+  };
+}

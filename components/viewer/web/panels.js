@@ -37,6 +37,7 @@ export function layout(channels) {
   $("camera-topic").textContent = cameras.length === 1 ? cameras[0] : "";
   $("camera-note").textContent = cameras.length ? "" : `no ${TYPES.image} in this graph`;
   $("volume").hidden = !volume;
+  $("view3d-section").hidden = !volume;
   if (volume) {
     $("volume-topics").textContent = cameras.length
       ? `${pattern(cameras)} with their fiducials`

@@ -1,7 +1,7 @@
 // The viewer's state: what the graph said last, kept for each panel from the decoded messages
 // of the channels topics.js chose, with which panels have news; draw.js and panels.js show it
 // at the browser's next animation frame.
-import { yaw } from "./geometry.js";
+import { compose, yaw } from "./geometry.js";
 import { TYPES, subject } from "./topics.js";
 
 const WORLD = "world";
@@ -14,6 +14,12 @@ const STAMPS_KEPT = 60;  // per frame: the last few images' fiducials, constella
 // A pose's orientation variance (rad^2) from which it has none: a robot of one marker carries
 // 1e9 (components/outputs/body_frames/body_frames.hpp).
 const UNKNOWN_ORIENTATION_VARIANCE = 1e6;
+// The 3D view's trails: each body's last seconds, a point every 1/30 s at most (a swarm's poses
+// come 240 times a second: 100 trails of every pose would be most of a frame's lines).
+const TRACK_S = 3;
+const TRACK_STEP_S = 1 / 30;
+// tf frames deeper than this under the world are not looked for (and a loop ends).
+const TF_DEPTH = 16;
 
 // What was drawn: window.viewerState.
 export const report = {
@@ -40,10 +46,33 @@ export const report = {
   volumeBodiesDrawn: 0,  // bodies and robots drawn from above
   volumeMarkersDrawn: 0,  // points of the marker cloud drawn from above
   healthRows: {},  // status name -> its level as shown ("OK", "WARN", "ERROR", "STALE")
+  // The 3D view (view3d.js): what its last frame drew.
+  view3d: "",  // "drawn", or why not ("needs WebGL")
+  view3dFrames: 0,
+  view3dRenderer: "",  // WebGL's renderer
+  view3dBuffer: [0, 0],  // the drawing buffer's size (pixels)
+  view3dCanvas: [0, 0],  // the canvas's size on the page (CSS pixels)
+  // Each frame's time (ms) from the start of its drawing until the GPU had drawn it: the last 1000.
+  view3dDrawMs: [],
+  view3dCamerasDrawn: 0,  // as frusta
+  view3dCamerasByLevel: {},  // "OK", "WARN", "ERROR", "STALE" -> cameras drawn in its colour
+  view3dBodiesDrawn: 0,  // with their axes (oriented)
+  view3dRobotsDrawn: 0,  // single-marker robots, as points
+  view3dMarkersDrawn: 0,  // points of the marker cloud
+  view3dLabeledMarkers: 0,
+  view3dTrailSegments: 0,
+  view3dLabelsDrawn: 0,
+  view3dLabelsHidden: 0,  // bodies' names left out: they would cover others
+  view3dBodiesFrom: "",  // "/mocap/poses" or "/tf"
+  view3dEye: null,  // {azimuthDeg, elevationDeg, distanceM, target}
+  view3dSelected: "",  // the body whose figures are shown
+  view3dFollowing: "",
+  // Where the last frame put each camera and body: name -> [x, y], CSS pixels in the canvas.
+  view3dScreen: { cameras: {}, bodies: {} },
 };
 
 // The panels with news since the last animation frame.
-export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false, health: false };
+export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false, health: false, view3d: false };
 
 export const graph = {
   cameras: new Map(),  // image topic -> {name, image, frameStamp, dirty}, in topic order
@@ -51,7 +80,16 @@ export const graph = {
   poses: new Map(),  // topic of estimated poses -> its latest message
   tf: new Map(),  // child frame -> its latest transform, from every TFMessage topic
   trails: new Map(),  // board -> [{x, z}], seen from above in its camera's optical frame
-  bodies: new Map(),  // body -> {x, y, yaw (null: none), trail: [{x, y}]} in the world frame
+  // body -> {x, y, yaw (null: none), trail: [{x, y}]} in the world frame; for the 3D view
+  // also z, orientation (null: none), track: [{x, y, z, t}] (its last seconds, t in seconds of
+  // the poses' stamps), pose (its latest ConstellationPose), latencyMs, count and rate.
+  bodies: new Map(),
+  // Frames that /tf moves under the world (a ROS 2 graph's bodies without /mocap/poses): frame ->
+  // {x, y, z, orientation, track, updates}.
+  tfBodies: new Map(),
+  // The fusion's cameras' optical frames in its order (the order of its /tf_static message),
+  // which the marker cloud's `cameras` bits follow.
+  cameraOrder: [],
   markers: null,  // the newest marker cloud in the world frame (PointCloud2), read when drawn
   bases: new Map(),  // topic -> the pose of what stands on the floor
   robots: new Map(),  // topic -> its latest robots
@@ -80,6 +118,34 @@ export function inWorld(frame) {
   return t?.header.frame_id === WORLD ? t.transform : undefined;
 }
 
+// `frame`'s transform in the world frame through its parents, when tf joins it to the world.
+export function worldTransform(frame) {
+  let t = graph.tf.get(frame);
+  if (!t) return undefined;
+  let chained = t.transform;
+  for (let depth = 0; t.header.frame_id !== WORLD; depth++) {
+    t = graph.tf.get(t.header.frame_id);
+    if (!t || depth === TF_DEPTH) return undefined;
+    chained = compose(t.transform, chained);
+  }
+  return chained;
+}
+
+// A point of the 3D view's trail at `t` (s): one every TRACK_STEP_S, the last TRACK_S kept.
+function addToTrack(track, p, t) {
+  const last = track[track.length - 1];
+  if (last && t - last.t < TRACK_STEP_S && t >= last.t) {
+    // Newer than the step allows: the head moves, the trail keeps its spacing.
+    last.x = p.x;
+    last.y = p.y;
+    last.z = p.z;
+    return;
+  }
+  if (last && t < last.t) track.length = 0;  // time went back (a bag replayed): start again
+  track.push({ x: p.x, y: p.y, z: p.z, t });
+  while (track.length > 2 && track[1].t < t - TRACK_S) track.shift();
+}
+
 function remember(kind, header, value) {
   const byStamp = recent[kind].get(header.frame_id) ?? new Map();
   byStamp.set(stampKey(header), value);
@@ -101,16 +167,46 @@ function addToTrail(name, position) {
   graph.trails.set(name, trail);
 }
 
-// `pose` in the world frame, with its covariance (ConstellationPose.msg).
-function addToVolume(name, pose, covariance) {
-  const body = graph.bodies.get(name) ?? { trail: [] };
+// A ConstellationPose in the world frame, of a message stamped `t` (s) that took `latencyMs`
+// from capture to the bridge.
+function addToVolume(constellationPose, t, latencyMs) {
+  const { name, covariance } = constellationPose;
+  const pose = constellationPose.pose.pose;
+  const body = graph.bodies.get(name) ?? { trail: [], track: [], count: 0, rate: null };
   body.x = pose.position.x;
   body.y = pose.position.y;
+  body.z = pose.position.z;
   const oriented = [21, 28, 35].some((i) => covariance[i] < UNKNOWN_ORIENTATION_VARIANCE);
   body.yaw = oriented ? yaw(pose.orientation) : null;
+  body.orientation = oriented ? pose.orientation : null;
+  body.pose = constellationPose;
+  body.latencyMs = latencyMs;
+  body.receivedAt = Date.now();
+  body.count++;
   body.trail.push({ x: body.x, y: body.y });
   if (body.trail.length > TRAIL_LENGTH) body.trail.shift();
+  addToTrack(body.track, pose.position, t);
   graph.bodies.set(name, body);
+}
+
+// The frames of a /tf message that move under the world, for the 3D view. A frame /tf sends
+// more than once moves (/tf_static's come once); cameras' optical frames are cameras.
+function addTfBodies(message) {
+  for (const t of message.transforms) {
+    const frame = t.child_frame_id;
+    if (frame.endsWith("_optical")) continue;
+    const world = worldTransform(frame);
+    if (!world) continue;
+    const body = graph.tfBodies.get(frame) ?? { track: [], updates: 0 };
+    body.x = world.translation.x;
+    body.y = world.translation.y;
+    body.z = world.translation.z;
+    body.orientation = world.rotation;
+    body.updates++;
+    addToTrack(body.track, world.translation, stampSeconds(t.header));
+    graph.tfBodies.set(frame, body);
+    if (body.updates > 1) dirty.view3d = true;
+  }
 }
 
 const handlers = {
@@ -149,7 +245,8 @@ const handlers = {
     posesAt = Date.now();
     if (message.header.frame_id === WORLD) {
       // A volume's bodies.
-      for (const pose of message.poses) addToVolume(pose.name, pose.pose.pose, pose.covariance);
+      const t = stampSeconds(message.header);
+      for (const pose of message.poses) addToVolume(pose, t, report.latencyMs);
       dirty.volume = true;
     } else {
       for (const pose of message.poses) addToTrail(pose.name, pose.pose.pose.position);
@@ -158,6 +255,8 @@ const handlers = {
   },
   [TYPES.tf](message) {
     const posesLately = Date.now() - posesAt < POSES_FRESH_MS;
+    const cameras = message.transforms.filter((t) => t.header.frame_id === WORLD && t.child_frame_id.endsWith("_optical"));
+    if (cameras.length > graph.cameraOrder.length) graph.cameraOrder = cameras.map((t) => t.child_frame_id);
     for (const t of message.transforms) {
       graph.tf.set(t.child_frame_id, t);
       // Where a volume's cameras are (volume_fusion latches them).
@@ -169,6 +268,7 @@ const handlers = {
       report.transformsUsed++;
       dirty.side = true;
     }
+    if (!posesLately) addTfBodies(message);
   },
   // What stands on the floor, such as a mobile base: a pose in the world frame at its ground.
   [TYPES.pose](message, topic) {
@@ -251,4 +351,11 @@ export function rollRates() {
     t.count = 0;
     t.bytes = 0;
   }
+  for (const body of graph.bodies.values()) {
+    body.rate = body.count;
+    body.count = 0;
+  }
 }
+
+// Whether estimated poses came lately: the 3D view then draws them, else /tf's frames.
+export const posesFresh = () => Date.now() - posesAt < POSES_FRESH_MS;
