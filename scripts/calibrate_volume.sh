@@ -8,6 +8,12 @@
 # else.
 #
 #   scripts/calibrate_volume.sh OUTPUT [--wave SECONDS] [--floor SECONDS] [--marks "X,Y ..."]
+#                                      [--viewer-port PORT]
+#
+# While the board is waved, each camera's coverage (its image's regions the board has filled,
+# the shots it shares with another camera: the volume_calibration_coverage component) shows as a
+# bar a camera with what is still missing, redrawn on a terminal, and in the page at
+# http://localhost:PORT/ (default 8765; 0: any free port, named in waved.log).
 #
 # Defaults: 120 s of waving (the wave's path once round); 3 s on the floor at each of the marks
 # "0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1" (metres: the centre, 1 m along each axis and the
@@ -27,12 +33,13 @@ usage() {
 [ $# -ge 1 ] || usage
 out="$1"
 shift
-wave_s=120 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1"
+wave_s=120 floor_s=3 marks="0,0 1,0 0,1 -1,0 0,-1 1,1 -1,1 -1,-1 1,-1" viewer_port=8765
 while [ $# -gt 0 ]; do
   case "$1" in
     --wave) wave_s="${2:?}"; shift 2 ;;
     --floor) floor_s="${2:?}"; shift 2 ;;
     --marks) marks="${2:?}"; shift 2 ;;
+    --viewer-port) viewer_port="${2:?}"; shift 2 ;;
     *) echo "calibrate_volume.sh: unknown option $1" >&2; usage ;;
   esac
 done
@@ -40,9 +47,27 @@ launch="$root/launch_yaml/volume_calibration.yaml"
 mkdir -p "$out"
 # Each bag goes into a folder of its own name, written afresh; nothing else in OUTPUT is touched.
 rm -rf "$out/waved"
-echo "calibrate_volume: recording ${wave_s} s of the board carried through the volume"
+echo "calibrate_volume: recording ${wave_s} s of the board carried through the volume" \
+  "(coverage: http://localhost:$viewer_port/)"
 "$bin_dir/mocap_launch" "$launch" --duration "$wave_s" --set "recorder.output=$out/waved" \
-  > "$out/waved.log" 2>&1 || { tail -n 20 "$out/waved.log"; exit 1; }
+  --set "viewer.port=$viewer_port" > "$out/waved.log" 2>&1 &
+wave=$!
+# The coverage component's latest line for each camera ("coverage cam_0 [====   ] 40 %: ...").
+coverage() { { grep -o "coverage cam_[0-9]* \[.*" "$out/waved.log" || true; } | tail -n 4; }
+if [ -t 1 ]; then
+  shown=0
+  while kill -0 "$wave" 2> /dev/null; do
+    lines=$(coverage)
+    if [ -n "$lines" ]; then
+      [ "$shown" = 0 ] || printf '\033[%dA' "$shown"
+      while IFS= read -r line; do printf '\033[K  %s\n' "$line"; done <<< "$lines"
+      shown=$(wc -l <<< "$lines")
+    fi
+    sleep 1
+  done
+fi
+wait "$wave" || { tail -n 20 "$out/waved.log"; exit 1; }
+[ -t 1 ] || coverage | sed 's/^/calibrate_volume: /'
 floor_scene="$root/config/volume/calibration_floor.yaml"
 floors=()
 turns="0 180"
@@ -66,7 +91,8 @@ for mark in $marks; do
     for c in 0 1 2 3; do on_floor+=(--set "cam_$c.scene=$out/$name.yaml"); done
     rm -rf "${out:?}/$name"
     "$bin_dir/mocap_launch" "$launch" --duration "$floor_s" --set "recorder.output=$out/$name" \
-      "${on_floor[@]}" > "$out/$name.log" 2>&1 || { tail -n 20 "$out/$name.log"; exit 1; }
+      --set viewer.port=0 "${on_floor[@]}" > "$out/$name.log" 2>&1 ||
+      { tail -n 20 "$out/$name.log"; exit 1; }
     floors+=(--floor "$out/$name:$x,$y")
   done
 done

@@ -449,10 +449,19 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   test::write_file(dir / "floor_notes" / "marks.txt", "taped on Monday\n");
   auto [code, output] = test::run_command(
       {(test::source_dir() / "scripts" / "calibrate_volume.sh").string(), dir.path().string(),
-       "--wave", "30", "--floor", "2", "--marks", "0,0 1,0 0,1 -1,0 0,-1"},
+       "--wave", "30", "--floor", "2", "--marks", "0,0 1,0 0,1 -1,0 0,-1", "--viewer-port", "0"},
       environment(74), std::chrono::seconds(150));
   ASSERT_EQ(code, 0) << output;
   std::printf("%s", output.c_str());
+  // Each camera's coverage of the wave, as the coverage component saw it live and as the solver
+  // reads it from the bag.
+  for (const char* camera : {"cam_0", "cam_1", "cam_2", "cam_3"}) {
+    EXPECT_NE(output.find(fmt::format("calibrate_volume: coverage {} [", camera)),
+              std::string::npos)
+        << output;
+    EXPECT_NE(output.find(fmt::format("waved coverage: {} [", camera)), std::string::npos)
+        << output;
+  }
   const std::regex line(R"((cam_\d): at .* m; ([0-9.]+) mm and ([0-9.]+) deg from the input)");
   int cameras = 0;
   for (std::sregex_iterator it(output.begin(), output.end(), line), end; it != end; ++it) {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <mocap/bag/bag_error.hpp>
 #include <mocap/bag/bag_reader.hpp>
@@ -28,6 +29,8 @@
 
 #include "common/topics/graph_topics.hpp"
 #include "tracking/constellation_database/constellation_database.hpp"
+#include "volume/volume_calibration/board_sighting_message.hpp"
+#include "volume/volume_calibration/calibration_coverage.hpp"
 #include "volume/volume_calibration/volume_calibration.hpp"
 
 namespace {
@@ -64,7 +67,7 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
   std::vector<std::string> wanted;
   for (size_t c = 0; c < cameras.size(); ++c) {
     const std::string topic =
-        mocap::topics::member_of("/volume/{camera}/constellations", cameras[c]);
+        mocap::topics::member_of(mocap::topics::kVolumeConstellations, cameras[c]);
     camera_of_topic[topic] = c;
     wanted.push_back(topic);
   }
@@ -81,25 +84,9 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
       ++undecodable;
       continue;
     }
-    for (const auto& constellation : array.constellations()) {
-      if (constellation.name() != board.name) continue;
-      BoardSighting sighting;
-      sighting.camera = camera_of_topic.at(message.topic->name);
-      sighting.pixels.resize(board.points.size());
-      for (const auto& line : constellation.sub_constellations()) {
-        const auto model_line = std::find_if(board.lines.begin(), board.lines.end(),
-                                             [&](const auto& l) { return l.name == line.name(); });
-        if (model_line == board.lines.end()) continue;
-        const auto& fiducials = line.fiducial_array().fiducials();
-        const auto& stamp = line.fiducial_array().header().stamp();
-        sighting.stamp_ns = int64_t{stamp.sec()} * 1'000'000'000 + stamp.nanosec();
-        for (size_t i = 0; i < fiducials.size() && i < model_line->points.size(); ++i) {
-          if (!std::isfinite(fiducials[i].x()) || !std::isfinite(fiducials[i].y())) continue;
-          sighting.pixels[static_cast<size_t>(model_line->points[i])] =
-              Eigen::Vector2d(fiducials[i].x(), fiducials[i].y());
-        }
-      }
-      sightings.push_back(std::move(sighting));
+    if (auto sighting =
+            mocap::volume::board_sighting(array, camera_of_topic.at(message.topic->name), board)) {
+      sightings.push_back(std::move(*sighting));
     }
   }
   for (const std::string& problem : reader.problems())
@@ -114,6 +101,24 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
   }
   fmt::print("{}: {} sightings of {} ({})\n", path, sightings.size(), board.name, counts);
   return sightings;
+}
+
+// How the waved session covered each camera's image (calibration_coverage.hpp), as the
+// coverage component shows it live: what a poor solve of one camera comes from.
+void print_coverage(const std::vector<BoardSighting>& waved,
+                    const std::vector<mocap::calibration::CameraFile>& files) {
+  std::vector<mocap::volume::CoverageCamera> cameras;
+  for (const auto& file : files) {
+    cameras.push_back({file.name, {file.model->width(), file.model->height()}});
+  }
+  mocap::volume::CalibrationCoverage coverage(cameras);
+  for (const BoardSighting& sighting : waved) coverage.add(sighting);
+  for (size_t c = 0; c < coverage.camera_count(); ++c) {
+    const auto& camera = coverage.camera(c);
+    fmt::print("waved coverage: {} {}{}{}\n", camera.name,
+               mocap::volume::progress_bar(camera.progress),
+               camera.missing.empty() ? "" : ": missing ", fmt::join(camera.missing, ", "));
+  }
 }
 
 // BAG or BAG:X,Y. A path whose last ':' is not followed by a mark is all path.
@@ -153,6 +158,7 @@ int run(const Arguments& arguments) {
     return 2;
   }
   const auto waved = read_sightings(arguments.waved, names, *board);
+  print_coverage(waved, files);
   std::vector<mocap::volume::FloorPlacement> floor;
   for (const FloorBag& bag : arguments.floor) {
     floor.push_back({bag.mark, read_sightings(bag.path, names, *board)});

@@ -51,6 +51,12 @@ inline constexpr const char* kDiagnostics = "/diagnostics";       // diagnostic_
 inline constexpr const char* kClockProbe = "/mocap/clock/probe";  // mocap_msgs/ClockProbe
 inline constexpr const char* kClockReply = "/mocap/clock/reply";  // mocap_msgs/ClockProbeReply
 
+// Volume calibration.
+inline constexpr const char* kVolumeConstellations =
+    "/volume/{camera}/constellations";  // mocap_msgs/ConstellationArray
+inline constexpr const char* kCalibrationCoverage =
+    "/calibration/coverage";  // mocap_msgs/CalibrationCoverage
+
 // PixArt localization.
 inline constexpr const char* kPixartRaw = "/pixart/raw";  // mocap_msgs/PixartRawPointArray
 inline constexpr const char* kPixartFiducials = "/pixart/{camera}/fiducials";  // FiducialArray

@@ -43,8 +43,12 @@ export function layout(channels) {
       ? `${pattern(cameras)} with their fiducials`
       : "none: the cameras send no images";
   }
-  // A volume alone: the single camera's panels (its image, its top view, the floor) stay empty.
-  $("camera-section").hidden = volume;
+  // A calibration session: each camera's coverage as the board is waved.
+  const calibrating = types.has(TYPES.coverage);
+  $("coverage-section").hidden = !calibrating;
+  // A volume alone, or a calibration session: the single camera's panels (its image, its top
+  // view, the floor) stay empty.
+  $("camera-section").hidden = volume || (calibrating && !cameras.length);
   $("side-section").hidden = volume && !types.has(TYPES.robots) && !types.has(TYPES.footprints);
   const alertTopics = advertised.filter((c) => c.schemaName === TYPES.alert).map((c) => c.topic);
   $("alerts-topic").textContent = alertTopics.sort().join(", ");
@@ -102,6 +106,33 @@ export function health() {
       <td>${escape(r.message)}</td><td>${r.latency ? `${escape(r.latency.key.slice(11, -12))}: ${escape(r.latency.value)} ms` : ""}</td>
       <td>${escape(r.host)}</td></tr>`).join("")
     : `<tr><td colspan="5" class="note">no /diagnostics in this graph</td></tr>`;
+}
+
+// Each camera of the calibration session: its image's nine regions filled in as the board is
+// seen there (the count in each, full at what a region needs), a progress bar, the shots it
+// shares with another camera and what is still missing.
+export function coverage() {
+  const message = graph.coverage;
+  if (!message) return;
+  report.coverageCameras = message.cameras.length;
+  report.coverageProgress = message.progress;
+  report.coverageViews = message.cameras.reduce((sum, c) => sum + c.views.reduce((a, b) => a + b, 0), 0);
+  report.coverageMissing = Object.fromEntries(message.cameras.map((c) => [c.name, c.missing]));
+  $("coverage").innerHTML = message.cameras.map((camera) => {
+    const percent = Math.floor(100 * camera.progress);
+    const cells = Array.from(camera.views, (views) => {
+      const filled = Math.min(1, views / Math.max(1, camera.views_needed));
+      return `<div class="${filled >= 1 ? "full" : ""}" style="--filled: ${filled.toFixed(2)}">${views}</div>`;
+    }).join("");
+    const missing = camera.missing.length ? `missing: ${camera.missing.map(escape).join(", ")}` : "complete";
+    return `<figure class="${percent >= 100 ? "complete" : ""}">
+      <figcaption><b>${escape(camera.name)}</b> ${percent} %</figcaption>
+      <div class="regions" style="aspect-ratio: ${camera.image_width} / ${camera.image_height}">${cells}</div>
+      <div class="bar"><div style="width: ${percent}%"></div></div>
+      <p>${camera.shared_shots} shots with another camera (${camera.shared_shots_needed} needed); ${missing}</p>
+    </figure>`;
+  }).join("");
+  $("coverage-note").textContent = `the session: ${Math.floor(100 * message.progress)} % (its least covered camera)`;
 }
 
 export function turret() {

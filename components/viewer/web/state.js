@@ -69,10 +69,16 @@ export const report = {
   view3dFollowing: "",
   // Where the last frame put each camera and body: name -> [x, y], CSS pixels in the canvas.
   view3dScreen: { cameras: {}, bodies: {} },
+  // The calibration coverage shown (/calibration/coverage): cameras, the session's progress
+  // (0 to 1), sightings counted over every camera's regions, each camera's missing regions.
+  coverageCameras: 0,
+  coverageProgress: null,
+  coverageViews: 0,
+  coverageMissing: {},
 };
 
 // The panels with news since the last animation frame.
-export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false, health: false, view3d: false };
+export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false, health: false, view3d: false, coverage: false };
 
 export const graph = {
   cameras: new Map(),  // image topic -> {name, image, frameStamp, dirty}, in topic order
@@ -97,6 +103,7 @@ export const graph = {
   turret: null,  // {pan, tilt} in radians
   alerts: [],  // the newest first
   health: new Map(),  // /diagnostics status name -> {status, receivedAt (page clock, ms)}
+  coverage: null,  // the latest calibration coverage (volume_calibration_coverage)
   topics: new Map(),  // every advertised topic -> {type, count, bytes, rate, bandwidth}
 };
 
@@ -305,6 +312,10 @@ const handlers = {
   [TYPES.diagnostics](message) {
     for (const status of message.status) graph.health.set(status.name, { status, receivedAt: Date.now() });
     dirty.health = true;
+  },
+  [TYPES.coverage](message) {
+    graph.coverage = message;
+    dirty.coverage = true;
   },
   [TYPES.alert](alert) {
     graph.alerts.unshift(alert);

@@ -20,6 +20,7 @@ export const TYPES = {
   alert: "mocap_msgs/msg/Alert",
   markers: "sensor_msgs/msg/PointCloud2",
   diagnostics: "diagnostic_msgs/msg/DiagnosticArray",
+  coverage: "mocap_msgs/msg/CalibrationCoverage",
 };
 
 const namespace = (topic) => topic.slice(0, topic.lastIndexOf("/"));

@@ -67,6 +67,7 @@ function frame() {
   if (dirty.poses) panels.poses();
   if (dirty.alerts) panels.alerts();
   if (dirty.health) panels.health();
+  if (dirty.coverage) panels.coverage();
   for (const panel of Object.keys(dirty)) dirty[panel] = false;
   requestAnimationFrame(frame);
 }
