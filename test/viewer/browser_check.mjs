@@ -131,7 +131,8 @@ async function view3d(page, count, errors) {
     /cameras\s*\d/.test(boxText) && /px rms/.test(boxText),
     `a click on ${clicked?.view3dSelected} shows its figures: ${boxText.replace(/\s+/g, " ").trim()}`);
   await page.waitForTimeout(500);
-  await page.locator("#view3d-section").screenshot({ path: screenshot });
+  // A page on busy cores can take long to settle for its picture.
+  await page.locator("#view3d-section").screenshot({ path: screenshot, timeout: 90000 });
   console.log(`screenshot ${screenshot}`);
   if (clicked) {
     const s = await state(page);
