@@ -122,7 +122,6 @@ Recording read_bag(const std::string& path, const ExportOptions& options) {
     if (is_poses) {
       const int64_t stamp = to_nanoseconds(array.header().stamp());
       recording.frames.push_back(stamp);
-      recording.bodies.add_frame(stamp);
       for (const auto& pose : array.poses()) {
         recording.bodies.add(pose.name(), stamp, to_isometry(pose.pose().pose()));
       }
@@ -221,14 +220,14 @@ int write_csv_file(const std::string& path, const ExportOptions& options,
   const std::filesystem::path file =
       options.output.value_or(std::filesystem::path(path).filename().string() + ".csv");
   std::ofstream out(file, std::ios::binary);
-  motion_export::write_motive_csv(out, std::filesystem::path(path).filename().string(),
-                                  recording.frames, recording.bodies, bodies, recording.markers);
+  const size_t rows = motion_export::write_motive_csv(
+      out, std::filesystem::path(path).filename().string(), recording.frames, recording.bodies,
+      bodies, recording.markers);
   if (!out.flush()) {
     fmt::print(stderr, "mocap_bag: cannot write {}\n", file.string());
     return 1;
   }
-  fmt::print("{}: {} frames, {} bodies, {} markers\n", file.string(),
-             motion_export::make_point_table(recording.frames).frames.size(), bodies.size(),
+  fmt::print("{}: {} frames, {} bodies, {} markers\n", file.string(), rows, bodies.size(),
              recording.markers.markers().size());
   return 0;
 }

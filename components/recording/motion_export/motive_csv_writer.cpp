@@ -56,9 +56,9 @@ void cell(std::string& row, double value) {
 
 }  // namespace
 
-void write_motive_csv(std::ostream& out, const std::string& take_name,
-                      const std::vector<int64_t>& frames, const BodyTrajectories& trajectories,
-                      const std::vector<std::string>& bodies, const MarkerTrajectories& markers) {
+size_t write_motive_csv(std::ostream& out, const std::string& take_name,
+                        const std::vector<int64_t>& frames, const BodyTrajectories& trajectories,
+                        const std::vector<std::string>& bodies, const MarkerTrajectories& markers) {
   PointTable table = make_point_table(frames);
   add_marker_points(table, markers);
   const size_t count = table.frames.size();
@@ -122,6 +122,7 @@ void write_motive_csv(std::ostream& out, const std::string& take_name,
     row += "\r\n";
     out << row;
   }
+  return count;
 }
 
 }  // namespace mocap::motion_export

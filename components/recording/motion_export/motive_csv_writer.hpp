@@ -21,9 +21,9 @@ namespace mocap::motion_export {
 // A row for each of `frames` (capture stamps, any order, each written once), at its time since
 // the first; `bodies` (keys of trajectories.bodies()) then every marker of `markers`. `take_name`
 // goes in the take information; its capture start time is the first frame's, local time, as
-// Motive writes it.
-void write_motive_csv(std::ostream& out, const std::string& take_name,
-                      const std::vector<int64_t>& frames, const BodyTrajectories& trajectories,
-                      const std::vector<std::string>& bodies, const MarkerTrajectories& markers);
+// Motive writes it. Returns the rows written: the frames, each once.
+size_t write_motive_csv(std::ostream& out, const std::string& take_name,
+                        const std::vector<int64_t>& frames, const BodyTrajectories& trajectories,
+                        const std::vector<std::string>& bodies, const MarkerTrajectories& markers);
 
 }  // namespace mocap::motion_export
