@@ -81,6 +81,7 @@ poses:
 data_received:
   sec: 0
   nanosec: 0
+cameras_late: 0
 )");
 }
 

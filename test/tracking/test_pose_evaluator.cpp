@@ -72,6 +72,28 @@ TEST(PoseEvaluator, CountsMissesFalseIdentificationsAndLostFrames) {
   EXPECT_EQ(evaluator.take_window().frames, 0u);
 }
 
+// Frames made without a late camera's data are counted apart, in either arrival order, so that
+// what the tracking does with complete frames can be told from what a busy machine cost it.
+TEST(PoseEvaluator, CountsFramesShortOfACameraApart) {
+  PoseEvaluator evaluator;
+  evaluator.add_truth(1, {at("a", 0, 2), at("b", 1, 2)});
+  evaluator.add_estimate(1, {at("a", 0, 2), at("b", 1, 2)});
+  evaluator.add_estimate(2, {at("a", 0, 2)}, /*incomplete=*/true);  // before its truth
+  evaluator.add_truth(2, {at("a", 0, 2), at("b", 1, 2)});
+  evaluator.add_truth(3, {at("a", 0, 2), at("b", 1, 2)});
+  evaluator.add_estimate(3, {at("b", 1, 2)});
+  const EvaluationSummary& total = evaluator.total();
+  EXPECT_EQ(total.frames, 3u);
+  EXPECT_EQ(total.expected, 6u);
+  EXPECT_EQ(total.tracked, 4u);
+  EXPECT_EQ(total.incomplete_frames, 1u);
+  EXPECT_EQ(total.expected_in_incomplete, 2u);
+  EXPECT_EQ(total.tracked_in_incomplete, 1u);
+  EXPECT_NEAR(total.tracked_percent(), 100.0 * 4 / 6, 1e-12);
+  EXPECT_NEAR(total.tracked_percent_in_complete_frames(), 100.0 * 3 / 4, 1e-12);
+  EXPECT_EQ(evaluator.take_window().incomplete_frames, 1u);
+}
+
 TEST(Overlay, DrawsFiducialsLinesAndAxes) {
   calibration::PinholeIntrinsics k;
   k.fx = k.fy = 500;

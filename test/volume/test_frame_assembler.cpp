@@ -56,7 +56,7 @@ TEST(FrameAssembler, GathersOneFramePerCaptureTimeInOrder) {
 // A camera later than the wait: the frame goes without it, and its message, when it comes, is
 // dropped and counted; a newer frame does not overtake an older one still waiting.
 TEST(FrameAssembler, ALateCameraIsNotWaitedForBeyondTheWait) {
-  Frames frames(3);
+  Frames frames(3, {.wait = milliseconds(5)});
   Clock::time_point t0{};
   for (int camera = 0; camera < 3; ++camera) frames.add(camera, 0, camera, t0);  // heard once
   ASSERT_EQ(frames.take_ready(t0).size(), 1u);
@@ -80,9 +80,7 @@ TEST(FrameAssembler, ALateCameraIsNotWaitedForBeyondTheWait) {
 // A camera that stops: once silent, frames no longer wait for it and say it is out; its next
 // message takes it back.
 TEST(FrameAssembler, ASilentCameraIsLeftOutUntilItComesBack) {
-  FrameAssemblerOptions options;
-  options.silent_after = milliseconds(100);
-  Frames frames(2, options);
+  Frames frames(2, {.wait = milliseconds(5), .silent_after = milliseconds(100)});
   Clock::time_point now{};
   int64_t stamp = 0;
   auto frame_of = [&](bool with_camera_1) {
@@ -119,12 +117,12 @@ TEST(FrameAssembler, ASilentCameraIsLeftOutUntilItComesBack) {
   EXPECT_EQ(count_messages(back[0]), 2);
 }
 
-// At 240 Hz a frame lasts 4.2 ms: once the capture times show the rate, a frame waits a third of
-// it for a late camera (1.39 ms), not the 5 ms the options allow at most; with the share 0, the
-// whole 5 ms.
+// At 240 Hz a frame lasts 4.2 ms: once the capture times show the rate, a frame waits at most
+// that long for a late camera, not the 30 ms the options allow at most; a third of it with the
+// share 1/3; with the share 0, the whole 30 ms.
 TEST(FrameAssembler, TheWaitIsSizedToTheFrameRate) {
   constexpr int64_t kFrameNs = 4'166'667;  // 240 Hz
-  for (double share : {1.0 / 3.0, 0.0}) {
+  for (double share : {FrameAssemblerOptions{}.wait_share_of_frame, 1.0 / 3.0, 0.0}) {
     SCOPED_TRACE(share);
     Frames frames(2, {.wait_share_of_frame = share});
     Clock::time_point now{};
@@ -137,7 +135,9 @@ TEST(FrameAssembler, TheWaitIsSizedToTheFrameRate) {
       ASSERT_EQ(frames.take_ready(now).size(), 1u);
     }
     EXPECT_EQ(frames.frame_period().count(), kFrameNs);
-    const auto expected_wait = share > 0 ? std::chrono::nanoseconds(kFrameNs / 3) : milliseconds(5);
+    const auto expected_wait = share > 0 ? std::chrono::round<std::chrono::nanoseconds>(
+                                               std::chrono::nanoseconds(kFrameNs) * share)
+                                         : milliseconds(30);
     EXPECT_EQ(frames.wait(), expected_wait);
     // Camera 1 late: the frame goes without it once the wait has run out, not before.
     stamp += kFrameNs;

@@ -21,6 +21,9 @@ void merge(EvaluationSummary& into, const EvaluationSummary& from) {
   into.frames_lost += from.frames_lost;
   into.expected += from.expected;
   into.tracked += from.tracked;
+  into.incomplete_frames += from.incomplete_frames;
+  into.expected_in_incomplete += from.expected_in_incomplete;
+  into.tracked_in_incomplete += from.tracked_in_incomplete;
   into.false_identifications += from.false_identifications;
   into.identity_swaps += from.identity_swaps;
   into.objects = std::max(into.objects, from.objects);
@@ -69,6 +72,13 @@ double EvaluationSummary::tracked_percent() const {
   return expected == 0 ? std::numeric_limits<double>::quiet_NaN() : 100.0 * tracked / expected;
 }
 
+double EvaluationSummary::tracked_percent_in_complete_frames() const {
+  const uint64_t complete_expected = expected - expected_in_incomplete;
+  return complete_expected == 0 ? std::numeric_limits<double>::quiet_NaN()
+                                : 100.0 * static_cast<double>(tracked - tracked_in_incomplete) /
+                                      static_cast<double>(complete_expected);
+}
+
 double EvaluationSummary::quantile(std::vector<double> values, double q) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   size_t index = std::min(values.size() - 1, static_cast<size_t>(q * values.size()));
@@ -86,18 +96,20 @@ void PoseEvaluator::add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects)
   expire();
 }
 
-void PoseEvaluator::add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects) {
+void PoseEvaluator::add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects,
+                                 bool incomplete) {
+  Estimate estimate{std::move(objects), incomplete};
   if (auto truth = pending_truth_.find(stamp_ns); truth != pending_truth_.end()) {
-    evaluate(stamp_ns, truth->second, objects);
+    evaluate(stamp_ns, truth->second, estimate);
     pending_truth_.erase(truth);
     return;
   }
-  pending_estimates_[stamp_ns] = std::move(objects);
+  pending_estimates_[stamp_ns] = std::move(estimate);
   expire();
 }
 
 void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& truth,
-                             const std::vector<ObjectPose>& estimates) {
+                             const Estimate& estimate) {
   EvaluationSummary frame;
   auto count_false = [&](const std::string& name, double position, double orientation) {
     ++frame.false_identifications;
@@ -108,7 +120,7 @@ void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& tr
   for (const ObjectPose& t : truth) {
     if (t.visible_markers >= options_.min_visible_markers) ++frame.expected;
   }
-  for (const ObjectPose& e : estimates) {
+  for (const ObjectPose& e : estimate.objects) {
     auto t = std::find_if(truth.begin(), truth.end(),
                           [&](const ObjectPose& o) { return o.name == e.name; });
     if (t == truth.end()) {
@@ -140,6 +152,11 @@ void PoseEvaluator::evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& tr
       frame.angular_velocity_errors_dps.push_back(
           (*e.angular_velocity - *t->angular_velocity).norm() * 180 / M_PI);
     }
+  }
+  if (estimate.incomplete) {
+    frame.incomplete_frames = 1;
+    frame.expected_in_incomplete = frame.expected;
+    frame.tracked_in_incomplete = frame.tracked;
   }
   merge(total_, frame);
   merge(window_, frame);

@@ -55,6 +55,13 @@ struct EvaluationSummary {
   uint64_t frames_lost = 0;  // truth frames no estimate array arrived for
   uint64_t expected = 0;     // trackable objects in those frames
   uint64_t tracked = 0;      // of them, estimated within the false-identification bounds
+  // Frames whose estimate was made without the data of a camera that should have given it (late
+  // past the fusion's wait, or lost on the way): on a busy machine, a scheduler's doing rather
+  // than the tracker's. Their trackable objects and how many of them were tracked, also counted
+  // in `expected` and `tracked`.
+  uint64_t incomplete_frames = 0;
+  uint64_t expected_in_incomplete = 0;
+  uint64_t tracked_in_incomplete = 0;
   uint64_t false_identifications = 0;
   std::vector<FalseIdentification> false_identification_details;  // one per count above
   // Estimates nearer another object's true position than their own: one object reported as
@@ -67,6 +74,8 @@ struct EvaluationSummary {
   std::vector<double> velocity_errors_mps, angular_velocity_errors_dps;
 
   double tracked_percent() const;
+  // Over the frames made with every camera's data: what the tracking does with what it is given.
+  double tracked_percent_in_complete_frames() const;
   // Quantile q in [0, 1] of a list (NaN when empty).
   static double quantile(std::vector<double> values, double q);
 };
@@ -77,20 +86,24 @@ class PoseEvaluator {
   explicit PoseEvaluator(EvaluationOptions options = {});
 
   void add_truth(int64_t stamp_ns, std::vector<ObjectPose> objects);
-  void add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects);
+  // `incomplete`: made without the data of a camera that should have given it.
+  void add_estimate(int64_t stamp_ns, std::vector<ObjectPose> objects, bool incomplete = false);
 
   const EvaluationSummary& total() const { return total_; }
   // What was evaluated since the last call.
   EvaluationSummary take_window();
 
  private:
-  void evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& truth,
-                const std::vector<ObjectPose>& estimates);
+  struct Estimate {
+    std::vector<ObjectPose> objects;
+    bool incomplete = false;
+  };
+  void evaluate(int64_t stamp_ns, const std::vector<ObjectPose>& truth, const Estimate& estimate);
   void expire();
 
   EvaluationOptions options_;
   std::map<int64_t, std::vector<ObjectPose>> pending_truth_;
-  std::map<int64_t, std::vector<ObjectPose>> pending_estimates_;
+  std::map<int64_t, Estimate> pending_estimates_;
   EvaluationSummary total_;
   EvaluationSummary window_;
 };

@@ -118,7 +118,8 @@ class PoseEvaluatorComponent final : public Component {
           const auto latency = now() - from_time_msg(poses.header().stamp());
           latencies_s_.push_back(std::chrono::duration<double>(latency).count());
           latency_.add(latency);
-          evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses, false));
+          evaluator_.add_estimate(to_nanoseconds(poses.header().stamp()), objects(poses, false),
+                                  poses.cameras_late() > 0);
           check_done();
         });
     create_timer(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -203,21 +204,24 @@ class PoseEvaluatorComponent final : public Component {
     log().info(
         "| frames | lost | tracked | position mm (median, p95) | orientation deg "
         "(median, p95) | velocity error cm/s, deg/s (median) | false ids | latency ms (median, "
-        "p99) | robots | identity swaps |");
+        "p99) | robots | identity swaps | frames short of a camera | tracked in the others |");
     log().info(
         "| {} | {} | {:.2f} % | {:.3f}, {:.3f} | {:.3f}, {:.3f} | {:.2f}, {:.2f} | {} | {:.2f}, "
-        "{:.2f} | {} | {} |",
+        "{:.2f} | {} | {} | {} | {:.2f} % |",
         total.frames, total.frames_lost, total.tracked_percent(),
         q(total.position_errors_m, 0.5) * 1e3, q(total.position_errors_m, 0.95) * 1e3,
         q(total.orientation_errors_deg, 0.5), q(total.orientation_errors_deg, 0.95),
         q(total.velocity_errors_mps, 0.5) * 100, q(total.angular_velocity_errors_dps, 0.5),
         total.false_identifications, q(all_latencies_s_, 0.5) * 1e3,
-        q(all_latencies_s_, 0.99) * 1e3, total.objects, total.identity_swaps);
+        q(all_latencies_s_, 0.99) * 1e3, total.objects, total.identity_swaps,
+        total.incomplete_frames, total.tracked_percent_in_complete_frames());
     if (settings_.summary_file.empty()) return;
     std::ofstream out(settings_.summary_file);
     out << "frames: " << total.frames << "\nframes_lost: " << total.frames_lost
         << "\nrobots: " << total.objects << "\nexpected: " << total.expected
-        << "\ntracked: " << total.tracked
+        << "\ntracked: " << total.tracked << "\nincomplete_frames: " << total.incomplete_frames
+        << "\nexpected_in_incomplete: " << total.expected_in_incomplete
+        << "\ntracked_in_incomplete: " << total.tracked_in_incomplete
         << "\nfalse_identifications: " << total.false_identifications
         << "\nidentity_swaps: " << total.identity_swaps
         << "\nposition_error_median_m: " << q(total.position_errors_m, 0.5)

@@ -29,12 +29,17 @@ struct FrameAssemblerOptions {
   // together still stamp a little apart).
   std::chrono::nanoseconds same_capture{std::chrono::milliseconds(2)};
   // How long a frame waits for its late cameras after its first message arrived, at most.
-  std::chrono::nanoseconds wait{std::chrono::milliseconds(5)};
-  // The wait as a share of the frame period, when that is shorter than `wait`: at 240 Hz a frame
-  // lasts 4.2 ms, and a frame still waiting when the next is captured delays every frame behind
-  // it. The period is the median interval between the last capture times handed out (robust to
-  // a dropped frame). 0: `wait` alone.
-  double wait_share_of_frame = 1.0 / 3.0;
+  std::chrono::nanoseconds wait{std::chrono::milliseconds(30)};
+  // The wait as a share of the frame period, when that is shorter than `wait`: a frame still
+  // waiting when the next is captured delays every frame behind it. The period is the median
+  // interval between the last capture times handed out (robust to a dropped frame). 0: `wait`
+  // alone. A whole period, because cameras that capture together and share a host's cores are
+  // processed in turn: four cameras on two cores give their messages up to two processing times
+  // apart, and more on a busy host. A third of the period (5 ms at most) left 3 % of the
+  // frames without a camera in 20 s beside a compiler, and a body missed in one frame can take
+  // several to find again. A complete frame still goes out as its last message arrives: only a
+  // frame short of a camera waits longer.
+  double wait_share_of_frame = 1.0;
   // A camera with no message for this long is left out of the frames that follow.
   std::chrono::nanoseconds silent_after{std::chrono::milliseconds(500)};
 

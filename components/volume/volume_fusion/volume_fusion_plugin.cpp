@@ -4,11 +4,11 @@
 // Each camera's fiducials come on its own topic (/volume/{camera}/fiducials, the name in its
 // camera file), stamped at capture. The messages of one capture time are gathered
 // (frame_assembler.hpp): a frame is fused when every live camera has given its message, or
-// a third of the frame period (as the capture times show it) after its first one, `wait_s` at
-// most. A camera silent for `silent_after_s` is left out and reported
-// on /alerts, and taken back, also reported, at its next message; so is a camera found drifted
-// (its extrinsics moved: its residuals against the others' poses), and a body seen by one
-// camera only (its pose then rests on that camera alone).
+// a frame period (as the capture times show it) after its first one, `wait_s` (30 ms) at most. A
+// camera silent for `silent_after_s` is left out and reported on /alerts, and taken back, also
+// reported, at its next message; so is a camera found drifted (its extrinsics moved: its residuals
+// against the others' poses), and a body seen by one camera only (its pose then rests on that
+// camera alone).
 //
 // Every fused frame's markers in 3D (the marker cloud: marker_cloud.hpp) go out on
 // /mocap/markers as a PointCloud2 (marker_cloud_message.hpp), each labeled with the body or
@@ -110,7 +110,7 @@ struct Settings : VolumeTrackerOptions {
   MarkerCloudOptions cloud;
   SwarmTrackerOptions swarm;
   double same_capture_s = 0.002;
-  double wait_s = 0.005;
+  double wait_s = 0.03;
   double silent_after_s = 0.5;
   double behind_max_gap_s = 0.02;
   bool check_clocks = true;
@@ -195,8 +195,8 @@ const ParameterList<Settings> kParameters =
         .add("same_capture_s", "stamps this close are one capture time", &Settings::same_capture_s)
         .range(0, 1)
         .add("wait_s",
-             "how long a frame waits for late cameras after its first message, at most: a "
-             "third of the frame period when that is shorter",
+             "how long a frame waits for late cameras after its first message, at most: the "
+             "frame period when that is shorter",
              &Settings::wait_s)
         .range(0, 1)
         .add("silent_after_s", "a camera silent this long is left out until it returns",
@@ -675,6 +675,11 @@ class VolumeFusion final : public Component {
         to_time_msg(Clock::time_point(std::chrono::nanoseconds(assembled.stamp_ns))));
     message->header().frame_id("world");
     message->data_received(to_time_msg(assembled_at));
+    uint32_t late = 0;
+    for (size_t c = 0; c < assembled.messages.size(); ++c) {
+      late += !assembled.silent[c] && !assembled.messages[c];
+    }
+    message->cameras_late(late);
     for (const TrackedBodyPose& body : poses) {
       mocap_msgs::msg::ConstellationPose pose =
           pose_message(message->header(), body.name, body.world_from_body, body.covariance);
