@@ -36,6 +36,9 @@ std::string read_file(const std::filesystem::path& path);
 // The DDS implementation the tests run on: MOCAP_DDS_IMPLEMENTATION, else "fastdds".
 std::string dds_implementation();
 
+// A TCP port on 127.0.0.1 nobody listens on right now.
+int free_port();
+
 // The DDS domain of a test: each test that talks DDS passes its own `slot` (0..99), so tests
 // running at the same time never see each other's topics. Domains 100..199 under Fast DDS,
 // 0..99 under Cyclone DDS (MOCAP_DDS_IMPLEMENTATION), so the two runs of a test do not meet.

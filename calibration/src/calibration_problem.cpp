@@ -237,6 +237,27 @@ void bound_intrinsics(ceres::Problem& problem, double* block, const CameraSpec& 
   }
 }
 
+// Ceres's iterations as SolveIteration. The cost is half the sum of squared pixel errors, two
+// per point.
+class IterationReporter final : public ceres::IterationCallback {
+ public:
+  IterationReporter(std::function<bool(const SolveIteration&)> report, size_t points)
+      : report_(std::move(report)), points_(std::max<size_t>(points, 1)) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    const double before = summary.cost + summary.cost_change;
+    const bool go_on =
+        report_({.iteration = summary.iteration,
+                 .rms_px = std::sqrt(2 * summary.cost / static_cast<double>(points_)),
+                 .relative_decrease = before > 0 ? summary.cost_change / before : 0});
+    return go_on ? ceres::SOLVER_CONTINUE : ceres::SOLVER_ABORT;
+  }
+
+ private:
+  std::function<bool(const SolveIteration&)> report_;
+  size_t points_;
+};
+
 }  // namespace
 
 struct CalibrationProblem::State {
@@ -505,6 +526,10 @@ CalibrationReport CalibrationProblem::solve() {
   options.function_tolerance = 1e-10;
   options.gradient_tolerance = 1e-12;
   options.parameter_tolerance = 1e-10;
+  size_t points = 0;
+  for (const State::ShotResiduals& shot : s.shot_residuals) points += shot.points.size();
+  IterationReporter reporter(s.options.on_iteration, points);
+  if (s.options.on_iteration) options.callbacks.push_back(&reporter);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &s.problem, &summary);
   report.converged = summary.termination_type == ceres::CONVERGENCE;

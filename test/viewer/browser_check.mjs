@@ -22,13 +22,18 @@
 // a screenshot of the 3D panel, and the page without WebGL. With
 // --view3d-tf COUNT (a volume whose bridge offers /tf but not /mocap/poses, as a ROS 2 graph's
 // would), the 3D view's cameras and COUNT bodies drawn from /tf. With --coverage COUNT (a
-// calibration session), COUNT cameras' coverage with their regions and bars, growing.
+// calibration session), COUNT cameras' coverage with their regions and bars, growing. With
+// --calibration-result COUNT (a calibration's solve), its report of COUNT cameras: the cameras'
+// and the floor's tables, the picture from above, and one line per figure as the page shows it,
+// "PAGE " and the line mocap_volume_calibrate prints (without its camera file), for the test to
+// compare with the tool's report; the screenshot holds the coverage and the solve.
 // HTTPS certificates are not checked (the TLS test's is self-signed). One line per check; exit 0
 // when all passed.
 //
 //   node browser_check.mjs URL SCREENSHOT [--outage FLAG_FILE | --floor | --refused | --tf |
 //                                          --volume [SCREENSHOT_3D] | --swarm COUNT |
-//                                          --view3d COUNT | --view3d-tf COUNT | --coverage COUNT]
+//                                          --view3d COUNT | --view3d-tf COUNT | --coverage COUNT |
+//                                          --calibration-result COUNT]
 import { chromium } from "playwright-core";
 import { existsSync } from "node:fs";
 
@@ -163,6 +168,65 @@ async function view3d(page, count, errors) {
   }
 }
 
+// The text of each row's cells of the table `id`.
+const tableCells = (page, id) => page.locator(`#${id} tbody tr`).evaluateAll((rows) =>
+  rows.map((row) => [...row.cells].map((cell) => cell.textContent.trim())));
+
+// The --calibration-result checks, on a page showing a calibration's solve of `count` cameras.
+// Its report's lines are made of what the page shows (the summary, the tables' cells) in the
+// words of calibration_session.cpp's report_lines().
+async function calibrationResult(page, count, errors) {
+  // Recording the sessions and solving them take a while (the page may open before the solve).
+  const seen = await snapshot(page, new Function("s", `return s?.resultCameras.length >= ${count} && ` +
+    `s.calibrationPictureDrawn >= ${count};`), 180000);
+  // The report comes out before the solve says it is done.
+  const done = await snapshot(page, (s) => s.solveStage === "done", 10000).catch(() => state(page));
+  check(done.solveStage === "done" && done.solveProgress === 1, `the solve: ${done.solveStage} ` +
+    `${(100 * done.solveProgress).toFixed(0)} %: ${done.solveDetail}`);
+  const cameras = await tableCells(page, "result-cameras");
+  const floor = await tableCells(page, "result-floor");
+  check(cameras.length === count && floor.length === seen.resultFloor.length && floor.length > 0,
+    `the report: ${cameras.length} camera rows, ${floor.length} floor rows`);
+  check(seen.calibrationPictureDrawn === count, `the picture from above: ${seen.calibrationPictureDrawn} cameras drawn`);
+
+  const summaryText = await page.textContent("#result-summary");
+  const summary = summaryText.match(/^(\d+) capture times, RMS (\S+) px over (\d+) points, (\d+) iterations$/);
+  check(summary !== null, `the summary: ${summaryText}`);
+  if (summary) {
+    const [, frames, rms, points, iterations] = summary;
+    console.log(`PAGE waved: ${frames} capture times; RMS ${rms} px over ${points} points (${iterations} iterations)`);
+  }
+  for (const [mark, seenBy, rms, offMark] of floor) {
+    const off = offMark ? `; ${offMark} mm from its mark` : "";
+    console.log(`PAGE floor at ${mark}: the board seen by ${seenBy} cameras, RMS ${rms} px${off}`);
+  }
+  for (const [name, rms, , x, y, z, moved, turned] of cameras) {
+    const against = moved ? `; ${moved} mm and ${turned} deg from the input file's pose` : "";
+    console.log(`PAGE ${name}: at (${x}, ${y}, ${z}) m${against}, RMS ${rms} px`);
+  }
+  check(cameras.length === count && seen.calibrationPictureDrawn === count && summary !== null,
+    `calibration result: ${count} cameras`);
+
+  // The calibration's sections in one picture: the coverage (when shown) above the solve.
+  await page.waitForTimeout(500);
+  await page.evaluate(() => window.scrollTo(0, 0));
+  const boxes = [];
+  for (const id of ["#coverage-section", "#solve-section"]) {
+    if (await page.isVisible(id)) boxes.push(await page.locator(id).boundingBox());
+  }
+  const left = Math.min(...boxes.map((b) => b.x));
+  const top = Math.min(...boxes.map((b) => b.y));
+  const clip = {
+    x: left,
+    y: top,
+    width: Math.max(...boxes.map((b) => b.x + b.width)) - left,
+    height: Math.max(...boxes.map((b) => b.y + b.height)) - top,
+  };
+  await page.screenshot({ path: screenshot, fullPage: true, clip, timeout: 90000 });
+  console.log(`screenshot ${screenshot}`);
+  check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+}
+
 try {
   // The TLS test's certificate is self-signed.
   const page = await browser.newPage({ viewport: { width: 1600, height: 1000 }, ignoreHTTPSErrors: true });
@@ -238,6 +302,11 @@ try {
     check(await page.isHidden("#camera-section"), "the single camera's panel is hidden");
     await page.locator("#coverage-section").screenshot({ path: screenshot });
     check(errors.length === 0, `no page errors${errors.length ? ": " + errors.join("; ") : ""}`);
+    await browser.close();
+    process.exit(failed ? 1 : 0);
+  }
+  if (mode === "--calibration-result") {
+    await calibrationResult(page, Number(flagFile), errors);
     await browser.close();
     process.exit(failed ? 1 : 0);
   }

@@ -4,9 +4,6 @@
 // test/node_modules (`npm ci --prefix test`; scripts/test.sh runs it).
 #include <gtest/gtest.h>
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -36,19 +33,6 @@ using nlohmann::json;
 
 std::filesystem::path viewer_tests() { return test::source_dir() / "test" / "viewer"; }
 
-// A TCP port nobody listens on right now.
-int free_port() {
-  int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address));
-  socklen_t size = sizeof(address);
-  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
-  close(fd);
-  return ntohs(address.sin_port);
-}
-
 class FoxgloveBridgeTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -56,7 +40,7 @@ class FoxgloveBridgeTest : public ::testing::Test {
         << "run `npm ci --prefix test` (scripts/test.sh does)";
     auto [node_code, node_version] = test::run_command({"node", "--version"});
     ASSERT_EQ(node_code, 0) << "node is needed: " << node_version;
-    port_ = free_port();
+    port_ = test::free_port();
     start_graph();
   }
 
@@ -553,7 +537,7 @@ test::ChildProcess pixart_graph(const test::TempDir& dir, int port, int slot,
 // LED plane centred under it, and the built-in page draws them with the robots.
 TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
   test::TempDir dir;
-  const int port = free_port();
+  const int port = test::free_port();
   test::ChildProcess graph = pixart_graph(dir, port, 62, {});
   ASSERT_TRUE(graph.wait_for_output("Foxglove WebSocket server on", std::chrono::seconds(60)))
       << graph.output();
@@ -605,7 +589,7 @@ TEST(FoxgloveBridgePixart, LatchedFootprintsAndRobotsReachClientsAndThePage) {
 // folder (docs/viewer_volume.png and docs/viewer_3d_volume.png are made this way).
 TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
   test::TempDir dir;
-  const int port = free_port();
+  const int port = test::free_port();
   test::ChildProcess graph(
       {(test::bin_dir() / "mocap_launch").string(),
        (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string(), "--set",
@@ -639,7 +623,7 @@ TEST(FoxgloveBridgeVolume, ThePageShowsEveryCameraAndTheVolumeFromAbove) {
 // the page's 3D view draws the four cameras and the four boards from /tf alone.
 TEST(FoxgloveBridgeVolume, ThePageShowsTheVolumeIn3DFromTfAlone) {
   test::TempDir dir;
-  const int port = free_port();
+  const int port = test::free_port();
   test::ChildProcess graph(
       {(test::bin_dir() / "mocap_launch").string(),
        (test::source_dir() / "launch_yaml" / "volume_demo.yaml").string(), "--set",
@@ -674,7 +658,7 @@ TEST(FoxgloveBridgeVolume, ThePageShowsTheVolumeIn3DFromTfAlone) {
 // the extension (docs/viewer_swarm.png, docs/viewer_3d.png).
 TEST(FoxgloveBridgeVolume, ThePageDrawsASwarmFromAboveAndIn3D) {
   test::TempDir dir;
-  const int port = free_port();
+  const int port = test::free_port();
   std::vector<std::string> launch = {
       (test::bin_dir() / "mocap_launch").string(),
       (test::source_dir() / "launch_yaml" / "swarm_demo.yaml").string(),
@@ -729,7 +713,7 @@ TEST(FoxgloveBridgeVolume, ThePageDrawsASwarmFromAboveAndIn3D) {
 // MOCAP_VIEWER_SCREENSHOT with "_coverage" before the extension (docs/viewer_coverage.png).
 TEST(FoxgloveBridgeVolume, ThePageShowsTheCalibrationCoverageFillingIn) {
   test::TempDir dir;
-  const int port = free_port();
+  const int port = test::free_port();
   test::ChildProcess graph(
       {(test::bin_dir() / "mocap_launch").string(),
        (test::source_dir() / "launch_yaml" / "volume_calibration.yaml").string(), "--duration",
@@ -831,7 +815,7 @@ TEST(FoxgloveBridgeSecurity, TokenAndTlsLetInOnlyWhoShouldComeIn) {
        "-nodes", "-days", "2", "-subj", "/CN=localhost", "-addext", "subjectAltName=IP:127.0.0.1",
        "-keyout", key, "-out", certificate});
   ASSERT_EQ(made, 0) << openssl;
-  const int port = free_port();
+  const int port = test::free_port();
   test::ChildProcess graph =
       pixart_graph(dir, port, 72,
                    {"viewer.token=s3cret/+token", "viewer.certificate_file=" + certificate,
@@ -884,7 +868,7 @@ TEST(FoxgloveBridgeSecurity, OnlyTheBridgesOwnPageAndListedOriginsConnect) {
   test::TempDir dir;
   const std::map<std::string, std::string> environment = {
       {"MOCAP_DOMAIN_ID", std::to_string(test::test_domain(36))}};
-  const int port = free_port(), page_port = free_port();
+  const int port = test::free_port(), page_port = test::free_port();
   const std::string bridge = fmt::format("ws://127.0.0.1:{}/", port);
   const std::string other_page = fmt::format("http://127.0.0.1:{}", page_port);
   auto pages = [&] {

@@ -12,9 +12,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -43,13 +46,21 @@ struct Figures {
   double tracked_share() const {
     return node["tracked"].as<double>() / std::max(1.0, node["expected"].as<double>());
   }
+  // Frames fused without a live camera's data (late past the fusion's wait).
+  double incomplete_share() const {
+    return node["incomplete_frames"].as<double>() / std::max(1.0, node["frames"].as<double>());
+  }
   // Poses more than 5 cm or 5 degrees off: a wrong answer handed to a robot.
   int false_identifications() const { return node["false_identifications"].as<int>(); }
 };
 
+// Also holds the frames fused without a late camera's data to a tenth: more is a deployment that
+// does not keep up, or an assembly that waits too little.
 Figures read_figures(const std::filesystem::path& summary) {
   SCOPED_TRACE(test::read_file(summary));
-  return {YAML::LoadFile(summary.string())};
+  Figures figures{YAML::LoadFile(summary.string())};
+  EXPECT_LE(figures.incomplete_share(), 0.1) << test::read_file(summary);
+  return figures;
 }
 
 // 20 s of the demo: the four boards posed in the world within a millimetre (median) in nearly
@@ -421,15 +432,18 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
     EXPECT_NE(output.find(phase), std::string::npos) << phase << "\n" << output;
   }
   // The evaluator's row: | frames | lost | tracked % | position | orientation | velocity |
-  // false ids | latency |
+  // false ids | latency | robots | swaps | frames short of a camera | tracked in the others |
+  // (those short of a late camera bounded to a tenth, as read_figures does).
   std::smatch row;
   ASSERT_TRUE(std::regex_search(
       output, row,
-      std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) % \|[^|]*\|[^|]*\|[^|]*\| (\d+) \|)")))
+      std::regex(R"(measure: \| (\d+) \| (\d+) \| ([0-9.]+) % \|[^|]*\|[^|]*\|[^|]*\| (\d+) \|)"
+                 R"([^|]*\|[^|]*\|[^|]*\| (\d+) \| ([0-9.]+) % \|)")))
       << output;
   EXPECT_GT(std::stoi(row[1]), 400) << output;
   EXPECT_EQ(std::stoi(row[2]), 0) << output;
   EXPECT_GE(std::stod(row[3]), 99.0) << output;
+  EXPECT_LE(std::stod(row[5]), 0.1 * std::stod(row[1])) << output;
   EXPECT_EQ(std::stoi(row[4]), 0) << output;
 }
 
@@ -437,6 +451,8 @@ TEST(VolumeDemo, MultiHostFormSurvivesACrashAndALostLink) {
 // 30 s and laid on the floor at five marks, twice at each, for 2 s, recorded into bags and
 // solved; every camera within 0.5 mm and 0.01 degrees of where the simulator put it (the
 // issue's bound is 2 mm and 0.05 degrees), each board's centre within 0.3 mm of its mark. The
+// page shows the solve and its report, and mocap_volume_calibrate on the same recordings prints
+// the same figures as the script and the page (test/viewer/browser_check.mjs reads them). The
 // demo then runs on the files it wrote: poses within 0.15 mm (median; 0.03 mm on the true
 // cameras). Live, the wave's 30 s fall anywhere on its 120 s path, and how well they tie the
 // cameras together varies from run to run (0.07 mm measured once); the issue's 20 % is asserted
@@ -447,12 +463,28 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
   test::write_file(dir / "floor_plan.txt", "the lab's floor\n");
   std::filesystem::create_directories(dir / "floor_notes");
   test::write_file(dir / "floor_notes" / "marks.txt", "taped on Monday\n");
-  auto [code, output] = test::run_command(
+  const int port = test::free_port();
+  test::ChildProcess session(
       {(test::source_dir() / "scripts" / "calibrate_volume.sh").string(), dir.path().string(),
-       "--wave", "30", "--floor", "2", "--marks", "0,0 1,0 0,1 -1,0 0,-1", "--viewer-port", "0"},
-      environment(74), std::chrono::seconds(150));
-  ASSERT_EQ(code, 0) << output;
-  std::printf("%s", output.c_str());
+       "--wave", "30", "--floor", "2", "--marks", "0,0 1,0 0,1 -1,0 0,-1", "--viewer-port",
+       std::to_string(port), "--hold", "300"},
+      environment(74), dir / "session.log");
+  ASSERT_TRUE(session.wait_for_output("calibrate_volume: solving", std::chrono::seconds(150)))
+      << session.output();
+  // The page, from the solve's start: its progress, then the report; each figure printed as the
+  // tool prints it (PAGE lines).
+  std::filesystem::path screenshot = dir / "calibration.png";
+  if (const char* wanted = std::getenv("MOCAP_VIEWER_SCREENSHOT")) screenshot = wanted;
+  auto [page_code, page] = test::run_command(
+      {"node", (test::source_dir() / "test" / "viewer" / "browser_check.mjs").string(),
+       fmt::format("http://127.0.0.1:{}/", port), screenshot.string(), "--calibration-result", "4"},
+      {}, std::chrono::seconds(200));
+  session.signal(SIGTERM);  // ends the hold: the page has what it needs
+  ASSERT_EQ(session.wait(std::chrono::seconds(60)), 0) << session.output();
+  const std::string output = session.output();
+  std::printf("%s%s", output.c_str(), page.c_str());
+  EXPECT_EQ(page_code, 0) << page;
+  EXPECT_NE(page.find("PASS calibration result: 4 cameras"), std::string::npos) << page;
   // Each camera's coverage of the wave, as the coverage component saw it live and as the solver
   // reads it from the bag.
   for (const char* camera : {"cam_0", "cam_1", "cam_2", "cam_3"}) {
@@ -462,6 +494,9 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
     EXPECT_NE(output.find(fmt::format("waved coverage: {} [", camera)), std::string::npos)
         << output;
   }
+  EXPECT_NE(output.find("calibrate_volume: solve [====================] 100 % done"),
+            std::string::npos)
+      << output;
   const std::regex line(R"((cam_\d): at .* m; ([0-9.]+) mm and ([0-9.]+) deg from the input)");
   int cameras = 0;
   for (std::sregex_iterator it(output.begin(), output.end(), line), end; it != end; ++it) {
@@ -478,6 +513,56 @@ TEST(VolumeDemo, CalibratedFromARecordedSessionAndTrackedThroughIt) {
     EXPECT_LT(std::stod((*it)[2]), 0.3) << (*it)[0];
   }
   EXPECT_EQ(marks, 10) << output;  // each laid twice, the second time turned
+
+  // mocap_volume_calibrate on the same recordings: its report is the script's (the solve
+  // component's) and the page's, figure for figure.
+  std::vector<std::string> tool = {(test::bin_dir() / "mocap_volume_calibrate").string(), "--waved",
+                                   (dir / "waved").string()};
+  for (const char* at : {"0_0", "1_0", "0_1", "-1_0", "0_-1"}) {
+    std::string xy = at;
+    std::replace(xy.begin(), xy.end(), '_', ',');
+    for (const char* turned : {"", "_turned"}) {
+      tool.insert(tool.end(),
+                  {"--floor", (dir / fmt::format("floor_{}{}", at, turned)).string() + ":" + xy});
+    }
+  }
+  tool.insert(tool.end(), {"--output", (dir / "by_the_tool").string()});
+  for (int c = 0; c < 4; ++c) {
+    tool.push_back(
+        (test::source_dir() / "config" / "volume" / "cameras" / fmt::format("cam_{}.yaml", c))
+            .string());
+  }
+  auto [tool_code, printed] = test::run_command(tool, {}, std::chrono::seconds(120));
+  ASSERT_EQ(tool_code, 0) << printed;
+  std::istringstream lines(printed);
+  int compared = 0;
+  for (std::string tool_line; std::getline(lines, tool_line);) {
+    const bool camera = tool_line.starts_with("cam_"), floor = tool_line.starts_with("floor at");
+    if (!camera && !floor && !tool_line.starts_with("waved") &&
+        !tool_line.starts_with(dir.path().string())) {
+      continue;  // its progress lines
+    }
+    ++compared;
+    // The files written differ (the tool's into by_the_tool/): the rest is the script's line.
+    const std::string figures = tool_line.substr(0, tool_line.find(" -> "));
+    EXPECT_NE(output.find(figures), std::string::npos) << figures << "\n" << output;
+    if (camera || floor) {
+      EXPECT_NE(page.find("PAGE " + figures + "\n"), std::string::npos) << figures << "\n" << page;
+    }
+  }
+  // Each bag's sightings, the wave's coverage a camera, the solve, each placement, each camera.
+  EXPECT_EQ(compared, 11 + 4 + 1 + 10 + 4) << printed;
+  std::smatch solve;
+  ASSERT_TRUE(std::regex_search(printed, solve,
+                                std::regex(R"(waved: (\d+) capture times .*; RMS reprojection )"
+                                           R"(error ([0-9.]+) px over (\d+) points \((\d+) iter)")))
+      << printed;
+  EXPECT_NE(page.find(fmt::format("PAGE waved: {} capture times; RMS {} px over {} points ({} "
+                                  "iterations)",
+                                  solve[1].str(), solve[2].str(), solve[3].str(), solve[4].str())),
+            std::string::npos)
+      << page;
+
   EXPECT_EQ(test::read_file(dir / "floor_plan.txt"), "the lab's floor\n");
   EXPECT_EQ(test::read_file(dir / "floor_notes" / "marks.txt"), "taped on Monday\n");
 

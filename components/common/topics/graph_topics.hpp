@@ -56,6 +56,10 @@ inline constexpr const char* kVolumeConstellations =
     "/volume/{camera}/constellations";  // mocap_msgs/ConstellationArray
 inline constexpr const char* kCalibrationCoverage =
     "/calibration/coverage";  // mocap_msgs/CalibrationCoverage
+inline constexpr const char* kCalibrationProgress =
+    "/calibration/progress";  // mocap_msgs/CalibrationProgress
+inline constexpr const char* kCalibrationResult =
+    "/calibration/result";  // mocap_msgs/VolumeCalibrationResult
 
 // PixArt localization.
 inline constexpr const char* kPixartRaw = "/pixart/raw";  // mocap_msgs/PixartRawPointArray

@@ -1,7 +1,7 @@
 // The canvases, from the viewer's state (state.js): a single camera's image with the
 // fiducials, constellations and poses' axes found in it; a volume's cameras side by side and
 // seen from above with its bodies, robots and marker cloud; the boards seen from above in the
-// camera frame; the floor.
+// camera frame; the floor; a volume calibration's report seen from above.
 import { halfView, project, rotate, yaw } from "./geometry.js";
 import { points } from "./point_cloud.js";
 import { foundIn, graph, inWorld, report } from "./state.js";
@@ -421,4 +421,151 @@ export function drawFloor() {
     context.fillStyle = "#7d8794";
     context.fillText("no mobile base or robots in this graph", 12, 20);
   }
+}
+
+// The calibration's picture: the volume from above, scaled to its cameras and floor marks with
+// this much room around them (metres) and, in pixels, for the grid's figures and the names.
+const PICTURE_MARGIN_M = 0.6;
+const PICTURE_PAD = { left: 34, right: 14, top: 14, bottom: 26 };
+const LOOK_PX = 48;  // a camera's arrow when it looks level; shorter as it looks down
+const CALIBRATED = "#6cb6ff";
+const PREVIOUS = "#7d8794";
+const MARK = "#ffd54a";
+
+// The world-frame rectangle holding `spots` ({x, y}), with the margin.
+function extent(spots) {
+  const xs = spots.map((p) => p.x);
+  const ys = spots.map((p) => p.y);
+  return {
+    minX: Math.min(...xs) - PICTURE_MARGIN_M,
+    maxX: Math.max(...xs) + PICTURE_MARGIN_M,
+    minY: Math.min(...ys) - PICTURE_MARGIN_M,
+    maxY: Math.max(...ys) + PICTURE_MARGIN_M,
+  };
+}
+
+// A grid line every metre across the whole canvas, its figure (metres) along the bottom and the
+// left side; the world's axes brighter, named at their positive ends.
+function metreGrid(context, width, height, at, toWorld) {
+  context.fillStyle = "#000";
+  context.fillRect(0, 0, width, height);
+  const low = toWorld(0, height);
+  const high = toWorld(width, 0);
+  context.font = "12px system-ui, sans-serif";
+  context.lineWidth = 1;
+  for (let x = Math.ceil(low.x); x <= high.x; x++) {
+    const [px] = at({ x, y: 0 });
+    context.strokeStyle = x === 0 ? "#4a5562" : "#222a33";
+    context.beginPath();
+    context.moveTo(px, 0);
+    context.lineTo(px, height);
+    context.stroke();
+    context.fillStyle = PREVIOUS;
+    context.textAlign = "center";
+    context.fillText(String(x), px, height - 8);
+  }
+  for (let y = Math.ceil(low.y); y <= high.y; y++) {
+    const [, py] = at({ x: 0, y });
+    context.strokeStyle = y === 0 ? "#4a5562" : "#222a33";
+    context.beginPath();
+    context.moveTo(0, py);
+    context.lineTo(width, py);
+    context.stroke();
+    context.fillStyle = PREVIOUS;
+    context.textAlign = "left";
+    context.fillText(String(y), 6, py + 4);
+  }
+  const [ox, oy] = at({ x: 0, y: 0 });
+  context.fillStyle = "#aab3be";
+  context.textAlign = "right";
+  context.fillText("x m", width - 6, oy - 6);
+  context.textAlign = "left";
+  context.fillText("y m", ox + 6, 14);
+}
+
+// An arrow from (x, y) by (dx, dy) pixels, its head 6 px long.
+function arrow(context, x, y, dx, dy) {
+  const angle = Math.atan2(dy, dx);
+  const [ex, ey] = [x + dx, y + dy];
+  context.beginPath();
+  context.moveTo(x, y);
+  context.lineTo(ex, ey);
+  for (const side of [-1, 1]) {
+    context.moveTo(ex, ey);
+    context.lineTo(ex - 6 * Math.cos(angle + side * 0.5), ey - 6 * Math.sin(angle + side * 0.5));
+  }
+  context.stroke();
+}
+
+// The calibration's report from above (world frame: x right, y up): each floor mark the board
+// was laid at as a cross; each camera where its input file had it (a grey ring) and where the
+// solve put it (a dot with its name), the line between them and the move in mm (a few mm: the
+// line hides under the dot at this scale, the figure says it), and a short arrow where it looks.
+export function drawCalibration() {
+  const message = graph.result;
+  report.calibrationPictureDrawn = 0;
+  if (!message) return;  // hidden with the report
+  const canvas = $("calibration-top");
+  const context = canvas.getContext("2d");
+  const { width, height } = canvas;
+  const cameras = message.cameras;
+  // Each mark once: the board is laid twice at each, the second time turned.
+  const marks = [...new Map(message.floor.map((f) => [`${f.mark_x},${f.mark_y}`, { x: f.mark_x, y: f.mark_y }])).values()];
+  const placed = cameras.flatMap((c) => [c.pose.position, ...(c.has_previous_pose ? [c.previous_pose.position] : [])]);
+  const box = extent([...placed, ...marks, { x: 0, y: 0 }]);
+  const areaWidth = width - PICTURE_PAD.left - PICTURE_PAD.right;
+  const areaHeight = height - PICTURE_PAD.top - PICTURE_PAD.bottom;
+  const ppm = Math.min(areaWidth / (box.maxX - box.minX), areaHeight / (box.maxY - box.minY));
+  const cx = PICTURE_PAD.left + areaWidth / 2;
+  const cy = PICTURE_PAD.top + areaHeight / 2;
+  const mid = { x: (box.minX + box.maxX) / 2, y: (box.minY + box.maxY) / 2 };
+  const at = (p) => [cx + (p.x - mid.x) * ppm, cy - (p.y - mid.y) * ppm];
+  const toWorld = (px, py) => ({ x: mid.x + (px - cx) / ppm, y: mid.y - (py - cy) / ppm });
+  metreGrid(context, width, height, at, toWorld);
+
+  context.strokeStyle = MARK;
+  context.lineWidth = 2;
+  for (const mark of marks) {
+    const [px, py] = at(mark);
+    context.beginPath();
+    context.moveTo(px - 6, py);
+    context.lineTo(px + 6, py);
+    context.moveTo(px, py - 6);
+    context.lineTo(px, py + 6);
+    context.stroke();
+  }
+
+  context.font = "13px system-ui, sans-serif";
+  for (const c of cameras) {
+    const [px, py] = at(c.pose.position);
+    context.lineWidth = 1.5;
+    if (c.has_previous_pose) {
+      const [qx, qy] = at(c.previous_pose.position);
+      context.strokeStyle = PREVIOUS;
+      context.beginPath();
+      context.arc(qx, qy, 9, 0, 2 * Math.PI);
+      context.moveTo(qx, qy);
+      context.lineTo(px, py);
+      context.stroke();
+    }
+    // Its optical axis (+z of its frame) seen from above: short when it looks down.
+    const look = rotate(c.pose.orientation, { x: 0, y: 0, z: 1 });
+    context.strokeStyle = CALIBRATED;
+    arrow(context, px, py, LOOK_PX * look.x, -LOOK_PX * look.y);
+    context.fillStyle = CALIBRATED;
+    context.beginPath();
+    context.arc(px, py, 5, 0, 2 * Math.PI);
+    context.fill();
+    // The labels on the side away from the picture's middle, where the arrows point.
+    const outward = c.pose.position.x >= mid.x ? 1 : -1;
+    context.textAlign = outward > 0 ? "left" : "right";
+    context.fillStyle = "#d8dee6";
+    context.fillText(c.name, px + outward * 13, py - 3);
+    if (c.has_previous_pose) {
+      context.fillStyle = "#aab3be";
+      context.fillText(`${(c.moved_m * 1e3).toFixed(2)} mm`, px + outward * 13, py + 13);
+    }
+  }
+  context.textAlign = "left";
+  report.calibrationPictureDrawn = cameras.length;
 }

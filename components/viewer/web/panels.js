@@ -1,7 +1,8 @@
 // The page's text, from the viewer's state (state.js): the connection's status and the rates
 // in the header, which panels the graph fills and the topics they show, the poses' table, the
-// alerts, the processes' and components' health (/diagnostics), the turret's angles and every
-// topic with its rate and bandwidth.
+// alerts, the processes' and components' health (/diagnostics), a volume calibration's coverage,
+// its solve's progress and report, the turret's angles and every topic with its rate and
+// bandwidth.
 import { rollPitchYaw } from "./geometry.js";
 import { graph, report, stampSeconds } from "./state.js";
 import { TYPES } from "./topics.js";
@@ -43,9 +44,13 @@ export function layout(channels) {
       ? `${pattern(cameras)} with their fiducials`
       : "none: the cameras send no images";
   }
-  // A calibration session: each camera's coverage as the board is waved.
-  const calibrating = types.has(TYPES.coverage);
-  $("coverage-section").hidden = !calibrating;
+  // A calibration session: each camera's coverage as the board is waved; its solve's progress,
+  // then its report.
+  const covering = types.has(TYPES.coverage);
+  const solving = types.has(TYPES.progress) || types.has(TYPES.result);
+  const calibrating = covering || solving;
+  $("coverage-section").hidden = !covering;
+  $("solve-section").hidden = !solving;
   // A volume alone, or a calibration session: the single camera's panels (its image, its top
   // view, the floor) stay empty.
   $("camera-section").hidden = volume || (calibrating && !cameras.length);
@@ -133,6 +138,68 @@ export function coverage() {
     </figure>`;
   }).join("");
   $("coverage-note").textContent = `the session: ${Math.floor(100 * message.progress)} % (its least covered camera)`;
+}
+
+// The calibration's solve: a bar of its share done, its stage and what it says; a failure in the
+// page's error colour with why, its bar full so that it is seen at a glance.
+export function solve() {
+  const message = graph.solve;
+  if (!message) return;
+  report.solveStage = message.stage;
+  report.solveProgress = message.progress;
+  report.solveDetail = message.detail;
+  const failed = message.stage === "failed";
+  const percent = failed ? 100 : Math.floor(100 * message.progress);
+  $("solve-bar").className = `bar ${message.stage}`;  // coloured by its stage: viewer.css
+  $("solve-bar").firstElementChild.style.width = `${percent}%`;
+  $("solve-stage").className = failed ? "failed" : "";
+  $("solve-stage").textContent = failed
+    ? `failed: ${message.detail}`
+    : `${message.stage} ${percent} %${message.detail ? `: ${message.detail}` : ""}`;
+}
+
+// Figures as the report of mocap_volume_calibrate prints them, empty where it has none.
+const fixed = (value, digits) => (value === null ? "" : value.toFixed(digits));
+
+// The calibration's report: the solve in one line, each camera (its RMS, where it is, how far
+// from its camera file's pose) and each placement of the board on the floor. The figures go to
+// window.viewerState as the message has them, in metres turned into the millimetres shown.
+export function result() {
+  const message = graph.result;
+  $("result").hidden = !message;
+  if (!message) {
+    report.resultSummary = null;
+    report.resultCameras = [];
+    report.resultFloor = [];
+    return;
+  }
+  const { frames_used, rms_px, points, iterations } = message;
+  report.resultSummary = { frames_used, rms_px, points, iterations };
+  report.resultCameras = message.cameras.map((c) => ({
+    name: c.name,
+    rms_px: c.rms_px,
+    shots: c.shots,
+    ...c.pose.position,
+    moved_mm: c.has_previous_pose ? c.moved_m * 1e3 : null,
+    turned_deg: c.has_previous_pose ? c.turned_deg : null,
+  }));
+  report.resultFloor = message.floor.map((f) => ({
+    mark_x: f.mark_x,
+    mark_y: f.mark_y,
+    cameras: f.cameras,
+    rms_px: f.rms_px,
+    off_mark_mm: f.off_mark_m >= 0 ? f.off_mark_m * 1e3 : null,  // -1: a single mark
+  }));
+  $("result-summary").textContent =
+    `${frames_used} capture times, RMS ${rms_px.toFixed(3)} px over ${points} points, ${iterations} iterations`;
+  $("result-cameras").tBodies[0].innerHTML = report.resultCameras.map((c) =>
+    `<tr><td>${escape(c.name)}</td><td>${c.rms_px.toFixed(3)}</td><td>${c.shots}</td><td>${c.x.toFixed(4)}</td>
+      <td>${c.y.toFixed(4)}</td><td>${c.z.toFixed(4)}</td><td>${fixed(c.moved_mm, 2)}</td>
+      <td>${fixed(c.turned_deg, 4)}</td></tr>`).join("");
+  // The marks as the tool names them: "(1, 0)", "(0.5, -1)".
+  $("result-floor").tBodies[0].innerHTML = report.resultFloor.map((f) =>
+    `<tr><td>(${f.mark_x}, ${f.mark_y})</td><td>${f.cameras}</td><td>${f.rms_px.toFixed(3)}</td>
+      <td>${fixed(f.off_mark_mm, 3)}</td></tr>`).join("");
 }
 
 export function turret() {

@@ -75,10 +75,27 @@ export const report = {
   coverageProgress: null,
   coverageViews: 0,
   coverageMissing: {},
+  // The calibration's solve shown (/calibration/progress): its stage ("reading", "solving",
+  // "writing", "done", "failed"), its share done (0 to 1) and what it says.
+  solveStage: "",
+  solveProgress: null,
+  solveDetail: "",
+  // Its report shown (/calibration/result), as the message has it (moved_mm and turned_deg null
+  // for a camera whose file had no pose; off_mark_mm null for a single mark):
+  // {frames_used, rms_px, points, iterations}, [{name, rms_px, shots, x, y, z, moved_mm,
+  // turned_deg}], [{mark_x, mark_y, cameras, rms_px, off_mark_mm}], and the cameras drawn in its
+  // picture of the volume from above.
+  resultSummary: null,
+  resultCameras: [],
+  resultFloor: [],
+  calibrationPictureDrawn: 0,
 };
 
 // The panels with news since the last animation frame.
-export const dirty = { cameras: false, side: false, volume: false, poses: false, alerts: false, health: false, view3d: false, coverage: false };
+export const dirty = {
+  cameras: false, side: false, volume: false, poses: false, alerts: false, health: false, view3d: false,
+  coverage: false, solve: false, result: false,
+};
 
 export const graph = {
   cameras: new Map(),  // image topic -> {name, image, frameStamp, dirty}, in topic order
@@ -104,6 +121,8 @@ export const graph = {
   alerts: [],  // the newest first
   health: new Map(),  // /diagnostics status name -> {status, receivedAt (page clock, ms)}
   coverage: null,  // the latest calibration coverage (volume_calibration_coverage)
+  solve: null,  // the calibration's solve: its latest progress (volume_calibration_solve)
+  result: null,  // and its report, once calibrated
   topics: new Map(),  // every advertised topic -> {type, count, bytes, rate, bandwidth}
 };
 
@@ -316,6 +335,20 @@ const handlers = {
   [TYPES.coverage](message) {
     graph.coverage = message;
     dirty.coverage = true;
+  },
+  [TYPES.progress](message) {
+    graph.solve = message;
+    dirty.solve = true;
+    // A solve starting, or one that failed: the report shown is an earlier solve's (the page
+    // stays open from one to the next).
+    if (graph.result && (message.stage === "reading" || message.stage === "failed")) {
+      graph.result = null;
+      dirty.result = true;
+    }
+  },
+  [TYPES.result](message) {
+    graph.result = message;
+    dirty.result = true;
   },
   [TYPES.alert](alert) {
     graph.alerts.unshift(alert);

@@ -21,6 +21,8 @@ export const TYPES = {
   markers: "sensor_msgs/msg/PointCloud2",
   diagnostics: "diagnostic_msgs/msg/DiagnosticArray",
   coverage: "mocap_msgs/msg/CalibrationCoverage",
+  progress: "mocap_msgs/msg/CalibrationProgress",
+  result: "mocap_msgs/msg/VolumeCalibrationResult",
 };
 
 const namespace = (topic) => topic.slice(0, topic.lastIndexOf("/"));

@@ -5,7 +5,7 @@
 // exposes what was drawn, for the browser test and for a curious console.
 import { decode } from "./cdr.js";
 import { connect } from "./connection.js";
-import { drawCameras, drawFloor, drawTop, drawVolumeTop } from "./draw.js";
+import { drawCalibration, drawCameras, drawFloor, drawTop, drawVolumeTop } from "./draw.js";
 import * as panels from "./panels.js";
 import { advertised, counted, dirty, receive, report, rollRates, setCameras } from "./state.js";
 import { choose } from "./topics.js";
@@ -68,6 +68,11 @@ function frame() {
   if (dirty.alerts) panels.alerts();
   if (dirty.health) panels.health();
   if (dirty.coverage) panels.coverage();
+  if (dirty.solve) panels.solve();
+  if (dirty.result) {
+    panels.result();
+    drawCalibration();
+  }
   for (const panel of Object.keys(dirty)) dirty[panel] = false;
   requestAnimationFrame(frame);
 }

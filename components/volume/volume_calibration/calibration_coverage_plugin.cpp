@@ -15,14 +15,13 @@
 #include <mocap/calibration/camera_file.hpp>
 #include <mocap/component.hpp>
 #include <mocap/config_files.hpp>
-#include <mocap/message_time.hpp>
 #include <mocap_msgs/msg/calibration_coverage.hpp>
 #include <mocap_msgs/msg/constellation_array.hpp>
 
 #include "common/topics/graph_topics.hpp"
 #include "tracking/constellation_database/database_parameters.hpp"
-#include "volume/volume_calibration/board_sighting_message.hpp"
 #include "volume/volume_calibration/calibration_coverage.hpp"
+#include "volume/volume_calibration/calibration_messages.hpp"
 
 namespace mocap::volume {
 namespace {
@@ -130,25 +129,9 @@ class CalibrationCoverageComponent final : public Component {
  private:
   // Published each period; logged when it moved.
   void report() {
-    auto message = std::make_shared<CoverageMessage>();
-    message->header().frame_id("world");
-    message->header().stamp(
-        to_time_msg(std::chrono::system_clock::time_point(std::chrono::nanoseconds(latest_ns_))));
-    message->progress(static_cast<float>(coverage_->progress()));
-    for (size_t c = 0; c < coverage_->camera_count(); ++c) {
-      const CameraCoverage& camera = coverage_->camera(c);
-      mocap_msgs::msg::CameraCoverage& out = message->cameras().emplace_back();
-      out.name(camera.name);
-      out.image_width(static_cast<uint32_t>(camera.image_size.x()));
-      out.image_height(static_cast<uint32_t>(camera.image_size.y()));
-      for (size_t r = 0; r < camera.views.size(); ++r) out.views()[r] = camera.views[r];
-      out.views_needed(static_cast<uint32_t>(settings_.views_per_region));
-      out.shared_shots(camera.shared_shots);
-      out.shared_shots_needed(static_cast<uint32_t>(settings_.shared_shots));
-      out.progress(static_cast<float>(camera.progress));
-      out.missing(camera.missing);
-    }
-    publisher_.publish(std::move(message));
+    std::vector<CameraCoverage> cameras;
+    for (size_t c = 0; c < coverage_->camera_count(); ++c) cameras.push_back(coverage_->camera(c));
+    publisher_.publish(coverage_message(cameras, coverage_->progress(), settings_, latest_ns_));
     if (sightings_ != logged_sightings_) log_coverage();
   }
 

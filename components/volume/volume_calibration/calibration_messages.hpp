@@ -1,13 +1,18 @@
-// A camera's ConstellationArray (what constellation_identifier publishes) as the calibration's
-// BoardSighting: the board's markers by their index in the board's model, each where the camera
-// saw it.
+// The volume calibration's types and its messages: a camera's ConstellationArray (what
+// constellation_identifier publishes) as a BoardSighting, and the coverage, the solve's progress
+// and its result as the page reads them (/calibration/coverage, /progress, /result).
 #pragma once
 
 #include <optional>
 
+#include <mocap_msgs/msg/calibration_coverage.hpp>
+#include <mocap_msgs/msg/calibration_progress.hpp>
 #include <mocap_msgs/msg/constellation_array.hpp>
+#include <mocap_msgs/msg/volume_calibration_result.hpp>
 
 #include "tracking/constellation_database/constellation_database.hpp"
+#include "volume/volume_calibration/calibration_coverage.hpp"
+#include "volume/volume_calibration/calibration_session.hpp"
 #include "volume/volume_calibration/volume_calibration.hpp"
 
 namespace mocap::volume {
@@ -18,5 +23,15 @@ namespace mocap::volume {
 std::optional<BoardSighting> board_sighting(const mocap_msgs::msg::ConstellationArray& array,
                                             size_t camera,
                                             const constellations::ConstellationModel& board);
+
+// Every camera's coverage; `latest_ns` stamps it (the latest sighting's capture time).
+mocap_msgs::msg::CalibrationCoverage coverage_message(const std::vector<CameraCoverage>& cameras,
+                                                      double progress,
+                                                      const CoverageOptions& options,
+                                                      int64_t latest_ns);
+
+mocap_msgs::msg::CalibrationProgress progress_message(const SessionProgress& progress);
+
+mocap_msgs::msg::VolumeCalibrationResult result_message(const CalibrationSessionResult& result);
 
 }  // namespace mocap::volume

@@ -216,6 +216,7 @@ VolumeCalibration calibrate_volume(const std::vector<CalibrationCamera>& cameras
   calibration::CalibrationOptions solve;
   solve.robust_scale_px = options.robust_scale_px;
   solve.compute_covariance = false;
+  solve.on_iteration = options.on_iteration;
   std::vector<Eigen::Isometry3d> camera_from_reference(cameras.size());
   try {
     calibration::CalibrationProblem problem(problem_of(cameras, board, frames, start), solve);

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -53,6 +54,9 @@ struct VolumeCalibrationOptions {
   // Huber loss scale on each point's pixel error: a mis-detected marker cannot drag the fit.
   // 0: plain least squares.
   double robust_scale_px = 1.0;
+  // Called after each iteration of the solve (calibration_problem.hpp), on the calling thread;
+  // false stops the solve (calibrate_volume then throws VolumeCalibrationError).
+  std::function<bool(const calibration::SolveIteration&)> on_iteration{};
 
   // Why these options cannot be used, naming the field ("max_frames: 0; ..."); nullopt when
   // they can. calibrate_volume throws std::invalid_argument with it.

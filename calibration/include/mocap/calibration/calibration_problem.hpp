@@ -16,6 +16,7 @@
 // with a prior, its deviation from the prior times the stiffness.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -34,6 +35,17 @@ class CalibrationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// One iteration of the solve, as it goes: what a progress display shows.
+struct SolveIteration {
+  int iteration = 0;  // 0: the starting point
+  // The RMS pixel error over every point the cost implies (exact where the robust loss leaves
+  // a point's error as it is: below its scale).
+  double rms_px = 0;
+  // The cost's relative decrease in this iteration: Levenberg–Marquardt stops once it falls
+  // under the function tolerance (1e-10), so its order of magnitude says how near the end is.
+  double relative_decrease = 0;
+};
+
 struct CalibrationOptions {
   // Huber loss on each point's pixel error, with this scale (pixels): points further off
   // than it count linearly, so a few bad points cannot drag the fit. 0: plain least squares.
@@ -44,6 +56,9 @@ struct CalibrationOptions {
   // Standard deviations of the parameters from the covariance at the solution, when the solver
   // converged (a sparse QR factorization of the Jacobian: about as long as the solve).
   bool compute_covariance = true;
+  // Called after each iteration of the solve, on the thread that solves; false ends the solve
+  // there (it then reports not converged: "stopped").
+  std::function<bool(const SolveIteration&)> on_iteration{};
 };
 
 struct CameraResult {
