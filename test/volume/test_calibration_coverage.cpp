@@ -24,7 +24,7 @@ TEST(CalibrationCoverage, ASightingCountsOnceInEachRegionItTouches) {
   coverage.add(sighting(0, 0,
                         {Eigen::Vector2d(10, 10), Eigen::Vector2d(390, 290),
                          Eigen::Vector2d(1190, 450), Eigen::Vector2d(1300, 10), std::nullopt}));
-  const CameraCoverage& cam_0 = coverage.camera(0);
+  const CameraCoverage& cam_0 = coverage.cameras()[0];
   EXPECT_EQ(cam_0.views[0], 1u);  // upper left corner, once for its two markers
   EXPECT_EQ(cam_0.views[5], 1u);  // right edge
   for (int r : {1, 2, 3, 4, 6, 7, 8}) EXPECT_EQ(cam_0.views[static_cast<size_t>(r)], 0u) << r;
@@ -36,9 +36,9 @@ TEST(CalibrationCoverage, ASightingCountsOnceInEachRegionItTouches) {
                                "centre", "right edge", "lower left corner", "bottom edge",
                                "lower right corner", "shots with another camera"}));
   coverage.add(sighting(0, 1'000'000'000, {Eigen::Vector2d(100, 100)}));
-  EXPECT_EQ(coverage.camera(0).views[0], 2u);
-  EXPECT_EQ(coverage.camera(0).missing.front(), "top edge");  // the upper left corner is full
-  EXPECT_EQ(coverage.camera(1).views[0], 0u);                 // cameras apart
+  EXPECT_EQ(coverage.cameras()[0].views[0], 2u);
+  EXPECT_EQ(coverage.cameras()[0].missing.front(), "top edge");  // the upper left corner is full
+  EXPECT_EQ(coverage.cameras()[1].views[0], 0u);                 // cameras apart
 }
 
 TEST(CalibrationCoverage, AShotIsSharedWhenAnotherCameraSawTheWholeBoardWithinACaptureTime) {
@@ -50,24 +50,24 @@ TEST(CalibrationCoverage, AShotIsSharedWhenAnotherCameraSawTheWholeBoardWithinAC
   // t = 0: cam_0 whole, cam_1 whole 1 ms later (one capture time): both gain a shot; cam_2
   // partly: not it.
   coverage.add(sighting(0, 0, whole));
-  EXPECT_EQ(coverage.camera(0).shared_shots, 0u);
+  EXPECT_EQ(coverage.cameras()[0].shared_shots, 0u);
   coverage.add(sighting(1, 1'000'000, whole));
   coverage.add(sighting(2, 0, partial));
-  EXPECT_EQ(coverage.camera(0).shared_shots, 1u);
-  EXPECT_EQ(coverage.camera(1).shared_shots, 1u);
-  EXPECT_EQ(coverage.camera(2).shared_shots, 0u);
+  EXPECT_EQ(coverage.cameras()[0].shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[1].shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[2].shared_shots, 0u);
   // cam_2 whole at the same capture time: its own shot, the others' counted once already.
   coverage.add(sighting(2, 500'000, whole));
-  EXPECT_EQ(coverage.camera(2).shared_shots, 1u);
-  EXPECT_EQ(coverage.camera(0).shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[2].shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[0].shared_shots, 1u);
   // 5 ms apart: two capture times, nothing shared.
   coverage.add(sighting(0, 100'000'000, whole));
   coverage.add(sighting(1, 105'000'000, whole));
-  EXPECT_EQ(coverage.camera(0).shared_shots, 1u);
-  EXPECT_EQ(coverage.camera(1).shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[0].shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[1].shared_shots, 1u);
   // The same camera twice at one capture time counts once.
   coverage.add(sighting(1, 105'500'000, whole));
-  EXPECT_EQ(coverage.camera(1).shared_shots, 1u);
+  EXPECT_EQ(coverage.cameras()[1].shared_shots, 1u);
 }
 
 TEST(CalibrationCoverage, ASessionIsCompleteWhenItsLeastCoveredCameraIs) {
@@ -80,18 +80,18 @@ TEST(CalibrationCoverage, ASessionIsCompleteWhenItsLeastCoveredCameraIs) {
     for (size_t c : {0u, 1u}) coverage.add(sighting(c, shot * 33'000'000, {centre}));
   }
   // Each region seen once or twice: not enough yet.
-  EXPECT_LT(coverage.camera(0).progress, 1);
+  EXPECT_LT(coverage.cameras()[0].progress, 1);
   for (int shot = 12; shot < 27; ++shot) {
     const int region = shot % kCoverageRegions;
     const Eigen::Vector2d centre(200 + 400 * (region % 3), 150 + 300 * (region / 3));
     for (size_t c : {0u, 1u}) coverage.add(sighting(c, shot * 33'000'000, {centre}));
   }
-  EXPECT_DOUBLE_EQ(coverage.camera(0).progress, 1);
-  EXPECT_TRUE(coverage.camera(0).missing.empty());
-  EXPECT_DOUBLE_EQ(coverage.camera(1).progress, 1);
+  EXPECT_DOUBLE_EQ(coverage.cameras()[0].progress, 1);
+  EXPECT_TRUE(coverage.cameras()[0].missing.empty());
+  EXPECT_DOUBLE_EQ(coverage.cameras()[1].progress, 1);
   // cam_2 saw nothing: the session is as far as it.
   EXPECT_DOUBLE_EQ(coverage.progress(), 0);
-  EXPECT_EQ(coverage.camera(2).missing.size(), 10u);
+  EXPECT_EQ(coverage.cameras()[2].missing.size(), 10u);
 }
 
 TEST(CalibrationCoverage, OptionsAndImagesThatCannotBeUsedAreNamed) {

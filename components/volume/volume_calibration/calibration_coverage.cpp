@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 namespace mocap::volume {
 namespace {
@@ -108,10 +109,15 @@ void CalibrationCoverage::update_progress(CameraCoverage& camera) const {
   camera.progress = static_cast<double>(have) / (kCoverageRegions * needed + shared);
 }
 
-double CalibrationCoverage::progress() const {
-  double least = cameras_.empty() ? 0 : 1;
-  for (const CameraCoverage& camera : cameras_) least = std::min(least, camera.progress);
+double least_progress(const std::vector<CameraCoverage>& cameras) {
+  double least = cameras.empty() ? 0 : 1;
+  for (const CameraCoverage& camera : cameras) least = std::min(least, camera.progress);
   return least;
+}
+
+std::string coverage_line(const CameraCoverage& camera) {
+  return fmt::format("{} {}{}{}", camera.name, progress_bar(camera.progress),
+                     camera.missing.empty() ? "" : ": missing ", fmt::join(camera.missing, ", "));
 }
 
 std::string progress_bar(double fraction, int width) {

@@ -60,6 +60,13 @@ struct CoverageCamera {
   Eigen::Vector2i image_size = Eigen::Vector2i::Zero();
 };
 
+// The least complete camera's progress: a session is as far as its worst camera (0 for none).
+double least_progress(const std::vector<CameraCoverage>& cameras);
+
+// "cam_0 [=====               ]  25 %: missing lower left corner, bottom edge": a camera's bar
+// and what it still needs, as the command line and the log show it.
+std::string coverage_line(const CameraCoverage& camera);
+
 class CalibrationCoverage {
  public:
   // Throws std::invalid_argument for options that cannot be used or an image of no size.
@@ -70,10 +77,9 @@ class CalibrationCoverage {
   // across cameras, each camera's in the order of its stamps.
   void add(const BoardSighting& sighting);
 
-  const CameraCoverage& camera(size_t index) const { return cameras_.at(index); }
-  size_t camera_count() const { return cameras_.size(); }
-  // The least complete camera's progress: the session is as far as its worst camera.
-  double progress() const;
+  // In the order of the cameras given.
+  const std::vector<CameraCoverage>& cameras() const { return cameras_; }
+  double progress() const { return least_progress(cameras_); }
 
  private:
   void update_progress(CameraCoverage& camera) const;

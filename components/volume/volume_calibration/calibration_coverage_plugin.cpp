@@ -117,8 +117,7 @@ class CalibrationCoverageComponent final : public Component {
 
   void report_health(HealthReport& report) override {
     report.add("progress %", fmt::format("{:.0f}", 100 * coverage_->progress()));
-    for (size_t c = 0; c < coverage_->camera_count(); ++c) {
-      const CameraCoverage& camera = coverage_->camera(c);
+    for (const CameraCoverage& camera : coverage_->cameras()) {
       if (!camera.missing.empty()) {
         report.flag(HealthLevel::warn,
                     fmt::format("{}: {}", camera.name, fmt::join(camera.missing, ", ")));
@@ -129,19 +128,15 @@ class CalibrationCoverageComponent final : public Component {
  private:
   // Published each period; logged when it moved.
   void report() {
-    std::vector<CameraCoverage> cameras;
-    for (size_t c = 0; c < coverage_->camera_count(); ++c) cameras.push_back(coverage_->camera(c));
-    publisher_.publish(coverage_message(cameras, coverage_->progress(), settings_, latest_ns_));
+    publisher_.publish(coverage_message(coverage_->cameras(), settings_, latest_ns_));
     if (sightings_ != logged_sightings_) log_coverage();
   }
 
   // A line a camera: "coverage cam_0 [=====     ]  50 %: missing lower left corner, ...".
   void log_coverage() {
     logged_sightings_ = sightings_;
-    for (size_t c = 0; c < coverage_->camera_count(); ++c) {
-      const CameraCoverage& camera = coverage_->camera(c);
-      log().info("coverage {} {}{}{}", camera.name, progress_bar(camera.progress),
-                 camera.missing.empty() ? "" : ": missing ", fmt::join(camera.missing, ", "));
+    for (const CameraCoverage& camera : coverage_->cameras()) {
+      log().info("coverage {}", coverage_line(camera));
     }
   }
 

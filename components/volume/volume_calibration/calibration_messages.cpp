@@ -37,14 +37,13 @@ std::optional<BoardSighting> board_sighting(const mocap_msgs::msg::Constellation
 }
 
 mocap_msgs::msg::CalibrationCoverage coverage_message(const std::vector<CameraCoverage>& cameras,
-                                                      double progress,
                                                       const CoverageOptions& options,
                                                       int64_t latest_ns) {
   mocap_msgs::msg::CalibrationCoverage message;
   message.header().frame_id("world");
   message.header().stamp(
       to_time_msg(std::chrono::system_clock::time_point(std::chrono::nanoseconds(latest_ns))));
-  message.progress(static_cast<float>(progress));
+  message.progress(static_cast<float>(least_progress(cameras)));
   for (const CameraCoverage& camera : cameras) {
     mocap_msgs::msg::CameraCoverage& out = message.cameras().emplace_back();
     out.name(camera.name);

@@ -24,9 +24,9 @@ std::optional<BoardSighting> board_sighting(const mocap_msgs::msg::Constellation
                                             size_t camera,
                                             const constellations::ConstellationModel& board);
 
-// Every camera's coverage; `latest_ns` stamps it (the latest sighting's capture time).
+// Every camera's coverage, and the session's (the least covered camera's); `latest_ns` stamps
+// it (the latest sighting's capture time).
 mocap_msgs::msg::CalibrationCoverage coverage_message(const std::vector<CameraCoverage>& cameras,
-                                                      double progress,
                                                       const CoverageOptions& options,
                                                       int64_t latest_ns);
 

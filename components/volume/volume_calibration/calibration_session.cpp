@@ -25,13 +25,20 @@ constexpr double kSolvingEnd = 0.95;
 // Levenberg–Marquardt ends once an iteration lowers the cost by less than this share.
 constexpr double kFunctionTolerance = 1e-10;
 
-// Reports the progress, and ends the session where a stop was asked for.
+// Reports where the session is, unless a stop was asked for.
 struct Reporter {
-  const std::function<void(const SessionProgress&)>& report;
+  const std::function<void(const SessionProgress&)>& callback;
   std::stop_token stop;
-  void operator()(const std::string& stage, double fraction, std::string detail = {}) const {
-    if (stop.stop_requested()) throw VolumeCalibrationError("stopped");
-    if (report) report({stage, std::clamp(fraction, 0.0, 1.0), std::move(detail)});
+  // False, reporting nothing, once a stop was asked for: for Ceres's callback, which must not
+  // throw.
+  bool operator()(const std::string& stage, double fraction, std::string detail = {}) const {
+    if (stop.stop_requested()) return false;
+    if (callback) callback({stage, std::clamp(fraction, 0.0, 1.0), std::move(detail)});
+    return true;
+  }
+  // Ends the session where a stop was asked for.
+  void step(const std::string& stage, double fraction, std::string detail = {}) const {
+    if (!(*this)(stage, fraction, std::move(detail))) throw VolumeCalibrationError("stopped");
   }
 };
 
@@ -66,8 +73,8 @@ std::vector<BoardSighting> read_sightings(const std::string& path,
     const std::string name = std::filesystem::path(path).filename().string();
     while (reader.next(message)) {
       if (++done % 256 == 0 && total > 0) {
-        report("reading", from + (to - from) * static_cast<double>(done) / total,
-               fmt::format("{}: {} of {} messages", name, done, total));
+        report.step("reading", from + (to - from) * static_cast<double>(done) / total,
+                    fmt::format("{}: {} of {} messages", name, done, total));
       }
       try {
         type.deserialize(message.data, &array);
@@ -143,7 +150,7 @@ CalibrationSessionResult run_calibration_session(
     const CalibrationSession& session, const std::function<void(const SessionProgress&)>& progress,
     std::stop_token stop) {
   const Reporter report{progress, stop};
-  report("reading", 0);
+  report.step("reading", 0);
   std::vector<calibration::CameraFile> files;
   std::vector<CalibrationCamera> cameras;
   std::vector<std::string> names;
@@ -179,8 +186,7 @@ CalibrationSessionResult run_calibration_session(
       read_sightings(session.waved, names, *board, result.waved, report, 0, bag_share);
   CalibrationCoverage coverage(coverage_cameras);
   for (const BoardSighting& sighting : waved) coverage.add(sighting);
-  for (size_t c = 0; c < coverage.camera_count(); ++c)
-    result.coverage.push_back(coverage.camera(c));
+  result.coverage = coverage.cameras();
   std::vector<FloorPlacement> floor;
   for (size_t f = 0; f < session.floor.size(); ++f) {
     RecordingRead& read = result.floor.emplace_back();
@@ -189,16 +195,14 @@ CalibrationSessionResult run_calibration_session(
                                                            read, report, from, from + bag_share)});
   }
 
-  report("solving", kReadingShare, fmt::format("{} sightings of the waved board", waved.size()));
+  report.step("solving", kReadingShare,
+              fmt::format("{} sightings of the waved board", waved.size()));
   VolumeCalibrationOptions options;
   SolveGauge gauge;
   options.on_iteration = [&](const calibration::SolveIteration& iteration) {
-    if (stop.stop_requested()) return false;
-    if (progress) {
-      progress({"solving", kReadingShare + (kSolvingEnd - kReadingShare) * gauge(iteration),
-                fmt::format("iteration {}, RMS {:.3f} px", iteration.iteration, iteration.rms_px)});
-    }
-    return true;
+    return report(
+        "solving", kReadingShare + (kSolvingEnd - kReadingShare) * gauge(iteration),
+        fmt::format("iteration {}, RMS {:.3f} px", iteration.iteration, iteration.rms_px));
   };
   try {
     result.calibration = calibrate_volume(cameras, board->points, waved, floor, options);
@@ -207,7 +211,7 @@ CalibrationSessionResult run_calibration_session(
     throw;
   }
 
-  report("writing", kSolvingEnd, session.output);
+  report.step("writing", kSolvingEnd, session.output);
   std::filesystem::create_directories(session.output);
   for (size_t c = 0; c < files.size(); ++c) {
     CalibratedCamera& camera = result.cameras.emplace_back();
@@ -242,9 +246,7 @@ std::vector<std::string> report_lines(const CalibrationSessionResult& result) {
     lines.push_back(reading_line(read, names, result.board));
   }
   for (const CameraCoverage& camera : result.coverage) {
-    lines.push_back(
-        fmt::format("waved coverage: {} {}{}{}", camera.name, progress_bar(camera.progress),
-                    camera.missing.empty() ? "" : ": missing ", fmt::join(camera.missing, ", ")));
+    lines.push_back("waved coverage: " + coverage_line(camera));
   }
   const VolumeCalibration& calibration = result.calibration;
   lines.push_back(fmt::format(

@@ -117,8 +117,7 @@ class CalibrationSolveComponent final : public Component {
     try {
       const CalibrationSessionResult result = run_calibration_session(
           session_, [this](const SessionProgress& progress) { report(progress); }, stop);
-      coverage_.publish(
-          coverage_message(result.coverage, least_progress(result.coverage), CoverageOptions{}, 0));
+      coverage_.publish(coverage_message(result.coverage, CoverageOptions{}, 0));
       for (const std::string& line : problem_lines(result)) log().warn("{}", line);
       for (const std::string& line : report_lines(result)) log().info("report: {}", line);
       // Said done in the log before the page can have the result: a script that follows the log
@@ -149,12 +148,6 @@ class CalibrationSolveComponent final : public Component {
     reported_ = now;
     progress_.publish(progress_message(progress));
     log().info("{}", progress_line(progress));
-  }
-
-  static double least_progress(const std::vector<CameraCoverage>& cameras) {
-    double least = 1;
-    for (const CameraCoverage& camera : cameras) least = std::min(least, camera.progress);
-    return least;
   }
 
   CalibrationSession session_;
