@@ -63,15 +63,34 @@ TEST(ClockOffset, TheFilterTakesTheExchangeWithTheShortestRoundTrip) {
   EXPECT_GT(std::abs(mean_error), 0.5 * kMs);
 }
 
-TEST(ClockOffset, TheFilterForgetsAllButItsLastSamples) {
+// Exchanges 10 ms apart: the quick one is kept while the last exchange is within the
+// window of it, and forgotten after.
+TEST(ClockOffset, TheFilterForgetsExchangesOlderThanItsWindow) {
+  const int64_t window_ns = std::chrono::nanoseconds(ClockOffsetFilter::kWindow).count();
   ClockOffsetFilter filter;
   filter.add(exchange(0, 1 * kMs, 10'000, 10'000));  // the quickest, and the oldest
-  for (size_t i = 1; i <= ClockOffsetFilter::kSamples; ++i) {
-    filter.add(exchange(static_cast<int64_t>(i) * kMs, 3 * kMs, 200'000, 200'000));
+  const int64_t quick_received_ns = 20'000 + 10'000 + 10'000;
+  constexpr int64_t kStep = 10 * kMs;
+  int64_t start_ns = kStep;
+  for (; start_ns + 420'000 - quick_received_ns <= window_ns; start_ns += kStep) {
+    filter.add(exchange(start_ns, 3 * kMs, 200'000, 200'000));
   }
   ASSERT_TRUE(filter.offset());
+  EXPECT_EQ(filter.offset()->offset_ns, 1 * kMs);
+  EXPECT_EQ(filter.offset()->span_ns, start_ns - kStep + 420'000 - quick_received_ns);
+  filter.add(exchange(start_ns, 3 * kMs, 200'000, 200'000));
   EXPECT_EQ(filter.offset()->offset_ns, 3 * kMs);
-  EXPECT_EQ(filter.offset()->samples, static_cast<int>(ClockOffsetFilter::kSamples));
+  EXPECT_EQ(filter.offset()->samples, static_cast<int>(window_ns / kStep));
+  EXPECT_LE(filter.offset()->span_ns, window_ns);
+}
+
+// However often a peer is probed, the filter holds kMaxSamples at most.
+TEST(ClockOffset, TheFilterHoldsABoundedNumberOfExchanges) {
+  ClockOffsetFilter filter;
+  for (size_t i = 0; i < 3 * ClockOffsetFilter::kMaxSamples; ++i) {
+    filter.add(exchange(static_cast<int64_t>(i) * 1000, 0, 100'000, 100'000));
+  }
+  EXPECT_EQ(filter.offset()->samples, static_cast<int>(ClockOffsetFilter::kMaxSamples));
 }
 
 TEST(ClockOffset, WhatAnExchangeProvesIsTheOffsetLessHalfItsRoundTrip) {

@@ -21,7 +21,11 @@ int64_t ClockOffset::least_offset_ns() const {
 void ClockOffsetFilter::add(const ClockExchange& exchange) {
   if (exchange.round_trip_ns() < 0) return;
   samples_.push_back(exchange);
-  if (samples_.size() > kSamples) samples_.pop_front();
+  const int64_t oldest_kept_ns =
+      exchange.reply_received_ns - std::chrono::nanoseconds(kWindow).count();
+  while (samples_.size() > kMaxSamples || samples_.front().reply_received_ns < oldest_kept_ns) {
+    samples_.pop_front();
+  }
 }
 
 std::optional<ClockOffset> ClockOffsetFilter::offset() const {
@@ -30,7 +34,8 @@ std::optional<ClockOffset> ClockOffsetFilter::offset() const {
                                      [](const ClockExchange& a, const ClockExchange& b) {
                                        return a.round_trip_ns() < b.round_trip_ns();
                                      });
-  return ClockOffset{best->offset_ns(), best->round_trip_ns(), static_cast<int>(samples_.size())};
+  return ClockOffset{best->offset_ns(), best->round_trip_ns(), static_cast<int>(samples_.size()),
+                     samples_.back().reply_received_ns - samples_.front().reply_received_ns};
 }
 
 void PeerClocks::add(uint64_t instance, std::string_view host, std::string_view process,

@@ -3,8 +3,8 @@
 // t4 on ours. If the way there and the way back take equally long, their clock is ahead of ours
 // by ((t2 - t1) + (t3 - t4)) / 2, and the round trip took (t4 - t1) - (t3 - t2). A sample is off
 // by at most half its round trip, and queues make round trips long one way more than the other:
-// of the last few samples, the one with the shortest round trip is the one to trust (NTP's
-// clock filter, over more samples than NTP keeps: below).
+// of the last few seconds' samples, the one with the shortest round trip is the one to trust
+// (NTP's clock filter, over more samples than NTP keeps: below).
 //
 //   ClockOffsetFilter filter;
 //   filter.add({t1, t2, t3, t4});
@@ -37,6 +37,7 @@ struct ClockOffset {
   int64_t offset_ns = 0;      // the other clock minus ours
   int64_t round_trip_ns = 0;  // of the exchange it comes from: the offset is good to half of it
   int samples = 0;            // exchanges the filter holds
+  int64_t span_ns = 0;        // from the first of them to the last, on our clock
 
   // What the exchange proves: the other clock is off by at least this much (0 when the round
   // trip leaves room for none). A check on this does not flap with the network's queues.
@@ -45,13 +46,17 @@ struct ClockOffset {
 
 class ClockOffsetFilter {
  public:
-  // NTP keeps 8, polling every 64 s and more; probes twenty times a second on a busy host meet
-  // queues more often, and a clock drifts a few microseconds in the seconds 32 of them span.
-  static constexpr size_t kSamples = 32;
+  // NTP keeps 8 samples, polling every 64 s and more. Probes many times a second on a busy host
+  // meet queues more often, and a quick exchange among them is rarer: the filter keeps the
+  // exchanges of the last two seconds, in which a clock drifts a few microseconds at most.
+  static constexpr std::chrono::seconds kWindow{2};
+  // Bounds what a peer costs however often it is probed.
+  static constexpr size_t kMaxSamples = 1024;
 
   // An exchange whose round trip is negative (a clock stepped during it) is not kept.
   void add(const ClockExchange& exchange);
-  // Of the last kSamples exchanges, the one with the shortest round trip; none yet: nullopt.
+  // Of the exchanges within kWindow of the last one, the one with the shortest round trip;
+  // none yet: nullopt.
   std::optional<ClockOffset> offset() const;
 
  private:
