@@ -26,8 +26,8 @@ for part in "${parts[@]}"; do
       cmake -DBUILD=build -P scripts/check_test_parts.cmake
       # The tests' independent clients and readers (pinned in test/package-lock.json).
       npm ci --prefix test --no-audit --no-fund --loglevel=error
-      # Two at a time (test/CMakeLists.txt); what CI compiles beside them runs in the idle class
-      # (.ci/run).
+      # Two at a time (test/CMakeLists.txt); what CI compiles beside them runs in an idle
+      # CPU cgroup (.ci/run, scripts/run_idle.sh).
       MOCAP_TEST_PARALLEL=2 scripts/run_tests.sh build "plain, real time" -L '^realtime$'
       # Side by side: the slow-subscriber loads are paced by their subscribers and the package
       # tests wait on dpkg and a compiler; then the loads that keep every core busy, one at a
