@@ -54,6 +54,7 @@ CalibrationCoverage::CalibrationCoverage(const std::vector<CoverageCamera>& came
 
 void CalibrationCoverage::add(const BoardSighting& sighting) {
   if (sighting.camera >= cameras_.size()) return;
+  latest_stamp_ns_ = std::max(latest_stamp_ns_, sighting.stamp_ns);
   CameraCoverage& camera = cameras_[sighting.camera];
   std::array<bool, kCoverageRegions> touched{};
   bool whole = !sighting.pixels.empty();

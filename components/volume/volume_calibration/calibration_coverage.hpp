@@ -80,6 +80,8 @@ class CalibrationCoverage {
   // In the order of the cameras given.
   const std::vector<CameraCoverage>& cameras() const { return cameras_; }
   double progress() const { return least_progress(cameras_); }
+  // The capture time of the latest sighting added (0 before any): what the coverage is as of.
+  int64_t latest_stamp_ns() const { return latest_stamp_ns_; }
 
  private:
   void update_progress(CameraCoverage& camera) const;
@@ -88,6 +90,7 @@ class CalibrationCoverage {
   std::vector<CameraCoverage> cameras_;
   // Recent capture times: the cameras that saw the board whole at each (a bit per camera).
   std::map<int64_t, uint64_t> whole_at_;
+  int64_t latest_stamp_ns_ = 0;
 };
 
 // "[=========           ] 45 %": `fraction` (0 to 1) as a bar of `width` characters.

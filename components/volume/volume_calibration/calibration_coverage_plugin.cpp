@@ -96,7 +96,6 @@ class CalibrationCoverageComponent final : public Component {
           topics::member_of(topics::kVolumeConstellations, cameras[c].name),
           [this, c](const ConstellationArray& array) {
             if (auto sighting = board_sighting(array, c, *board_)) {
-              latest_ns_ = std::max(latest_ns_, sighting->stamp_ns);
               coverage_->add(*sighting);
               ++sightings_;
             }
@@ -128,7 +127,8 @@ class CalibrationCoverageComponent final : public Component {
  private:
   // Published each period; logged when it moved.
   void report() {
-    publisher_.publish(coverage_message(coverage_->cameras(), settings_, latest_ns_));
+    publisher_.publish(
+        coverage_message(coverage_->cameras(), settings_, coverage_->latest_stamp_ns()));
     if (sightings_ != logged_sightings_) log_coverage();
   }
 
@@ -144,7 +144,6 @@ class CalibrationCoverageComponent final : public Component {
   const constellations::ConstellationModel* board_ = nullptr;
   std::optional<CalibrationCoverage> coverage_;
   Publisher<CoverageMessage> publisher_;
-  int64_t latest_ns_ = 0;
   uint64_t sightings_ = 0, logged_sightings_ = 0;
 };
 

@@ -187,6 +187,7 @@ CalibrationSessionResult run_calibration_session(
   CalibrationCoverage coverage(coverage_cameras);
   for (const BoardSighting& sighting : waved) coverage.add(sighting);
   result.coverage = coverage.cameras();
+  result.coverage_stamp_ns = coverage.latest_stamp_ns();
   std::vector<FloorPlacement> floor;
   for (size_t f = 0; f < session.floor.size(); ++f) {
     RecordingRead& read = result.floor.emplace_back();

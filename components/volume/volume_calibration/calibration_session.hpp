@@ -74,6 +74,7 @@ struct CalibrationSessionResult {
   std::vector<RecordingRead> floor;
   std::vector<FloorRecording> marks;     // the floor's, as given
   std::vector<CameraCoverage> coverage;  // of the waved session
+  int64_t coverage_stamp_ns = 0;         // its latest sighting's capture time
   VolumeCalibration calibration;
   std::vector<CalibratedCamera> cameras;  // in the camera files' order
 };

@@ -117,7 +117,8 @@ class CalibrationSolveComponent final : public Component {
     try {
       const CalibrationSessionResult result = run_calibration_session(
           session_, [this](const SessionProgress& progress) { report(progress); }, stop);
-      coverage_.publish(coverage_message(result.coverage, CoverageOptions{}, 0));
+      coverage_.publish(
+          coverage_message(result.coverage, CoverageOptions{}, result.coverage_stamp_ns));
       for (const std::string& line : problem_lines(result)) log().warn("{}", line);
       for (const std::string& line : report_lines(result)) log().info("report: {}", line);
       // Said done in the log before the page can have the result: a script that follows the log
