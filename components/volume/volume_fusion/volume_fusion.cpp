@@ -242,7 +242,8 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
     const std::vector<CameraDetections> cameras = for_body(*track);
     const double usual =
         track->usual_normalized_rms > 0 ? track->usual_normalized_rms : usual_normalized_rms_;
-    std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px, usual);
+    std::optional<Fused> fused = fuse(b, start, cameras, options_.match_radius_px, usual,
+                                      track->cameras_used >= 2 ? &start : nullptr);
     if (fused && fused->pose.cameras_used == 1) {
       // The other cameras' detections may lie beyond the radius from a prediction that one
       // camera's poor depth put off: from that camera's pose, a wider net, which the fusion's
@@ -336,46 +337,44 @@ std::vector<TrackedBodyPose> VolumeTracker::track(int64_t stamp_ns,
 
 std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     size_t body, const Eigen::Isometry3d& start, const std::vector<CameraDetections>& detections,
-    double radius_px, double usual_normalized_rms) {
+    double radius_px, double usual_normalized_rms, const Eigen::Isometry3d* fused_prediction) {
   const std::vector<Eigen::Vector3d>& markers = bodies_.bodies[body].markers;
   std::vector<CameraView> views = views_near(detections, markers, start, radius_px);
   if (points_in(views) < options_.fusion.min_points) return std::nullopt;
-  MultiCameraPose fused = estimate_multi_camera_pose(views, start, options_.fusion);
-  if (!fused.valid && fused.reprojection_rms_px > 0) {
-    // Points far off the least-squares pose: a marker an occluder cut in half (its centre
-    // moved) or one merged with a neighbour's. Without them the others may agree.
-    std::vector<CameraView> kept =
-        without_outliers(views, fused.world_from_body,
-                         kOutlierFactor * options_.fusion.max_reprojection_rms_px, Units::Pixels);
-    const int points = points_in(kept);
-    if (points >= options_.fusion.min_points && points < points_in(views)) {
-      MultiCameraPose again =
-          estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
-      if (again.valid) {
-        views = std::move(kept);
-        fused = std::move(again);
+  MultiCameraPose fused = fit_without_outliers(views, start);
+  // Of two cameras, each agrees with itself: the one whose residuals against other cameras'
+  // poses are on their way to calling it drifted, or else the one off where the fused track
+  // predicts the body, is the one to leave out. Asked at most once (it may record a residual).
+  std::optional<size_t> suspect;
+  auto suspect_of_the_two = [&] {
+    if (!suspect) {
+      suspect = suspect_of_two(views);
+      if (*suspect == views.size() && fused_prediction) {
+        suspect = off_the_prediction(views, *fused_prediction);
       }
     }
-  }
+    return *suspect;
+  };
   std::optional<size_t> left_out;
   if (!fused.valid && cameras_seeing(views) >= 2) {
-    // One camera that disagrees with the rest: the one whose removal lets them agree. Of two
-    // cameras, each agrees with itself: the one whose residuals against other cameras' poses
-    // are on their way to calling it drifted is the one left out.
+    // One camera that disagrees with the rest: the one whose removal lets them agree.
     const std::vector<double> without = rms_without_each_view_px(views, start, options_.fusion);
     size_t best = views.size();
     for (size_t c = 0; c < without.size(); ++c) {
       if (!std::isnan(without[c]) && (best == views.size() || without[c] < without[best])) best = c;
     }
-    if (cameras_seeing(views) == 2) best = suspect_of_two(views);
-    if (best < views.size() && without[best] <= options_.fusion.max_reprojection_rms_px) {
+    if (cameras_seeing(views) == 2) best = suspect_of_the_two();
+    // Without it, the others' points far off are left out as the whole fit's were: a view may
+    // hold a neighbour's marker that the fit pulled by the camera left out did not show.
+    if (best < views.size()) {
       std::vector<CameraView> others = views;
       empty_view(others[best]);
-      fused = estimate_multi_camera_pose(others, start, options_.fusion);
-      if (fused.valid) {
+      MultiCameraPose fit = fit_without_outliers(others, start);
+      if (fit.valid) {
         left_out = best;
         ++health_[best].left_out;
-        empty_view(views[best]);  // its detections stay for others
+        views = std::move(others);  // the left-out camera's detections stay for others
+        fused = std::move(fit);
       }
     }
   }
@@ -387,7 +386,8 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     MultiCameraPose without_camera = fused, without_points = fused;
     std::vector<CameraView> fewer_points = views;
     const std::optional<size_t> other =
-        disagreeing_view(views, without_camera, usual_normalized_rms);
+        disagreeing_view(views, without_camera, usual_normalized_rms,
+                         cameras_seeing(views) == 2 ? suspect_of_the_two() : views.size());
     const bool points_out =
         without_worst_points(fewer_points, without_points, usual_normalized_rms);
     if (other && !(points_out && without_points.points_used > without_camera.points_used)) {
@@ -441,6 +441,37 @@ size_t VolumeTracker::suspect_of_two(const std::vector<CameraView>& views) const
   return views.size();
 }
 
+MultiCameraPose VolumeTracker::fit_without_outliers(std::vector<CameraView>& views,
+                                                    const Eigen::Isometry3d& start) const {
+  MultiCameraPose fused = estimate_multi_camera_pose(views, start, options_.fusion);
+  if (fused.valid || !(fused.reprojection_rms_px > 0)) return fused;
+  std::vector<CameraView> kept =
+      without_outliers(views, fused.world_from_body,
+                       kOutlierFactor * options_.fusion.max_reprojection_rms_px, Units::Pixels);
+  const int points = points_in(kept);
+  if (points < options_.fusion.min_points || points == points_in(views)) return fused;
+  MultiCameraPose again = estimate_multi_camera_pose(kept, fused.world_from_body, options_.fusion);
+  if (!again.valid) return fused;
+  views = std::move(kept);
+  return again;
+}
+
+size_t VolumeTracker::off_the_prediction(const std::vector<CameraView>& views,
+                                         const Eigen::Isometry3d& prediction) {
+  std::vector<size_t> seeing;
+  for (size_t c = 0; c < views.size(); ++c) {
+    if (!views[c].pixels.empty()) seeing.push_back(c);
+  }
+  const double a = view_median_error_px(views[seeing[0]], prediction);
+  const double b = view_median_error_px(views[seeing[1]], prediction);
+  const double on = options_.fusion.max_reprojection_rms_px;
+  size_t off = views.size();
+  if (a > options_.drift_px && b <= on) off = seeing[0];
+  if (b > options_.drift_px && a <= on) off = seeing[1];
+  if (off < views.size()) record_residual(off, off == seeing[0] ? a : b);
+  return off;
+}
+
 bool VolumeTracker::without_worst_points(std::vector<CameraView>& views, MultiCameraPose& fused,
                                          double usual_normalized_rms) const {
   std::vector<CameraView> kept = views;
@@ -476,7 +507,8 @@ bool VolumeTracker::without_worst_points(std::vector<CameraView>& views, MultiCa
 
 std::optional<size_t> VolumeTracker::disagreeing_view(const std::vector<CameraView>& views,
                                                       MultiCameraPose& fused,
-                                                      double usual_normalized_rms) const {
+                                                      double usual_normalized_rms,
+                                                      size_t suspect) const {
   // What each view adds to the fit's chi-square, per residual of its own: about one for a view
   // that agrees with the others (in units of the usual), far more for one that does not.
   const double usual = expected_rms(usual_normalized_rms);
@@ -485,7 +517,7 @@ std::optional<size_t> VolumeTracker::disagreeing_view(const std::vector<CameraVi
   MultiCameraPose worst_fit;
   double worst_added = kDisagreeingSigmas * kDisagreeingSigmas * usual * usual;
   for (size_t v = 0; v < views.size(); ++v) {
-    if (views[v].pixels.empty()) continue;
+    if (views[v].pixels.empty() || (suspect < views.size() && v != suspect)) continue;
     std::vector<CameraView> others = views;
     empty_view(others[v]);
     if (points_in(others) < options_.fusion.min_points) continue;

@@ -138,13 +138,27 @@ class VolumeTracker {
   // puts its markers, with a disagreeing camera left out when the others agree without it:
   // one whose points make the fit fail, or one whose points raise the fit's residuals well
   // above `usual_normalized_rms` (what the body's fits usually have) where the others' alone
-  // are as usual.
+  // are as usual. Of two cameras that disagree, where neither one's residuals so far say which
+  // is off, `fused_prediction` (where a track that several cameras fused puts the body now; null
+  // for none) tells: see off_the_prediction.
   std::optional<Fused> fuse(size_t body, const Eigen::Isometry3d& start,
                             const std::vector<CameraDetections>& detections, double radius_px,
-                            double usual_normalized_rms);
+                            double usual_normalized_rms,
+                            const Eigen::Isometry3d* fused_prediction = nullptr);
+  // The pose fitted to `views` from `start`; where it fails, fitted again without the points
+  // far off it (a marker an occluder cut in half, its centre moved, or one merged with a
+  // neighbour's: without them the others may agree), `views` then left without them.
+  MultiCameraPose fit_without_outliers(std::vector<CameraView>& views,
+                                       const Eigen::Isometry3d& start) const;
   // Of the two views with points, the camera whose residuals say it is on its way to being
   // called drifted while the other's do not; views.size() when neither stands out.
   size_t suspect_of_two(const std::vector<CameraView>& views) const;
+  // Of the two views with points, the camera whose points lie beyond drift_px of where
+  // `prediction` puts them while the other's lie within the fusion's RMS limit; views.size()
+  // when neither. Its error is recorded as a residual (the prediction rests on other cameras'
+  // poses), so that it stays the suspect once the track goes on from the other camera alone.
+  size_t off_the_prediction(const std::vector<CameraView>& views,
+                            const Eigen::Isometry3d& prediction);
   // Leaves the points furthest off out of `views`, one by one (a few at most), and refits
   // `fused`, when that brings the fit's residuals back to the usual; false (nothing changed)
   // otherwise.
@@ -152,8 +166,10 @@ class VolumeTracker {
                             double usual_normalized_rms) const;
   // The view whose points disagree with the others' (disagreeing above), `fused` refitted
   // without it; nullopt when leaving no one view out brings the residuals back to the usual.
+  // Of two views each fits alone: a `suspect` (below views.size()) is the only one looked at.
   std::optional<size_t> disagreeing_view(const std::vector<CameraView>& views,
-                                         MultiCameraPose& fused, double usual_normalized_rms) const;
+                                         MultiCameraPose& fused, double usual_normalized_rms,
+                                         size_t suspect) const;
   // A marker merged with a neighbour's, half hidden by another board, or another body's taken
   // for one of this body's moves its pixel by a pixel or more where the rest agree within a
   // tenth: a few such points stay under the RMS limit yet tilt the pose. The points far above
