@@ -86,6 +86,28 @@ struct Sequence {
 
 int64_t stamp_of(int frame) { return static_cast<int64_t>(frame * 1e9 / kRate_hz); }
 
+// The board of eight markers at `truth` as each camera whose `sees` is set sees it through
+// `extrinsics` (the cameras' true places), with 0.1 px of noise; every camera's message came.
+std::vector<CameraFrame> board_frame(const test::Volume& volume,
+                                     const std::vector<Eigen::Isometry3d>& extrinsics,
+                                     const Eigen::Isometry3d& truth, int64_t stamp_ns,
+                                     const std::vector<bool>& sees, std::mt19937& random) {
+  std::normal_distribution<double> noise(0, 0.1);
+  std::vector<CameraFrame> frame(extrinsics.size());
+  for (size_t c = 0; c < extrinsics.size(); ++c) {
+    frame[c] = {true, stamp_ns, {}, {}};
+    if (!sees[c]) continue;
+    for (const Eigen::Vector3d& marker : test::kBoard) {
+      const Eigen::Vector3d in_camera = extrinsics[c] * truth * marker;
+      const auto pixel = volume.camera->project(in_camera);
+      if (in_camera.z() <= 0 || !pixel || !volume.camera->in_image(*pixel)) continue;
+      frame[c].pixels.push_back(*pixel + test::draws<2>(noise, random));
+      frame[c].pixel_sigma_px.push_back(0.1);
+    }
+  }
+  return frame;
+}
+
 double position_error(const TrackedBodyPose& pose, const std::vector<Eigen::Isometry3d>& truth) {
   const size_t b = pose.name == "helmet" ? 0 : 1;
   return (pose.world_from_body.translation() - truth[b].translation()).norm();
@@ -175,23 +197,14 @@ TEST(VolumeTracker, OneCameraAloneKeepsATrackFlaggedAsSuch) {
   const std::vector<VolumeCamera> cameras = cameras_of(volume);
   VolumeTracker tracker(cameras, bodies);
   std::mt19937 random(7);
-  std::normal_distribution<double> noise(0, 0.1);
   int single = 0, beyond_three_sigma = 0;
   std::vector<double> errors;
   for (int f = 0; f < 360; ++f) {
     const Eigen::Isometry3d truth = truth_at(f / kRate_hz)[0];
-    std::vector<CameraFrame> frame(cameras.size());
-    for (size_t c = 0; c < cameras.size(); ++c) {
-      frame[c] = {true, stamp_of(f), {}, {}};
-      if (f >= 120 && c != 0) continue;
-      for (const Eigen::Vector3d& marker : test::kBoard) {
-        const Eigen::Vector3d in_camera = volume.extrinsics[c] * truth * marker;
-        const auto pixel = volume.camera->project(in_camera);
-        if (in_camera.z() <= 0 || !pixel || !volume.camera->in_image(*pixel)) continue;
-        frame[c].pixels.push_back(*pixel + test::draws<2>(noise, random));
-        frame[c].pixel_sigma_px.push_back(0.1);
-      }
-    }
+    std::vector<bool> sees(cameras.size(), f < 120);
+    sees[0] = true;
+    const std::vector<CameraFrame> frame =
+        board_frame(volume, volume.extrinsics, truth, stamp_of(f), sees, random);
     for (const TrackedBodyPose& pose : tracker.track(stamp_of(f), frame)) {
       if (f < 120) continue;
       EXPECT_EQ(pose.cameras_used, 1) << "frame " << f;
@@ -228,24 +241,14 @@ TEST(VolumeTracker, OfTwoCamerasThatDisagreeTheOneOffTheFusedTrackIsLeftOut) {
   std::vector<Eigen::Isometry3d> actual = volume.extrinsics;
   actual[1] = Eigen::AngleAxisd(0.25 * test::kPi / 180, Eigen::Vector3d::UnitY()) * actual[1];
   std::mt19937 random(11);
-  std::normal_distribution<double> noise(0, 0.1);
   int posed = 0;
   std::vector<double> errors;
   for (int f = 0; f < 360; ++f) {
     const Eigen::Isometry3d truth = truth_at(f / kRate_hz)[0];
-    std::vector<CameraFrame> frame(actual.size());
-    for (size_t c = 0; c < actual.size(); ++c) {
-      frame[c] = {true, stamp_of(f), {}, {}};
-      const bool sees = f < 120 ? (c == 0 || c == 2) : (c == 1 || c == 2);
-      if (!sees) continue;
-      for (const Eigen::Vector3d& marker : test::kBoard) {
-        const Eigen::Vector3d in_camera = actual[c] * truth * marker;
-        const auto pixel = volume.camera->project(in_camera);
-        if (in_camera.z() <= 0 || !pixel || !volume.camera->in_image(*pixel)) continue;
-        frame[c].pixels.push_back(*pixel + test::draws<2>(noise, random));
-        frame[c].pixel_sigma_px.push_back(0.1);
-      }
-    }
+    const std::vector<bool> sees = f < 120 ? std::vector<bool>{true, false, true, false}
+                                           : std::vector<bool>{false, true, true, false};
+    const std::vector<CameraFrame> frame =
+        board_frame(volume, actual, truth, stamp_of(f), sees, random);
     for (const TrackedBodyPose& pose : tracker.track(stamp_of(f), frame)) {
       if (f < 120) continue;
       ++posed;
