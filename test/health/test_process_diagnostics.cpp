@@ -169,5 +169,34 @@ TEST(RateFigures, WarnsBelowTheExpectedRateFromTheSecondReportOn) {
   EXPECT_EQ(fast.values[0], (std::pair<std::string, std::string>("frames expected (Hz)", "0.0")));
 }
 
+// Judged over the last five periods: a 30 Hz camera that stalled for a fifth of a second once
+// (24 frames in one second) is not flagged; one that stays at 24 Hz is, from the period where
+// the window falls below 27 Hz; once it stops, it starts a window of its own.
+TEST(RateFigures, AStallOfOnePeriodIsNotAStreamTooSlow) {
+  using std::chrono::seconds;
+  RateFigures rate;
+  std::chrono::steady_clock::time_point now{};
+  auto period = [&](int frames) {
+    for (int i = 0; i < frames; ++i) rate.add();
+    now += seconds(1);
+    HealthReport report;
+    rate.report(report, "frames", 30, "the host is too busy", now);
+    return report;
+  };
+  period(30);  // the start's
+  for (int s = 0; s < 4; ++s) EXPECT_EQ(period(30).level, HealthLevel::ok);
+  const HealthReport stalled = period(24);
+  EXPECT_EQ(stalled.level, HealthLevel::ok) << stalled.message;
+  EXPECT_EQ(stalled.values[1].second, "28.8");   // (4 x 30 + 24) / 5
+  EXPECT_EQ(period(24).level, HealthLevel::ok);  // 27.6 Hz
+  const HealthReport slow = period(24);          // 26.4 Hz
+  EXPECT_EQ(slow.level, HealthLevel::warn);
+  EXPECT_EQ(slow.message, "frames at 26.4 Hz of 30.0: the host is too busy");
+  EXPECT_EQ(period(0).values[1].second, "0.0");
+  const HealthReport again = period(30);
+  EXPECT_EQ(again.level, HealthLevel::ok);
+  EXPECT_EQ(again.values[1].second, "30.0");
+}
+
 }  // namespace
 }  // namespace mocap::health

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -56,20 +57,31 @@ class LatencyFigures {
   std::vector<int64_t> samples_;
 };
 
-// A stream's rate over each report's period against the rate it should have (a camera's
-// frames against its rate_hz): report() adds "<what> (Hz)" and "<what> expected (Hz)", and
-// flags WARN with `why_low` when it ran below 90 % of it. A stream that stopped (0 Hz: a camera
-// waiting for its first subscriber) is left to who reads it. The first period, which holds the
-// start, is not judged. Thread-safe.
+// A stream's rate against the rate it should have (a camera's frames against its rate_hz),
+// over the last kWindow reports' periods (about 5 s), as ROS's diagnostic_updater judges a
+// frequency by default: one stall of a fifth of a second on a busy host is not a stream too
+// slow, a stream that stays slow is. report() adds "<what> (Hz)" and "<what> expected (Hz)",
+// and flags WARN with `why_low` when the window ran below 90 % of it. A stream that stopped
+// (none in the last period: a camera waiting for its first subscriber) shows 0 Hz, is left to
+// who reads it, and starts a new window. The first period, which holds the start, is not
+// judged. Thread-safe.
 class RateFigures {
  public:
+  static constexpr size_t kWindow = 5;
+
   void add() { count_.fetch_add(1, std::memory_order_relaxed); }
   void report(HealthReport& report, std::string_view what, double expected_hz,
-              std::string_view why_low);
+              std::string_view why_low,
+              std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now());
 
  private:
+  struct Period {
+    uint64_t count = 0;
+    std::chrono::steady_clock::duration length{};
+  };
   std::atomic<uint64_t> count_{0};
   std::optional<std::chrono::steady_clock::time_point> since_;
+  std::deque<Period> window_;  // the last kWindow periods, newest last
 };
 
 // What the runtime counts for one topic of a component, since the component started.

@@ -50,8 +50,7 @@ void LatencyFigures::report(HealthReport& report, std::string_view stage) {
 }
 
 void RateFigures::report(HealthReport& report, std::string_view what, double expected_hz,
-                         std::string_view why_low) {
-  const auto now = std::chrono::steady_clock::now();
+                         std::string_view why_low, std::chrono::steady_clock::time_point now) {
   const uint64_t count = count_.exchange(0, std::memory_order_relaxed);
   const std::optional<std::chrono::steady_clock::time_point> since = since_;
   since_ = now;
@@ -60,10 +59,22 @@ void RateFigures::report(HealthReport& report, std::string_view what, double exp
     report.add(fmt::format("{} (Hz)", what), "-");
     return;
   }
-  const double hz =
-      static_cast<double>(count) / std::chrono::duration<double>(now - *since).count();
+  if (count == 0) {
+    window_.clear();
+    report.add(fmt::format("{} (Hz)", what), "0.0");
+    return;
+  }
+  window_.push_back({count, now - *since});
+  if (window_.size() > kWindow) window_.pop_front();
+  uint64_t counted = 0;
+  std::chrono::steady_clock::duration length{};
+  for (const Period& period : window_) {
+    counted += period.count;
+    length += period.length;
+  }
+  const double hz = static_cast<double>(counted) / std::chrono::duration<double>(length).count();
   report.add(fmt::format("{} (Hz)", what), fmt::format("{:.1f}", hz));
-  if (hz > 0 && hz < 0.9 * expected_hz) {
+  if (hz < 0.9 * expected_hz) {
     report.flag(HealthLevel::warn,
                 fmt::format("{} at {:.1f} Hz of {:.1f}: {}", what, hz, expected_hz, why_low));
   }
