@@ -273,8 +273,8 @@ TEST(VolumeDemo, ACameraKilledUnderTheLauncherIsRestartedAndFusedAgain) {
 // Tracked: 98 %, the figure of a camera away, which cam_1 is once named. Until then, a board that
 // cam_1 and one other camera see (their views disagree by 4 px, each agrees with itself) is posed
 // from the other camera once cam_1's residuals, or the board's track that other cameras fused,
-// mark cam_1 out; the other camera's view is fitted without its far-off points. Without these,
-// such a board went unposed for 2 s in 2 runs of about 20 (97.2 % and 97.5 % tracked).
+// mark cam_1 out; the other camera's view is then fitted without its far-off points, as a whole
+// fit is. Without that, such a board went unposed for up to 2 s (97.2 % tracked in a CI run).
 // Counted from the second second, as the other volume tests are: the first is the camera
 // processes coming up (81 % in a CI run that then missed the bound with 97.7 % over the run,
 // 99.1 % without it).
