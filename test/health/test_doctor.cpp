@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <regex>
@@ -218,6 +219,7 @@ TEST_F(Doctor, NamesAHostWhoseClockDisagrees) {
       output, ahead,
       std::regex(R"(problem: the clock of source on \S+ is ([0-9.]+) ms ahead of this host's)")))
       << output;
+  std::printf("source's clock measured %s ms ahead (set 5 ms ahead)\n", ahead[1].str().c_str());
   EXPECT_NEAR(std::stod(ahead[1]), 5.0, 0.1) << output;
   EXPECT_EQ(output.find("the clock of sink"), std::string::npos) << output;
 }
