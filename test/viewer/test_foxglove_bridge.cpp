@@ -312,8 +312,13 @@ TEST_F(FoxgloveBridgeTest, RosOwnDefinitionsDecodeTheDiagnostics) {
     return "(none)";
   };
   EXPECT_EQ(value(statuses["robot"], "restarts"), "0");
-  // The camera's 30 Hz, and its fiducials' latency from the capture stamp.
-  EXPECT_NEAR(std::stod(value(statuses["robot/camera"], "out /camera/ir/image_raw (msg/s)")), 30, 3)
+  // The camera's 30 Hz as it judges its rate (over the last five periods: in one second beside
+  // CI's calibration test its images came at 24 a second, a stall of a fifth of a second), the
+  // runtime's count of its images over the last period, and its fiducials' latency from the
+  // capture stamp.
+  EXPECT_NEAR(std::stod(value(statuses["robot/camera"], "frames (Hz)")), 30, 3)
+      << statuses["robot/camera"].dump();
+  EXPECT_GT(std::stod(value(statuses["robot/camera"], "out /camera/ir/image_raw (msg/s)")), 0)
       << statuses["robot/camera"].dump();
   EXPECT_GT(std::stod(value(statuses["robot/tracker"], "capture -> fiducials sent median (ms)")), 0)
       << statuses["robot/tracker"].dump();
