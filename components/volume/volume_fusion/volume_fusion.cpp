@@ -358,12 +358,17 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   std::optional<size_t> left_out;
   if (!fused.valid && cameras_seeing(views) >= 2) {
     // One camera that disagrees with the rest: the one whose removal lets them agree.
-    const std::vector<double> without = rms_without_each_view_px(views, start, options_.fusion);
     size_t best = views.size();
-    for (size_t c = 0; c < without.size(); ++c) {
-      if (!std::isnan(without[c]) && (best == views.size() || without[c] < without[best])) best = c;
+    if (cameras_seeing(views) == 2) {
+      best = suspect_of_the_two();
+    } else {
+      const std::vector<double> without = rms_without_each_view_px(views, start, options_.fusion);
+      for (size_t c = 0; c < without.size(); ++c) {
+        if (!std::isnan(without[c]) && (best == views.size() || without[c] < without[best])) {
+          best = c;
+        }
+      }
     }
-    if (cameras_seeing(views) == 2) best = suspect_of_the_two();
     // Without it, the others' points far off are left out as the whole fit's were: a view may
     // hold a neighbour's marker that the fit pulled by the camera left out did not show.
     if (best < views.size()) {
