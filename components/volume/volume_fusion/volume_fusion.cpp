@@ -342,25 +342,12 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   std::vector<CameraView> views = views_near(detections, markers, start, radius_px);
   if (points_in(views) < options_.fusion.min_points) return std::nullopt;
   MultiCameraPose fused = fit_without_outliers(views, start);
-  // Of two cameras, each agrees with itself: the one whose residuals against other cameras'
-  // poses are on their way to calling it drifted, or else the one off where the fused track
-  // predicts the body, is the one to leave out. Asked at most once (it may record a residual).
-  std::optional<size_t> suspect;
-  auto suspect_of_the_two = [&] {
-    if (!suspect) {
-      suspect = suspect_of_two(views);
-      if (*suspect == views.size() && fused_prediction) {
-        suspect = off_the_prediction(views, *fused_prediction);
-      }
-    }
-    return *suspect;
-  };
   std::optional<size_t> left_out;
   if (!fused.valid && cameras_seeing(views) >= 2) {
     // One camera that disagrees with the rest: the one whose removal lets them agree.
     size_t best = views.size();
     if (cameras_seeing(views) == 2) {
-      best = suspect_of_the_two();
+      best = suspect_of_two(views, fused_prediction);
     } else {
       const std::vector<double> without = rms_without_each_view_px(views, start, options_.fusion);
       for (size_t c = 0; c < without.size(); ++c) {
@@ -390,9 +377,9 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
     // A camera's points, or a few worst points: whichever keeps more of the fit's points.
     MultiCameraPose without_camera = fused, without_points = fused;
     std::vector<CameraView> fewer_points = views;
-    const std::optional<size_t> other =
-        disagreeing_view(views, without_camera, usual_normalized_rms,
-                         cameras_seeing(views) == 2 ? suspect_of_the_two() : views.size());
+    const std::optional<size_t> other = disagreeing_view(
+        views, without_camera, usual_normalized_rms,
+        cameras_seeing(views) == 2 ? suspect_of_two(views, fused_prediction) : views.size());
     const bool points_out =
         without_worst_points(fewer_points, without_points, usual_normalized_rms);
     if (other && !(points_out && without_points.points_used > without_camera.points_used)) {
@@ -433,7 +420,8 @@ std::optional<VolumeTracker::Fused> VolumeTracker::fuse(
   return result;
 }
 
-size_t VolumeTracker::suspect_of_two(const std::vector<CameraView>& views) const {
+size_t VolumeTracker::suspect_of_two(const std::vector<CameraView>& views,
+                                     const Eigen::Isometry3d* fused_prediction) {
   std::vector<size_t> seeing;
   for (size_t c = 0; c < views.size(); ++c) {
     if (!views[c].pixels.empty()) seeing.push_back(c);
@@ -443,6 +431,21 @@ size_t VolumeTracker::suspect_of_two(const std::vector<CameraView>& views) const
   const double suspicious = kSuspectFraction * options_.drift_px;
   if (a.average_error_px > suspicious && b.average_error_px < suspicious / 2) return seeing[0];
   if (b.average_error_px > suspicious && a.average_error_px < suspicious / 2) return seeing[1];
+  if (fused_prediction == nullptr) return views.size();
+  // Off where the track puts the body: its error goes into its residuals (the prediction rests
+  // on other cameras' poses), so that it stays the suspect once the track goes on from the
+  // other camera alone.
+  const double error_a = view_median_error_px(views[seeing[0]], *fused_prediction);
+  const double error_b = view_median_error_px(views[seeing[1]], *fused_prediction);
+  const double on = options_.fusion.max_reprojection_rms_px;
+  if (error_a > options_.drift_px && error_b <= on) {
+    record_residual(seeing[0], error_a);
+    return seeing[0];
+  }
+  if (error_b > options_.drift_px && error_a <= on) {
+    record_residual(seeing[1], error_b);
+    return seeing[1];
+  }
   return views.size();
 }
 
@@ -459,22 +462,6 @@ MultiCameraPose VolumeTracker::fit_without_outliers(std::vector<CameraView>& vie
   if (!again.valid) return fused;
   views = std::move(kept);
   return again;
-}
-
-size_t VolumeTracker::off_the_prediction(const std::vector<CameraView>& views,
-                                         const Eigen::Isometry3d& prediction) {
-  std::vector<size_t> seeing;
-  for (size_t c = 0; c < views.size(); ++c) {
-    if (!views[c].pixels.empty()) seeing.push_back(c);
-  }
-  const double a = view_median_error_px(views[seeing[0]], prediction);
-  const double b = view_median_error_px(views[seeing[1]], prediction);
-  const double on = options_.fusion.max_reprojection_rms_px;
-  size_t off = views.size();
-  if (a > options_.drift_px && b <= on) off = seeing[0];
-  if (b > options_.drift_px && a <= on) off = seeing[1];
-  if (off < views.size()) record_residual(off, off == seeing[0] ? a : b);
-  return off;
 }
 
 bool VolumeTracker::without_worst_points(std::vector<CameraView>& views, MultiCameraPose& fused,

@@ -138,9 +138,8 @@ class VolumeTracker {
   // puts its markers, with a disagreeing camera left out when the others agree without it:
   // one whose points make the fit fail, or one whose points raise the fit's residuals well
   // above `usual_normalized_rms` (what the body's fits usually have) where the others' alone
-  // are as usual. Of two cameras that disagree, where neither one's residuals so far say which
-  // is off, `fused_prediction` (where a track that several cameras fused puts the body now; null
-  // for none) tells: see off_the_prediction.
+  // are as usual. Of two cameras that disagree, `fused_prediction` (where a track that several
+  // cameras fused puts the body now; null for none) may tell which is off: see suspect_of_two.
   std::optional<Fused> fuse(size_t body, const Eigen::Isometry3d& start,
                             const std::vector<CameraDetections>& detections, double radius_px,
                             double usual_normalized_rms,
@@ -150,15 +149,13 @@ class VolumeTracker {
   // neighbour's: without them the others may agree), `views` then left without them.
   MultiCameraPose fit_without_outliers(std::vector<CameraView>& views,
                                        const Eigen::Isometry3d& start) const;
-  // Of the two views with points, the camera whose residuals say it is on its way to being
-  // called drifted while the other's do not; views.size() when neither stands out.
-  size_t suspect_of_two(const std::vector<CameraView>& views) const;
-  // Of the two views with points, the camera whose points lie beyond drift_px of where
-  // `prediction` puts them while the other's lie within the fusion's RMS limit; views.size()
-  // when neither. Its error is recorded as a residual (the prediction rests on other cameras'
-  // poses), so that it stays the suspect once the track goes on from the other camera alone.
-  size_t off_the_prediction(const std::vector<CameraView>& views,
-                            const Eigen::Isometry3d& prediction);
+  // Of the two views with points (each agrees with itself), the camera to leave out: the one
+  // whose residuals say it is on its way to being called drifted while the other's do not;
+  // else, given a `fused_prediction`, the one whose points lie beyond drift_px of where it puts
+  // them while the other's lie within the fusion's RMS limit, its error then recorded as a
+  // residual. views.size() when neither stands out.
+  size_t suspect_of_two(const std::vector<CameraView>& views,
+                        const Eigen::Isometry3d* fused_prediction);
   // Leaves the points furthest off out of `views`, one by one (a few at most), and refits
   // `fused`, when that brings the fit's residuals back to the usual; false (nothing changed)
   // otherwise.
